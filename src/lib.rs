@@ -1,0 +1,4 @@
+//! candela — a spectral path tracer whose output is measured light.
+//!
+//! Every pixel is a calibrated photometric quantity (luminance in cd/m², illuminance in lux);
+//! internally everything is spectral radiometry (W·m⁻²·sr⁻¹·nm⁻¹).
