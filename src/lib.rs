@@ -2,3 +2,23 @@
 //!
 //! Every pixel is a calibrated photometric quantity (luminance in cd/m², illuminance in lux);
 //! internally everything is spectral radiometry (W·m⁻²·sr⁻¹·nm⁻¹).
+//!
+//! Data flow: `scene` (RON) → `world` (spectra resolved, lights in W, one BVH) →
+//! `integrator` per sample → `film` (absolute XYZ sums) → `output` (EXR, PNG).
+
+pub mod bench;
+pub mod bxdf;
+pub mod camera;
+pub mod cli_colour;
+pub mod colour;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod light;
+pub mod output;
+pub mod photometry;
+pub mod render;
+pub mod sampler;
+pub mod scene;
+pub mod spectrum;
+pub mod world;

@@ -1,0 +1,126 @@
+//! Scattering: the [`Material`] enum and its BSDF interface, in the local shading frame where
+//! the normal is +z.
+//!
+//! Conventions (as pbrt-v4): `wo` points toward the viewer (back along the incoming path),
+//! `wi` toward the light; both are unit vectors leaving the surface. `eval` returns f(wo, wi)
+//! in sr⁻¹ without the cosine; `sample` returns f, the sampled `wi` and its pdf w.r.t. solid
+//! angle. Each material family lives in its own file.
+
+pub mod diffuse;
+
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
+
+pub use diffuse::Diffuse;
+
+/// Every material the renderer knows. The integrator only calls the methods below, so a new
+/// family is one new variant and one new file.
+#[derive(Clone, Debug)]
+pub enum Material {
+    /// Lambertian reflection.
+    Diffuse(Diffuse),
+    /// Absorbs everything (an emitter that reflects nothing, or a light-trap).
+    Black,
+}
+
+/// Result of sampling a BSDF.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// Sampled incident direction (local frame).
+    pub wi: Vec3,
+    /// f(wo, wi), sr⁻¹ (for a specular lobe: the lobe's weight divided by |cos θi|).
+    pub f: SampledSpectrum,
+    /// Density of `wi` w.r.t. solid angle (for a specular lobe: the discrete probability).
+    pub pdf: f32,
+    /// Delta distribution: no MIS with light sampling.
+    pub specular: bool,
+}
+
+impl Material {
+    pub fn eval(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Material::Diffuse(d) => d.eval(wo, wi, wl),
+            Material::Black => SampledSpectrum::ZERO,
+        }
+    }
+    /// `uc` chooses between lobes; `u` samples the lobe.
+    pub fn sample(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        wl: &mut SampledWavelengths,
+    ) -> Option<BsdfSample> {
+        let _ = uc;
+        match self {
+            Material::Diffuse(d) => d.sample(wo, u, wl),
+            Material::Black => None,
+        }
+    }
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self {
+            Material::Diffuse(d) => d.pdf(wo, wi),
+            Material::Black => 0.0,
+        }
+    }
+    /// True if the material scatters nothing, so paths can stop at it.
+    pub fn is_black(&self) -> bool {
+        matches!(self, Material::Black)
+    }
+}
+
+/// An orthonormal frame (tangent, bitangent, normal).
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    pub t: Vec3,
+    pub b: Vec3,
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// Frame around a unit normal (Duff et al. 2017, "Building an Orthonormal Basis, Revisited").
+    pub fn from_normal(n: Vec3) -> Self {
+        let sign = 1.0f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let t = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let bt = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+        Self { t, b: bt, n }
+    }
+    #[inline]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
+    }
+    #[inline]
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.t * v.x + self.b * v.y + self.n * v.z
+    }
+}
+
+/// Cosine-weighted direction on the +z hemisphere (Malley's method); pdf = cos θ / π.
+pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = crate::camera::concentric_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+#[inline]
+pub fn same_hemisphere(a: Vec3, b: Vec3) -> bool {
+    a.z * b.z > 0.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal() {
+        for n in [Vec3::Z, -Vec3::Z, Vec3::new(0.3, -0.4, 0.866).normalize(), Vec3::X] {
+            let f = Frame::from_normal(n);
+            assert!(f.t.dot(f.b).abs() < 1e-6 && f.t.dot(f.n).abs() < 1e-6);
+            assert!((f.t.length() - 1.0).abs() < 1e-6 && (f.b.length() - 1.0).abs() < 1e-6);
+            let v = Vec3::new(0.2, 0.5, -0.7);
+            assert!((f.to_world(f.to_local(v)) - v).length() < 1e-6);
+        }
+    }
+}

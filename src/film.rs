@@ -1,0 +1,166 @@
+//! The film: per-pixel accumulation of absolute CIE 1931 2° XYZ.
+//!
+//! One camera sample with wavelengths λᵢ (densities pᵢ) and radiance L(λᵢ) contributes
+//! `X = K_m · (1/N) Σᵢ L(λᵢ) x̄(λᵢ) / pᵢ` (likewise Y, Z), an unbiased estimate of
+//! `K_m ∫ L(λ) x̄(λ) dλ`. Y is then luminance in cd/m² because ȳ = V(λ).
+//! Sums are kept in f64: f32 sums drift by percents past ~2²⁰ samples per pixel.
+
+use crate::colour::tables::{cmfs, Observer};
+use crate::photometry::K_M;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, DENSE_LEN, LAMBDA_MIN, N_LAMBDA};
+use std::sync::LazyLock;
+
+/// The CIE 1931 2° colour-matching functions as f32 tables for the hot path (from the colour
+/// library's 1 nm data).
+pub struct FilmCmfs {
+    pub x: [f32; DENSE_LEN],
+    pub y: [f32; DENSE_LEN],
+    pub z: [f32; DENSE_LEN],
+}
+
+static FILM_CMFS: LazyLock<FilmCmfs> = LazyLock::new(|| {
+    let c = cmfs(Observer::Cie1931_2);
+    let mut t = FilmCmfs {
+        x: [0.0; DENSE_LEN],
+        y: [0.0; DENSE_LEN],
+        z: [0.0; DENSE_LEN],
+    };
+    for i in 0..DENSE_LEN {
+        t.x[i] = c.x[i] as f32;
+        t.y[i] = c.y[i] as f32;
+        t.z[i] = c.z[i] as f32;
+    }
+    t
+});
+
+#[inline]
+fn lerp_table(t: &[f32; DENSE_LEN], lambda: f32) -> f32 {
+    let x = lambda - LAMBDA_MIN;
+    if !(0.0..=(DENSE_LEN - 1) as f32).contains(&x) {
+        return 0.0;
+    }
+    let i = (x as usize).min(DENSE_LEN - 2);
+    let f = x - i as f32;
+    t[i] * (1.0 - f) + t[i + 1] * f
+}
+
+/// Absolute XYZ (Y in cd/m² when `l` is radiance in W·m⁻²·sr⁻¹·nm⁻¹) estimated from one
+/// sample's spectral radiance. Lanes with pdf 0 (terminated secondaries) contribute nothing.
+#[inline]
+pub fn radiance_to_xyz(l: &SampledSpectrum, wl: &SampledWavelengths) -> [f64; 3] {
+    let c = &*FILM_CMFS;
+    let mut xyz = [0.0f64; 3];
+    for i in 0..N_LAMBDA {
+        if wl.pdf[i] == 0.0 || l.0[i] == 0.0 {
+            continue;
+        }
+        let w = l.0[i] as f64 / wl.pdf[i] as f64;
+        xyz[0] += w * lerp_table(&c.x, wl.lambda[i]) as f64;
+        xyz[1] += w * lerp_table(&c.y, wl.lambda[i]) as f64;
+        xyz[2] += w * lerp_table(&c.z, wl.lambda[i]) as f64;
+    }
+    let k = K_M / N_LAMBDA as f64;
+    [xyz[0] * k, xyz[1] * k, xyz[2] * k]
+}
+
+/// Running sums for one pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelSums {
+    pub sum_xyz: [f64; 3],
+    /// Σ Y², for the sample variance of luminance.
+    pub sum_y2: f64,
+    pub count: u64,
+}
+
+impl PixelSums {
+    #[inline]
+    pub fn add(&mut self, xyz: [f64; 3]) {
+        self.sum_xyz[0] += xyz[0];
+        self.sum_xyz[1] += xyz[1];
+        self.sum_xyz[2] += xyz[2];
+        self.sum_y2 += xyz[1] * xyz[1];
+        self.count += 1;
+    }
+    pub fn merge(&mut self, o: &PixelSums) {
+        for k in 0..3 {
+            self.sum_xyz[k] += o.sum_xyz[k];
+        }
+        self.sum_y2 += o.sum_y2;
+        self.count += o.count;
+    }
+    /// Mean absolute XYZ.
+    pub fn mean_xyz(&self) -> [f64; 3] {
+        if self.count == 0 {
+            return [0.0; 3];
+        }
+        let n = self.count as f64;
+        [
+            self.sum_xyz[0] / n,
+            self.sum_xyz[1] / n,
+            self.sum_xyz[2] / n,
+        ]
+    }
+    /// Standard error of the mean luminance, √(s²/n) with the unbiased sample variance s².
+    pub fn y_standard_error(&self) -> f64 {
+        if self.count < 2 {
+            return 0.0;
+        }
+        let n = self.count as f64;
+        let mean = self.sum_xyz[1] / n;
+        let var = ((self.sum_y2 - n * mean * mean) / (n - 1.0)).max(0.0);
+        (var / n).sqrt()
+    }
+}
+
+/// The whole image's sums.
+#[derive(Clone, Debug)]
+pub struct Film {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<PixelSums>,
+}
+
+impl Film {
+    pub fn new(width: usize, height: usize) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![PixelSums::default(); width * height],
+        }
+    }
+    /// Mean XYZ per pixel as f32 (row-major).
+    pub fn xyz_image(&self) -> Vec<[f32; 3]> {
+        self.pixels
+            .iter()
+            .map(|p| {
+                let m = p.mean_xyz();
+                [m[0] as f32, m[1] as f32, m[2] as f32]
+            })
+            .collect()
+    }
+    pub fn y_stderr_image(&self) -> Vec<f32> {
+        self.pixels
+            .iter()
+            .map(|p| p.y_standard_error() as f32)
+            .collect()
+    }
+    pub fn total_samples(&self) -> u64 {
+        self.pixels.iter().map(|p| p.count).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn standard_error_of_known_samples() {
+        let mut p = PixelSums::default();
+        for y in [1.0, 2.0, 3.0, 4.0] {
+            p.add([0.0, y, 0.0]);
+        }
+        // s² = 5/3, se = sqrt(5/12)
+        assert!((p.y_standard_error() - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
+        assert_eq!(p.mean_xyz()[1], 2.5);
+    }
+}

@@ -1,0 +1,207 @@
+//! Unidirectional spectral path tracing with next-event estimation and multiple importance
+//! sampling (Veach 1997, power heuristic β = 2), Russian roulette and a maximum depth.
+//!
+//! The integrator only talks to materials through [`crate::bxdf::Material`]'s interface and to
+//! lights through [`crate::light::Light`]'s, so new families slot in without touching it.
+
+use crate::bxdf::Frame;
+use crate::geometry::{offset_ray_origin, Hit};
+use crate::sampler::Sampler;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::world::World;
+use glam::Vec3;
+
+/// Counters for the closing summary.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RayStats {
+    pub camera_rays: u64,
+    pub bounce_rays: u64,
+    pub shadow_rays: u64,
+    /// Samples whose estimate was not finite and was dropped (should stay 0).
+    pub non_finite: u64,
+}
+
+impl RayStats {
+    pub fn total_rays(&self) -> u64 {
+        self.camera_rays + self.bounce_rays + self.shadow_rays
+    }
+    pub fn merge(&mut self, o: &RayStats) {
+        self.camera_rays += o.camera_rays;
+        self.bounce_rays += o.bounce_rays;
+        self.shadow_rays += o.shadow_rays;
+        self.non_finite += o.non_finite;
+    }
+}
+
+#[inline]
+fn power_heuristic(f: f32, g: f32) -> f32 {
+    let (f2, g2) = (f * f, g * g);
+    if f2.is_infinite() {
+        return 1.0;
+    }
+    if f2 + g2 == 0.0 {
+        return 0.0;
+    }
+    f2 / (f2 + g2)
+}
+
+/// Spectral radiance (W·m⁻²·sr⁻¹·nm⁻¹ at each of `wl`'s wavelengths) arriving at `origin`
+/// from direction `dir` (unit).
+pub fn radiance(
+    world: &World,
+    origin: Vec3,
+    dir: Vec3,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+) -> SampledSpectrum {
+    let settings = &world.settings;
+    let mut l = SampledSpectrum::ZERO;
+    let mut beta = SampledSpectrum::ONE;
+    let mut ray_o = origin;
+    let mut ray_d = dir;
+    // For MIS of emission found by BSDF sampling.
+    let mut prev_specular = true;
+    let mut prev_pdf = 0.0f32;
+    let mut prev_p = origin;
+    let mut depth = 0u32;
+
+    loop {
+        let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
+        let Some(hit) = hit else {
+            for &li in &world.infinite_lights {
+                let light = &world.lights[li as usize];
+                let le = light.escaped(wl);
+                if le.is_black() {
+                    continue;
+                }
+                if prev_specular {
+                    l += beta * le;
+                } else {
+                    let p_light = world.light_sampler.pmf(li as usize) * light.pdf_li_escape();
+                    l += beta * le * power_heuristic(prev_pdf, p_light);
+                }
+            }
+            break;
+        };
+        let object = world.objects[hit.object as usize];
+
+        // Emission seen along the path.
+        if let Some(li) = object.light {
+            let light = &world.lights[li as usize];
+            let le = light.emitted(&hit, wl);
+            if !le.is_black() {
+                if prev_specular {
+                    l += beta * le;
+                } else {
+                    let p_light =
+                        world.light_sampler.pmf(li as usize) * light.pdf_li_hit(&world.geometry, prev_p, &hit);
+                    l += beta * le * power_heuristic(prev_pdf, p_light);
+                }
+            }
+        }
+
+        if depth >= settings.max_depth {
+            break;
+        }
+        let material = &world.materials[object.material as usize];
+        if material.is_black() {
+            break;
+        }
+
+        let frame = Frame::from_normal(hit.ns);
+        let wo_world = -ray_d;
+        let wo = frame.to_local(wo_world);
+        if wo.z == 0.0 {
+            break;
+        }
+
+        // Next-event estimation.
+        let u_light = sampler.get1d();
+        let u_prim = sampler.get1d();
+        let u_pt = sampler.get2d();
+        if let Some((k, p_select)) = world.light_sampler.sample(u_light) {
+            let light = &world.lights[k];
+            if let Some(ls) = light.sample_li(&world.geometry, hit.p, u_prim, u_pt, wl) {
+                if ls.pdf > 0.0 && !ls.li.is_black() {
+                    let wi = frame.to_local(ls.wi);
+                    let f = material.eval(wo, wi, wl) * wi.z.abs();
+                    if !f.is_black() {
+                        stats.shadow_rays += 1;
+                        if unoccluded(world, &hit, &ls) {
+                            let pdf = p_select * ls.pdf;
+                            let w = if ls.delta {
+                                1.0
+                            } else {
+                                power_heuristic(pdf, material.pdf(wo, wi))
+                            };
+                            l += beta * f * ls.li * (w / pdf);
+                        }
+                    }
+                }
+            }
+        }
+
+        // Continue the path by sampling the BSDF.
+        let uc = sampler.get1d();
+        let u = sampler.get2d();
+        let Some(bs) = material.sample(wo, uc, u, wl) else {
+            break;
+        };
+        if !(bs.pdf > 0.0) {
+            break;
+        }
+        beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+        if beta.is_black() {
+            break;
+        }
+        prev_specular = bs.specular;
+        prev_pdf = bs.pdf;
+        prev_p = hit.p;
+        let wi_world = frame.to_world(bs.wi);
+        ray_o = offset_ray_origin(&hit, wi_world);
+        ray_d = wi_world.normalize();
+        stats.bounce_rays += 1;
+        depth += 1;
+
+        // Russian roulette.
+        let u_rr = sampler.get1d();
+        if depth > settings.rr_depth {
+            let m = beta.max_component();
+            if m < 1.0 {
+                let q = (1.0 - m).max(0.0);
+                if u_rr < q {
+                    break;
+                }
+                beta = beta / (1.0 - q);
+            }
+        }
+    }
+    l
+}
+
+/// Shadow test between a shading point and a light sample.
+fn unoccluded(world: &World, hit: &Hit, ls: &crate::light::LightSample) -> bool {
+    let origin = offset_ray_origin(hit, ls.wi);
+    match ls.point {
+        Some((p, n)) => {
+            let target = crate::geometry::offset_point(p, n, -ls.wi);
+            let d = target - origin;
+            let dist = d.length();
+            if dist <= 0.0 {
+                return true;
+            }
+            !world.geometry.occluded(origin, d / dist, dist)
+        }
+        None => {
+            let t_max = if ls.dist.is_finite() {
+                // Distance from the offset origin to the light.
+                let to = hit.p + ls.wi * ls.dist;
+                (to - origin).length()
+            } else {
+                f32::INFINITY
+            };
+            !world.geometry.occluded(origin, ls.wi, t_max)
+        }
+    }
+}

@@ -1,0 +1,331 @@
+//! Light sources, in radiometric units (the scene loader converts the user's photometric
+//! amounts: see [`photometric_scale`]).
+//!
+//! | light | stored spectrum | unit |
+//! |---|---|---|
+//! | point, spot | radiant intensity I_e(λ) | W·sr⁻¹·nm⁻¹ |
+//! | distant | irradiance at normal incidence E_e(λ) | W·m⁻²·nm⁻¹ |
+//! | environment, area | radiance L_e(λ) | W·m⁻²·sr⁻¹·nm⁻¹ |
+
+pub mod sampler;
+
+use crate::bxdf::Frame;
+use crate::colour::tables::photopic_v;
+use crate::geometry::{Hit, SceneGeometry};
+use crate::photometry::K_M;
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+pub use sampler::LightSampler;
+
+/// K_m ∫ S(λ) V(λ) dλ over 360–830 nm at 1 nm (the colour library's V(λ) table), i.e. the
+/// photometric amount one unit of the radiometric spectrum `s` carries (lm per W, cd per
+/// W·sr⁻¹, …).
+pub fn luminous_integral(s: &DenseSpectrum) -> f64 {
+    K_M * s.weighted_sum(photopic_v())
+}
+
+/// Factor that scales spectrum `s` so that it carries `amount` photometric units:
+/// `amount / (K_m ∫ S V dλ)`. Errors if the spectrum has no visible content.
+pub fn photometric_scale(s: &DenseSpectrum, amount: f64) -> Result<f32, String> {
+    let k = luminous_integral(s);
+    if !(k > 0.0) || !k.is_finite() {
+        return Err("the spectrum has no luminous content (K_m ∫ S V dλ = 0), so a photometric amount cannot be assigned to it".into());
+    }
+    Ok((amount / k) as f32)
+}
+
+#[derive(Clone, Debug)]
+pub enum Light {
+    /// Isotropic point source.
+    Point {
+        position: Vec3,
+        intensity: DenseSpectrum,
+    },
+    /// Spot: intensity `intensity` on the axis, smooth falloff (smoothstep in cos θ) from the
+    /// inner to the outer cone, zero outside.
+    Spot {
+        position: Vec3,
+        frame: Frame,
+        cos_inner: f32,
+        cos_outer: f32,
+        intensity: DenseSpectrum,
+    },
+    /// Parallel light arriving from direction `to_light` (unit, pointing toward the source).
+    Distant {
+        to_light: Vec3,
+        irradiance: DenseSpectrum,
+    },
+    /// Uniform radiance from every direction at infinity.
+    Environment { radiance: DenseSpectrum },
+    /// Emission from the primitives of one scene object.
+    Area {
+        object: u32,
+        prims: Vec<u32>,
+        /// Cumulative area fractions, last = 1.
+        cdf: Vec<f32>,
+        total_area: f32,
+        radiance: DenseSpectrum,
+        two_sided: bool,
+    },
+}
+
+/// A sampled direction toward a light.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shading point toward the light.
+    pub wi: Vec3,
+    /// Incident radiance (or, for delta lights, irradiance-like quantity I/d² or E) carried
+    /// along `wi`, before the cosine at the receiver.
+    pub li: SampledSpectrum,
+    /// Density of `wi` w.r.t. solid angle (1 for delta lights); excludes light selection.
+    pub pdf: f32,
+    /// Distance to the sampled point (∞ for lights at infinity).
+    pub dist: f32,
+    /// The sampled point on an area light and its normal, for the shadow ray.
+    pub point: Option<(Vec3, Vec3)>,
+    pub delta: bool,
+}
+
+impl Light {
+    /// Whether the light is a delta distribution (cannot be hit by rays).
+    pub fn is_delta(&self) -> bool {
+        matches!(
+            self,
+            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+        )
+    }
+
+    /// Photometric power proxy (lm) used to choose lights in proportion to their output.
+    pub fn power_lm(&self, geom: &SceneGeometry, scene_radius: f32) -> f64 {
+        let r2 = (scene_radius as f64).powi(2);
+        let pi = std::f64::consts::PI;
+        match self {
+            Light::Point { intensity, .. } => 4.0 * pi * luminous_integral(intensity),
+            Light::Spot {
+                intensity,
+                cos_inner,
+                cos_outer,
+                ..
+            } => {
+                2.0 * pi
+                    * luminous_integral(intensity)
+                    * (1.0 - 0.5 * (*cos_inner as f64 + *cos_outer as f64))
+            }
+            Light::Distant { irradiance, .. } => luminous_integral(irradiance) * pi * r2,
+            Light::Environment { radiance } => luminous_integral(radiance) * pi * pi * r2,
+            Light::Area {
+                prims,
+                radiance,
+                two_sided,
+                ..
+            } => {
+                let area: f64 = prims.iter().map(|&p| geom.prim_area(p) as f64).sum();
+                let sides = if *two_sided { 2.0 } else { 1.0 };
+                pi * luminous_integral(radiance) * area * sides
+            }
+        }
+    }
+
+    /// Sample incident light at point `p`. `u` is a 2-D sample, `uc` a 1-D one (primitive choice).
+    pub fn sample_li(
+        &self,
+        geom: &SceneGeometry,
+        p: Vec3,
+        uc: f32,
+        u: Vec2,
+        wl: &SampledWavelengths,
+    ) -> Option<LightSample> {
+        match self {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let d = *position - p;
+                let dist2 = d.length_squared();
+                if dist2 == 0.0 {
+                    return None;
+                }
+                let dist = dist2.sqrt();
+                Some(LightSample {
+                    wi: d / dist,
+                    li: intensity.sample(wl) / dist2,
+                    pdf: 1.0,
+                    dist,
+                    point: None,
+                    delta: true,
+                })
+            }
+            Light::Spot {
+                position,
+                frame,
+                cos_inner,
+                cos_outer,
+                intensity,
+            } => {
+                let d = *position - p;
+                let dist2 = d.length_squared();
+                if dist2 == 0.0 {
+                    return None;
+                }
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let cos_theta = (-wi).dot(frame.n);
+                let falloff = smoothstep(*cos_outer, *cos_inner, cos_theta);
+                if falloff <= 0.0 {
+                    return None;
+                }
+                Some(LightSample {
+                    wi,
+                    li: intensity.sample(wl) * (falloff / dist2),
+                    pdf: 1.0,
+                    dist,
+                    point: None,
+                    delta: true,
+                })
+            }
+            Light::Distant {
+                to_light,
+                irradiance,
+            } => Some(LightSample {
+                wi: *to_light,
+                li: irradiance.sample(wl),
+                pdf: 1.0,
+                dist: f32::INFINITY,
+                point: None,
+                delta: true,
+            }),
+            Light::Environment { radiance } => {
+                let wi = sample_uniform_sphere(u);
+                Some(LightSample {
+                    wi,
+                    li: radiance.sample(wl),
+                    pdf: 1.0 / (4.0 * PI),
+                    dist: f32::INFINITY,
+                    point: None,
+                    delta: false,
+                })
+            }
+            Light::Area {
+                prims,
+                cdf,
+                radiance,
+                two_sided,
+                ..
+            } => {
+                let (k, p_prim) = pick_from_cdf(cdf, uc);
+                let prim = prims[k];
+                let (sp, pdf_sa) = geom.sample_prim_solid_angle(prim, p, u)?;
+                let d = sp.p - p;
+                let dist = d.length();
+                if dist == 0.0 || !(pdf_sa > 0.0) || !pdf_sa.is_finite() {
+                    return None;
+                }
+                let wi = d / dist;
+                let facing = sp.n.dot(-wi) > 0.0;
+                if !facing && !two_sided {
+                    return None;
+                }
+                Some(LightSample {
+                    wi,
+                    li: radiance.sample(wl),
+                    pdf: pdf_sa * p_prim,
+                    dist,
+                    point: Some((sp.p, sp.n)),
+                    delta: false,
+                })
+            }
+        }
+    }
+
+    /// Density (solid angle, excluding light selection) with which `sample_li` from `p` would
+    /// have produced the ray that hit this area light at `hit`.
+    pub fn pdf_li_hit(&self, geom: &SceneGeometry, p: Vec3, hit: &Hit) -> f32 {
+        match self {
+            Light::Area {
+                prims,
+                cdf,
+                total_area,
+                ..
+            } => {
+                let _ = (prims, cdf);
+                let p_prim = geom.prim_area(hit.prim) / total_area;
+                p_prim * geom.pdf_prim_solid_angle(hit.prim, p, hit)
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Density of direction `wi` for an environment light (solid angle).
+    pub fn pdf_li_escape(&self) -> f32 {
+        match self {
+            Light::Environment { .. } => 1.0 / (4.0 * PI),
+            _ => 0.0,
+        }
+    }
+
+    /// Radiance leaving an area light's surface toward the viewer, given the hit.
+    pub fn emitted(&self, hit: &Hit, wl: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Light::Area {
+                radiance,
+                two_sided,
+                ..
+            } if hit.front_face || *two_sided => radiance.sample(wl),
+            _ => SampledSpectrum::ZERO,
+        }
+    }
+
+    /// Radiance arriving along an escaped ray.
+    pub fn escaped(&self, wl: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Light::Environment { radiance } => radiance.sample(wl),
+            _ => SampledSpectrum::ZERO,
+        }
+    }
+}
+
+/// Choose an index from a cumulative distribution (last entry 1); returns it and its probability.
+pub fn pick_from_cdf(cdf: &[f32], u: f32) -> (usize, f32) {
+    let k = cdf.partition_point(|&c| c <= u).min(cdf.len() - 1);
+    let lo = if k == 0 { 0.0 } else { cdf[k - 1] };
+    (k, cdf[k] - lo)
+}
+
+pub fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
+    if a == b {
+        return if x < a { 0.0 } else { 1.0 };
+    }
+    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cdf_pick() {
+        let cdf = [0.25, 0.5, 1.0];
+        assert_eq!(pick_from_cdf(&cdf, 0.1), (0, 0.25));
+        assert_eq!(pick_from_cdf(&cdf, 0.3), (1, 0.25));
+        assert_eq!(pick_from_cdf(&cdf, 0.99), (2, 0.5));
+    }
+
+    #[test]
+    fn photometric_scale_gives_the_amount() {
+        let s = DenseSpectrum::constant(1.0);
+        let k = photometric_scale(&s, 1000.0).unwrap();
+        let scaled = s.scaled(k);
+        assert!((luminous_integral(&scaled) - 1000.0).abs() < 1e-3);
+        assert!(photometric_scale(&DenseSpectrum::constant(0.0), 1.0).is_err());
+    }
+}

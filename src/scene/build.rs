@@ -1,0 +1,654 @@
+//! From parsed scene to [`World`]: check every value, resolve spectra, convert photometric
+//! amounts to radiometric light spectra, build the BVH.
+
+use super::schema::*;
+use super::SceneError;
+use crate::bxdf::{Diffuse, Frame, Material};
+use crate::camera::{Camera, PixelFilter};
+use crate::colour::sd::SpectralDistribution;
+use crate::colour::{planck::planck_law, tables};
+use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
+use crate::light::{photometric_scale, Light, LightSampler};
+use crate::spectrum::rgb_upsample::fit_linear_srgb;
+use crate::spectrum::DenseSpectrum;
+use crate::world::{Object, RenderSettings, World};
+use glam::Vec3;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// Command-line overrides of the scene's render settings.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    pub spp: Option<u32>,
+    pub seed: Option<u64>,
+    pub max_depth: Option<u32>,
+}
+
+/// Largest image the renderer accepts (pixels), so a typo cannot exhaust memory.
+pub const MAX_PIXELS: u64 = 1 << 28;
+
+/// Load and build a scene file.
+pub fn load_world(path: &Path, overrides: &Overrides) -> Result<World, SceneError> {
+    let scene = super::load(path)?;
+    build(&scene, path, overrides)
+}
+
+struct Ctx<'a> {
+    path: &'a Path,
+    dir: PathBuf,
+}
+
+impl Ctx<'_> {
+    fn err(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            path: self.path.to_path_buf(),
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+    fn finite(&self, field: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("{v} is not a finite number")))
+        }
+    }
+    fn positive(&self, field: &str, v: f64) -> Result<f64, SceneError> {
+        self.finite(field, v)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("must be greater than 0, got {v}")))
+        }
+    }
+    fn vec3(&self, field: &str, v: V3) -> Result<Vec3, SceneError> {
+        for (k, c) in v.iter().enumerate() {
+            if !c.is_finite() {
+                return Err(self.err(
+                    format!("{field}.{}", ["x", "y", "z"][k]),
+                    format!("{c} is not a finite number"),
+                ));
+            }
+        }
+        Ok(Vec3::from_array(v))
+    }
+    fn resolve(&self, rel: &str) -> PathBuf {
+        self.dir.join(rel)
+    }
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Role {
+    Reflectance,
+    Emission,
+}
+
+fn resolve_spectrum(
+    ctx: &Ctx,
+    field: &str,
+    desc: &SpectrumDesc,
+    role: Role,
+) -> Result<DenseSpectrum, SceneError> {
+    let dense = match desc {
+        SpectrumDesc::Constant(v) => {
+            let v = ctx.finite(field, *v)?;
+            DenseSpectrum::constant(v as f32)
+        }
+        SpectrumDesc::Blackbody(t) => {
+            if role == Role::Reflectance {
+                return Err(ctx.err(
+                    field,
+                    "a blackbody spectrum describes emission, not a reflectance",
+                ));
+            }
+            let t = ctx.positive(field, *t)?;
+            // Relative shape only: normalise to 1 at 560 nm to keep f32 in range.
+            let norm = planck_law(560e-9, t);
+            DenseSpectrum::from_fn(|nm| planck_law(nm * 1e-9, t) / norm)
+        }
+        SpectrumDesc::Named(name) => {
+            let sd = tables::named_spectrum(name).ok_or_else(|| {
+                ctx.err(
+                    field,
+                    format!(
+                        "unknown spectrum name {name:?}; known names: {}",
+                        tables::named_spectrum_names().join(", ")
+                    ),
+                )
+            })?;
+            DenseSpectrum::from_fn(|nm| sd.value(nm))
+        }
+        SpectrumDesc::Tabulated(pairs) => {
+            let (w, v): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
+            let sd = SpectralDistribution::new(w, v).map_err(|e| ctx.err(field, e.to_string()))?;
+            DenseSpectrum::from_fn(|nm| sd.value(nm))
+        }
+        SpectrumDesc::Csv(rel) => {
+            let p = ctx.resolve(rel);
+            let sd = SpectralDistribution::from_csv_path(&p)
+                .map_err(|e| ctx.err(field, e.to_string()))?;
+            DenseSpectrum::from_fn(|nm| sd.value(nm))
+        }
+        SpectrumDesc::Rgb(r, g, b) => {
+            let rgb = [*r, *g, *b];
+            for (k, c) in rgb.iter().enumerate() {
+                ctx.finite(field, *c)?;
+                if !(0.0..=1.0).contains(c) {
+                    return Err(ctx.err(
+                        field,
+                        format!(
+                            "RGB component {} is {c}; linear sRGB components must lie in [0, 1]",
+                            ["r", "g", "b"][k]
+                        ),
+                    ));
+                }
+            }
+            let (sig, _residual) =
+                fit_linear_srgb(rgb).map_err(|e| ctx.err(field, e.to_string()))?;
+            match role {
+                Role::Reflectance => DenseSpectrum::from_fn(|nm| sig.value(nm)),
+                Role::Emission => {
+                    // An RGB emitter is the smooth reflectance-like shape times D65, so that
+                    // white (1,1,1) emits D65 (pbrt-v4's RGBIlluminantSpectrum).
+                    let d65 = tables::named_spectrum("D65").expect("D65 ships with candela");
+                    DenseSpectrum::from_fn(|nm| sig.value(nm) * d65.value(nm))
+                }
+            }
+        }
+    };
+    if dense.values.iter().any(|v| !v.is_finite()) {
+        return Err(ctx.err(field, "the spectrum has non-finite values"));
+    }
+    let min = dense.min_value();
+    if min < 0.0 {
+        return Err(ctx.err(
+            field,
+            format!("the spectrum is negative (minimum {min}); spectra must be ≥ 0"),
+        ));
+    }
+    if role == Role::Reflectance {
+        let max = dense.max_value();
+        if max > 1.0 {
+            let at = dense.values.iter().position(|&v| v == max).unwrap_or(0) + 360;
+            return Err(ctx.err(
+                field,
+                format!(
+                    "reflectance {max} at {at} nm is above 1; a passive surface cannot reflect more light than it receives"
+                ),
+            ));
+        }
+    }
+    Ok(dense)
+}
+
+fn object_field(i: usize, o: &ObjectDesc) -> String {
+    match &o.name {
+        Some(n) => format!("objects[{i}] {n:?}"),
+        None => format!("objects[{i}]"),
+    }
+}
+
+fn build_shape(ctx: &Ctx, field: &str, desc: &ShapeDesc) -> Result<Shape, SceneError> {
+    let f = |s: &str| format!("{field}.{s}");
+    Ok(match desc {
+        ShapeDesc::Sphere { center, radius } => Shape::Sphere {
+            center: ctx.vec3(&f("center"), *center)?,
+            radius: ctx.positive(&f("radius"), *radius as f64)? as f32,
+        },
+        ShapeDesc::Quad {
+            origin,
+            edge_u,
+            edge_v,
+        } => {
+            let eu = ctx.vec3(&f("edge_u"), *edge_u)?;
+            let ev = ctx.vec3(&f("edge_v"), *edge_v)?;
+            if eu.cross(ev).length_squared() == 0.0 {
+                return Err(ctx.err(field, "the quad has zero area (edge_u and edge_v are parallel or zero)"));
+            }
+            Shape::Quad {
+                origin: ctx.vec3(&f("origin"), *origin)?,
+                edge_u: eu,
+                edge_v: ev,
+            }
+        }
+        ShapeDesc::Disk {
+            center,
+            normal,
+            radius,
+        } => {
+            let n = ctx.vec3(&f("normal"), *normal)?;
+            if n.length_squared() == 0.0 {
+                return Err(ctx.err(f("normal"), "the normal is the zero vector"));
+            }
+            Shape::Disk {
+                center: ctx.vec3(&f("center"), *center)?,
+                normal: n.normalize(),
+                radius: ctx.positive(&f("radius"), *radius as f64)? as f32,
+            }
+        }
+        ShapeDesc::Triangles {
+            positions,
+            indices,
+            normals,
+        } => {
+            let mut mesh = TriangleMesh::default();
+            for (k, p) in positions.iter().enumerate() {
+                mesh.positions
+                    .push(ctx.vec3(&format!("{field}.positions[{k}]"), *p)?);
+            }
+            for (k, tri) in indices.iter().enumerate() {
+                for &ix in tri {
+                    if ix as usize >= positions.len() {
+                        return Err(ctx.err(
+                            format!("{field}.indices[{k}]"),
+                            format!(
+                                "vertex index {ix} is out of range (the mesh has {} positions)",
+                                positions.len()
+                            ),
+                        ));
+                    }
+                }
+                mesh.indices.push(*tri);
+            }
+            if mesh.indices.is_empty() {
+                return Err(ctx.err(f("indices"), "the mesh has no triangles"));
+            }
+            if let Some(ns) = normals {
+                if ns.len() != positions.len() {
+                    return Err(ctx.err(
+                        f("normals"),
+                        format!(
+                            "{} normals given for {} positions; give one per position",
+                            ns.len(),
+                            positions.len()
+                        ),
+                    ));
+                }
+                let mut v = Vec::with_capacity(ns.len());
+                for (k, n) in ns.iter().enumerate() {
+                    v.push(ctx.vec3(&format!("{field}.normals[{k}]"), *n)?.normalize_or_zero());
+                }
+                mesh.normals = Some(v);
+            }
+            Shape::Mesh(mesh)
+        }
+        ShapeDesc::Obj(rel) => Shape::Mesh(
+            geometry::load_obj(&ctx.resolve(rel)).map_err(|e| ctx.err(field, e.to_string()))?,
+        ),
+        ShapeDesc::Ply(rel) => Shape::Mesh(
+            geometry::load_ply(&ctx.resolve(rel)).map_err(|e| ctx.err(field, e.to_string()))?,
+        ),
+    })
+}
+
+fn build_transform(ctx: &Ctx, field: &str, t: &TransformDesc) -> Result<Transform, SceneError> {
+    let tr = match t.translate {
+        Some(v) => ctx.vec3(&format!("{field}.translate"), v)?,
+        None => Vec3::ZERO,
+    };
+    let rot = match t.rotate_deg {
+        Some(v) => ctx.vec3(&format!("{field}.rotate_deg"), v)?,
+        None => Vec3::ZERO,
+    };
+    let sc = match t.scale {
+        Some(v) => ctx.vec3(&format!("{field}.scale"), v)?,
+        None => Vec3::ONE,
+    };
+    if sc.min_element() <= 0.0 {
+        return Err(ctx.err(
+            format!("{field}.scale"),
+            format!("scale factors must be greater than 0, got {sc}"),
+        ));
+    }
+    Ok(Transform::from_trs(tr, rot, sc))
+}
+
+/// Check one scene and build the world.
+pub fn build(
+    scene: &SceneFile,
+    path: &Path,
+    overrides: &Overrides,
+) -> Result<World, SceneError> {
+    let ctx = Ctx {
+        path,
+        dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+    };
+
+    // Camera.
+    let c = &scene.camera;
+    let position = ctx.vec3("camera.position", c.position)?;
+    let look_at = ctx.vec3("camera.look_at", c.look_at)?;
+    let up = ctx.vec3("camera.up", c.up)?;
+    let forward = look_at - position;
+    if forward.length_squared() == 0.0 {
+        return Err(ctx.err("camera.look_at", "look_at equals position"));
+    }
+    if forward.normalize().cross(up).length_squared() < 1e-12 {
+        return Err(ctx.err("camera.up", "up is zero or parallel to the view direction"));
+    }
+    let vfov = ctx.finite("camera.vfov_deg", c.vfov_deg as f64)?;
+    if !(vfov > 0.0 && vfov < 180.0) {
+        return Err(ctx.err(
+            "camera.vfov_deg",
+            format!("the field of view must lie strictly between 0 and 180 degrees, got {vfov}"),
+        ));
+    }
+    let (w, h) = c.resolution;
+    if w == 0 || h == 0 {
+        return Err(ctx.err(
+            "camera.resolution",
+            format!("the resolution must be at least 1×1, got {w}×{h}"),
+        ));
+    }
+    if w as u64 * h as u64 > MAX_PIXELS {
+        return Err(ctx.err(
+            "camera.resolution",
+            format!(
+                "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {} GiB)",
+                (w as u64 * h as u64 * 40) >> 30
+            ),
+        ));
+    }
+    let (lens_radius, focus) = match &c.lens {
+        None => (0.0, 1.0),
+        Some(l) => {
+            let r = ctx.finite("camera.lens.aperture_radius", l.aperture_radius as f64)?;
+            if r < 0.0 {
+                return Err(ctx.err(
+                    "camera.lens.aperture_radius",
+                    format!("must be ≥ 0, got {r}"),
+                ));
+            }
+            let f = ctx.positive("camera.lens.focus_distance", l.focus_distance as f64)?;
+            (r as f32, f as f32)
+        }
+    };
+    let camera = Camera::new(
+        position,
+        look_at,
+        up,
+        vfov as f32,
+        w as usize,
+        h as usize,
+        lens_radius,
+        focus,
+    );
+
+    // Render settings.
+    let r = &scene.render;
+    let spp = overrides.spp.unwrap_or(r.spp);
+    if spp == 0 {
+        return Err(ctx.err("render.spp", "samples per pixel must be at least 1"));
+    }
+    let max_depth = overrides.max_depth.unwrap_or(r.max_depth);
+    if max_depth > 10_000 {
+        return Err(ctx.err("render.max_depth", format!("{max_depth} is unreasonably deep (limit 10000)")));
+    }
+    let filter = match r.filter {
+        FilterDesc::Box => PixelFilter::Box,
+        FilterDesc::Tent { radius } => PixelFilter::Tent {
+            radius: ctx.positive("render.filter.radius", radius as f64)? as f32,
+        },
+        FilterDesc::Gaussian { sigma, radius } => PixelFilter::gaussian(
+            ctx.positive("render.filter.sigma", sigma as f64)? as f32,
+            ctx.positive("render.filter.radius", radius as f64)? as f32,
+        ),
+    };
+    let settings = RenderSettings {
+        spp,
+        max_depth,
+        rr_depth: r.rr_depth,
+        seed: overrides.seed.unwrap_or(r.seed),
+        filter,
+    };
+
+    // Materials.
+    let mut materials = vec![Material::Black];
+    let mut material_index: HashMap<&str, u32> = HashMap::new();
+    material_index.insert("black", 0);
+    for (name, m) in &scene.materials {
+        let field = format!("materials[{name:?}]");
+        let mat = match m {
+            MaterialDesc::Diffuse { reflectance } => Material::Diffuse(Diffuse {
+                reflectance: resolve_spectrum(
+                    &ctx,
+                    &format!("{field}.reflectance"),
+                    reflectance,
+                    Role::Reflectance,
+                )?,
+            }),
+            MaterialDesc::Black => Material::Black,
+        };
+        if name == "black" {
+            materials[0] = mat;
+        } else {
+            material_index.insert(name.as_str(), materials.len() as u32);
+            materials.push(mat);
+        }
+    }
+
+    // Objects and their shapes.
+    let mut shapes: Vec<(Shape, u32)> = Vec::with_capacity(scene.objects.len());
+    let mut objects = Vec::with_capacity(scene.objects.len());
+    let mut pending_area: Vec<(u32, String, DenseSpectrum, Amount, bool)> = Vec::new();
+    for (i, o) in scene.objects.iter().enumerate() {
+        let field = object_field(i, o);
+        let mat = *material_index.get(o.material.as_str()).ok_or_else(|| {
+            let mut known: Vec<&str> = material_index.keys().copied().collect();
+            known.sort();
+            ctx.err(
+                format!("{field}.material"),
+                format!(
+                    "unknown material {:?}; defined materials: {}",
+                    o.material,
+                    known.join(", ")
+                ),
+            )
+        })?;
+        let mut shape = build_shape(&ctx, &format!("{field}.shape"), &o.shape)?;
+        if let Some(t) = &o.transform {
+            let tf = build_transform(&ctx, &format!("{field}.transform"), t)?;
+            shape = shape
+                .to_world(&tf)
+                .map_err(|e| ctx.err(format!("{field}.transform"), e.to_string()))?;
+        }
+        shapes.push((shape, i as u32));
+        objects.push(Object {
+            material: mat,
+            light: None,
+        });
+        if let Some(e) = &o.emission {
+            let s = resolve_spectrum(
+                &ctx,
+                &format!("{field}.emission.spectrum"),
+                &e.spectrum,
+                Role::Emission,
+            )?;
+            pending_area.push((i as u32, field.clone(), s, e.amount, e.two_sided));
+        }
+    }
+    let geometry = SceneGeometry::build(&shapes).map_err(|e| ctx.err("objects", e.to_string()))?;
+    let (lo, hi) = geometry.bounds();
+    let scene_radius = if lo.is_finite() && hi.is_finite() && hi.cmpge(lo).all() {
+        (0.5 * (hi - lo).length()).max(1e-6)
+    } else {
+        1.0
+    };
+
+    // Lights.
+    let mut lights: Vec<Light> = Vec::new();
+    let mut infinite_lights = Vec::new();
+    for (object, field, s, amount, two_sided) in pending_area {
+        let prims = geometry.primitives_of_object(object).to_vec();
+        let areas: Vec<f64> = prims.iter().map(|&p| geometry.prim_area(p) as f64).collect();
+        let total: f64 = areas.iter().sum();
+        if !(total > 0.0) {
+            return Err(ctx.err(
+                format!("{field}.emission"),
+                "the emitting shape has zero area",
+            ));
+        }
+        let afield = format!("{field}.emission.amount");
+        let luminance = match amount {
+            Amount::Luminance(l) => nonneg(&ctx, &afield, l)?,
+            Amount::Flux(phi) => {
+                // Lambertian: Φ = π L A per emitting face.
+                let sides = if two_sided { 2.0 } else { 1.0 };
+                nonneg(&ctx, &afield, phi)? / (std::f64::consts::PI * total * sides)
+            }
+            other => {
+                return Err(ctx.err(
+                    afield,
+                    format!("{other:?} is not an amount for surface emission; use Luminance(cd/m²) or Flux(lm)"),
+                ))
+            }
+        };
+        let k = photometric_scale(&s, luminance)
+            .map_err(|m| ctx.err(format!("{field}.emission.spectrum"), m))?;
+        let mut cdf = Vec::with_capacity(areas.len());
+        let mut acc = 0.0;
+        for a in &areas {
+            acc += a / total;
+            cdf.push(acc as f32);
+        }
+        if let Some(last) = cdf.last_mut() {
+            *last = 1.0;
+        }
+        objects[object as usize].light = Some(lights.len() as u32);
+        lights.push(Light::Area {
+            object,
+            prims,
+            cdf,
+            total_area: total as f32,
+            radiance: s.scaled(k),
+            two_sided,
+        });
+    }
+    for (i, l) in scene.lights.iter().enumerate() {
+        let field = format!("lights[{i}]");
+        let light = build_light(&ctx, &field, l)?;
+        if matches!(light, Light::Environment { .. }) {
+            infinite_lights.push(lights.len() as u32);
+        }
+        lights.push(light);
+    }
+    let light_sampler = LightSampler::new(&lights, &geometry, scene_radius);
+
+    Ok(World {
+        geometry,
+        objects,
+        materials,
+        lights,
+        light_sampler,
+        infinite_lights,
+        camera,
+        settings,
+    })
+}
+
+fn nonneg(ctx: &Ctx, field: &str, v: f64) -> Result<f64, SceneError> {
+    ctx.finite(field, v)?;
+    if v < 0.0 {
+        return Err(ctx.err(field, format!("a photometric amount cannot be negative, got {v}")));
+    }
+    Ok(v)
+}
+
+fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneError> {
+    let afield = format!("{field}.amount");
+    let sfield = format!("{field}.spectrum");
+    let scaled = |spec: &SpectrumDesc, amount: f64| -> Result<DenseSpectrum, SceneError> {
+        let s = resolve_spectrum(ctx, &sfield, spec, Role::Emission)?;
+        let k = photometric_scale(&s, amount).map_err(|m| ctx.err(&sfield, m))?;
+        Ok(s.scaled(k))
+    };
+    let wrong = |a: &Amount, allowed: &str| {
+        ctx.err(
+            &afield,
+            format!("{a:?} is not an amount for this light; use {allowed}"),
+        )
+    };
+    Ok(match l {
+        LightDesc::Point {
+            position,
+            spectrum,
+            amount,
+        } => {
+            let cd = match amount {
+                Amount::Intensity(i) => nonneg(ctx, &afield, *i)?,
+                Amount::Flux(phi) => nonneg(ctx, &afield, *phi)? / (4.0 * std::f64::consts::PI),
+                a => return Err(wrong(a, "Intensity(cd) or Flux(lm)")),
+            };
+            Light::Point {
+                position: ctx.vec3(&format!("{field}.position"), *position)?,
+                intensity: scaled(spectrum, cd)?,
+            }
+        }
+        LightDesc::Spot {
+            position,
+            look_at,
+            inner_deg,
+            outer_deg,
+            spectrum,
+            amount,
+        } => {
+            let p = ctx.vec3(&format!("{field}.position"), *position)?;
+            let t = ctx.vec3(&format!("{field}.look_at"), *look_at)?;
+            if (t - p).length_squared() == 0.0 {
+                return Err(ctx.err(format!("{field}.look_at"), "look_at equals position"));
+            }
+            let inner = ctx.finite(&format!("{field}.inner_deg"), *inner_deg as f64)?;
+            let outer = ctx.finite(&format!("{field}.outer_deg"), *outer_deg as f64)?;
+            if !(0.0..=180.0).contains(&inner) || !(outer > 0.0 && outer <= 180.0) || inner > outer {
+                return Err(ctx.err(
+                    format!("{field}.outer_deg"),
+                    format!("cone half-angles must satisfy 0 ≤ inner ≤ outer ≤ 180 and outer > 0, got inner {inner}, outer {outer}"),
+                ));
+            }
+            let (ci, co) = (inner.to_radians().cos(), outer.to_radians().cos());
+            let cd = match amount {
+                Amount::Intensity(i) => nonneg(ctx, &afield, *i)?,
+                // Φ = ∫ I dω = 2π I [(1 − cos θi) + (cos θi − cos θo)/2] for the smoothstep falloff.
+                Amount::Flux(phi) => {
+                    nonneg(ctx, &afield, *phi)?
+                        / (2.0 * std::f64::consts::PI * (1.0 - 0.5 * (ci + co)))
+                }
+                a => return Err(wrong(a, "Intensity(cd) or Flux(lm)")),
+            };
+            Light::Spot {
+                position: p,
+                frame: Frame::from_normal((t - p).normalize()),
+                cos_inner: ci as f32,
+                cos_outer: co as f32,
+                intensity: scaled(spectrum, cd)?,
+            }
+        }
+        LightDesc::Distant {
+            direction,
+            spectrum,
+            amount,
+        } => {
+            let d = ctx.vec3(&format!("{field}.direction"), *direction)?;
+            if d.length_squared() == 0.0 {
+                return Err(ctx.err(format!("{field}.direction"), "the direction is the zero vector"));
+            }
+            let lux = match amount {
+                Amount::Illuminance(e) => nonneg(ctx, &afield, *e)?,
+                a => return Err(wrong(a, "Illuminance(lx)")),
+            };
+            Light::Distant {
+                to_light: -d.normalize(),
+                irradiance: scaled(spectrum, lux)?,
+            }
+        }
+        LightDesc::Environment { spectrum, amount } => {
+            let lum = match amount {
+                Amount::Luminance(l) => nonneg(ctx, &afield, *l)?,
+                a => return Err(wrong(a, "Luminance(cd/m²)")),
+            };
+            Light::Environment {
+                radiance: scaled(spectrum, lum)?,
+            }
+        }
+    })
+}

@@ -1,0 +1,57 @@
+//! Scene files: RON in ([`schema`]), a render-ready [`crate::world::World`] out ([`build`]).
+//!
+//! Every problem is reported as a [`SceneError`] naming the file, the position (line:column)
+//! where the parser knows it, and the field path (e.g. `objects[3] "floor".emission.amount`).
+
+pub mod build;
+pub mod schema;
+
+use std::path::{Path, PathBuf};
+
+pub use build::{build, load_world, Overrides};
+pub use schema::SceneFile;
+
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("cannot read scene file {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}:{line}:{col}: the scene file is not valid: {message}", path.display())]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        col: usize,
+        message: String,
+    },
+    #[error("{}: `{field}`: {message}", path.display())]
+    Invalid {
+        path: PathBuf,
+        field: String,
+        message: String,
+    },
+}
+
+/// Parse a scene file (syntax, types and unknown fields; values are checked by [`build`]).
+pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(&text, path)
+}
+
+/// Parse scene text; `path` is only used in messages.
+pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+    ron::Options::default()
+        .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+        .from_str::<SceneFile>(text)
+        .map_err(|e| SceneError::Parse {
+            path: path.to_path_buf(),
+            line: e.span.start.line,
+            col: e.span.start.col,
+            message: e.code.to_string(),
+        })
+}

@@ -1,0 +1,246 @@
+//! The RON scene format: serde types, one per construct. Field names carry their units.
+//! Every struct rejects unknown fields. The format is documented in `docs/scene-format.md`.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+pub type V3 = [f32; 3];
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub camera: CameraDesc,
+    #[serde(default)]
+    pub render: RenderDesc,
+    /// Materials by name; objects refer to them by name. `"black"` is predefined.
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialDesc>,
+    #[serde(default)]
+    pub objects: Vec<ObjectDesc>,
+    #[serde(default)]
+    pub lights: Vec<LightDesc>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Eye position, m.
+    pub position: V3,
+    /// Point looked at, m.
+    pub look_at: V3,
+    #[serde(default = "default_up")]
+    pub up: V3,
+    /// Full vertical field of view, degrees.
+    pub vfov_deg: f32,
+    /// Image width and height, pixels.
+    pub resolution: (u32, u32),
+    /// Thin lens; omitted = pinhole.
+    #[serde(default)]
+    pub lens: Option<LensDesc>,
+}
+
+fn default_up() -> V3 {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LensDesc {
+    /// Radius of the lens aperture, m.
+    pub aperture_radius: f32,
+    /// Distance from the lens to the plane in focus, m.
+    pub focus_distance: f32,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderDesc {
+    #[serde(default = "default_spp")]
+    pub spp: u32,
+    #[serde(default = "default_max_depth")]
+    pub max_depth: u32,
+    #[serde(default = "default_rr_depth")]
+    pub rr_depth: u32,
+    #[serde(default)]
+    pub seed: u64,
+    #[serde(default)]
+    pub filter: FilterDesc,
+}
+
+impl Default for RenderDesc {
+    fn default() -> Self {
+        Self {
+            spp: default_spp(),
+            max_depth: default_max_depth(),
+            rr_depth: default_rr_depth(),
+            seed: 0,
+            filter: FilterDesc::Box,
+        }
+    }
+}
+fn default_spp() -> u32 {
+    64
+}
+fn default_max_depth() -> u32 {
+    16
+}
+fn default_rr_depth() -> u32 {
+    3
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum FilterDesc {
+    #[default]
+    Box,
+    Tent {
+        radius: f32,
+    },
+    Gaussian {
+        sigma: f32,
+        radius: f32,
+    },
+}
+
+/// A spectral distribution.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum SpectrumDesc {
+    /// The same value at every wavelength.
+    Constant(f64),
+    /// Planck's law at this temperature, K (emission only).
+    Blackbody(f64),
+    /// A spectrum shipped in data/ (CIE illuminants, Cornell box, ColorChecker, TCS).
+    Named(String),
+    /// (wavelength nm, value) pairs, strictly increasing in wavelength; linear interpolation,
+    /// 0 outside.
+    Tabulated(Vec<(f64, f64)>),
+    /// A two-column CSV file (nm, value), path relative to the scene file.
+    Csv(String),
+    /// A linear-sRGB colour (components in [0, 1]) upsampled to a smooth spectrum.
+    Rgb(f64, f64, f64),
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MaterialDesc {
+    /// Lambertian reflection with reflectance in [0, 1].
+    Diffuse { reflectance: SpectrumDesc },
+    /// Absorbs all light.
+    Black,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectDesc {
+    /// Optional name, used in messages.
+    #[serde(default)]
+    pub name: Option<String>,
+    pub shape: ShapeDesc,
+    /// Name of an entry of `materials` (or `"black"`).
+    pub material: String,
+    #[serde(default)]
+    pub emission: Option<EmissionDesc>,
+    #[serde(default)]
+    pub transform: Option<TransformDesc>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ShapeDesc {
+    Sphere {
+        center: V3,
+        radius: f32,
+    },
+    /// Parallelogram `origin + s·edge_u + t·edge_v`; its front face is edge_u × edge_v.
+    Quad {
+        origin: V3,
+        edge_u: V3,
+        edge_v: V3,
+    },
+    Disk {
+        center: V3,
+        normal: V3,
+        radius: f32,
+    },
+    /// Inline triangle mesh; front faces wind counter-clockwise.
+    Triangles {
+        positions: Vec<V3>,
+        indices: Vec<[u32; 3]>,
+        #[serde(default)]
+        normals: Option<Vec<V3>>,
+    },
+    /// Wavefront OBJ file, relative to the scene file.
+    Obj(String),
+    /// PLY file (ASCII or binary), relative to the scene file.
+    Ply(String),
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformDesc {
+    #[serde(default)]
+    pub translate: Option<V3>,
+    /// Euler angles, degrees, applied about X, then Y, then Z.
+    #[serde(default)]
+    pub rotate_deg: Option<V3>,
+    #[serde(default)]
+    pub scale: Option<V3>,
+}
+
+/// A photometric amount.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Amount {
+    /// Luminance, cd/m².
+    Luminance(f64),
+    /// Luminous flux, lm.
+    Flux(f64),
+    /// Luminous intensity, cd.
+    Intensity(f64),
+    /// Illuminance, lx.
+    Illuminance(f64),
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EmissionDesc {
+    /// Spectral shape of the emission; only its shape matters, `amount` sets the level.
+    pub spectrum: SpectrumDesc,
+    /// `Luminance(cd/m²)` of the surface, or total `Flux(lm)` of the object.
+    pub amount: Amount,
+    /// Emit from both faces (default: only the front face).
+    #[serde(default)]
+    pub two_sided: bool,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum LightDesc {
+    /// Isotropic point light; amount `Intensity(cd)` or `Flux(lm)`.
+    Point {
+        position: V3,
+        spectrum: SpectrumDesc,
+        amount: Amount,
+    },
+    /// Spot light aimed at `look_at`; amount `Intensity(cd)` on the axis or `Flux(lm)`.
+    Spot {
+        position: V3,
+        look_at: V3,
+        /// Half-angle of full intensity, degrees.
+        inner_deg: f32,
+        /// Half-angle where the intensity reaches 0, degrees.
+        outer_deg: f32,
+        spectrum: SpectrumDesc,
+        amount: Amount,
+    },
+    /// Parallel light travelling along `direction`; amount `Illuminance(lx)` on a surface
+    /// facing it.
+    Distant {
+        direction: V3,
+        spectrum: SpectrumDesc,
+        amount: Amount,
+    },
+    /// Uniform light from every direction; amount `Luminance(cd/m²)`.
+    Environment { spectrum: SpectrumDesc, amount: Amount },
+}

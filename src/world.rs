@@ -1,0 +1,53 @@
+//! The built, render-ready scene: geometry in one BVH, materials, lights in radiometric units,
+//! the camera and the render settings. Produced by [`crate::scene::build`]; read-only while
+//! rendering.
+
+use crate::bxdf::Material;
+use crate::camera::{Camera, PixelFilter};
+use crate::geometry::SceneGeometry;
+use crate::light::{Light, LightSampler};
+
+/// What a primitive's `object` id refers to.
+#[derive(Clone, Copy, Debug)]
+pub struct Object {
+    pub material: u32,
+    /// Index into [`World::lights`] if the object emits.
+    pub light: Option<u32>,
+}
+
+/// Settings of one render.
+#[derive(Clone, Debug)]
+pub struct RenderSettings {
+    /// Camera samples per pixel.
+    pub spp: u32,
+    /// Maximum number of scattering events along a path (0 = only directly visible emission).
+    pub max_depth: u32,
+    /// Number of scattering events before Russian roulette may end a path.
+    pub rr_depth: u32,
+    pub seed: u64,
+    pub filter: PixelFilter,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            spp: 64,
+            max_depth: 16,
+            rr_depth: 3,
+            seed: 0,
+            filter: PixelFilter::Box,
+        }
+    }
+}
+
+pub struct World {
+    pub geometry: SceneGeometry,
+    pub objects: Vec<Object>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    pub light_sampler: LightSampler,
+    /// Indices of lights at infinity (environment), evaluated on escaped rays.
+    pub infinite_lights: Vec<u32>,
+    pub camera: Camera,
+    pub settings: RenderSettings,
+}

@@ -1,0 +1,54 @@
+//! Helpers shared by the render tests: build a world from RON text, render, summarise.
+#![allow(dead_code)]
+
+use candela::film::Film;
+use candela::scene::{self, Overrides};
+use candela::world::World;
+use std::path::Path;
+
+pub fn world(text: &str) -> World {
+    let path = Path::new("test-scene.ron");
+    let s = scene::parse(text, path).unwrap_or_else(|e| panic!("{e}"));
+    scene::build(&s, path, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+pub fn render(world: &World, threads: usize) -> Film {
+    candela::render::render(world, Some(threads), &|_, _| {})
+        .expect("render")
+        .film
+}
+
+/// Mean over all pixels of the per-pixel mean XYZ, and the standard error of the image-mean Y
+/// (pixels are independent: √(Σ se²)/n).
+pub fn image_mean(film: &Film) -> ([f64; 3], f64) {
+    let n = film.pixels.len() as f64;
+    let mut m = [0.0; 3];
+    let mut var = 0.0;
+    for p in &film.pixels {
+        let x = p.mean_xyz();
+        for k in 0..3 {
+            m[k] += x[k] / n;
+        }
+        var += p.y_standard_error().powi(2);
+    }
+    (m, var.sqrt() / n)
+}
+
+/// Assert that every pixel's Y is within `k` standard errors of `expected`, and the image mean
+/// within 4 standard errors.
+pub fn assert_every_pixel(film: &Film, expected: f64, k: f64) {
+    for (i, p) in film.pixels.iter().enumerate() {
+        let y = p.mean_xyz()[1];
+        let se = p.y_standard_error();
+        assert!(
+            (y - expected).abs() <= k * se,
+            "pixel {i}: Y = {y} cd/m², expected {expected} ± {k}·{se}"
+        );
+    }
+    let (m, se) = image_mean(film);
+    assert!(
+        (m[1] - expected).abs() <= 4.0 * se,
+        "image mean Y = {} cd/m², expected {expected} ± 4·{se}",
+        m[1]
+    );
+}
