@@ -6,3 +6,4 @@
 pub mod colour;
 pub mod output;
 pub mod photometry;
+pub mod spectrum;

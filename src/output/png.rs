@@ -27,6 +27,7 @@ use std::path::Path;
 use image::{codecs::png::PngEncoder, ExtendedColorType, ImageEncoder};
 
 use super::{write_atomic, OutputError};
+use crate::colour::rgb::{srgb_encode, xyz_to_linear_srgb};
 
 /// Reflected-light meter calibration constant K of ISO 2720, in cd·s·m⁻².
 pub const CALIBRATION_K: f64 = 12.5;
@@ -82,28 +83,6 @@ pub fn auto_exposure_ev(xyz: &[[f32; 3]]) -> f64 {
     match log_average_luminance(xyz) {
         Some(l) => (l * ISO_SPEED / CALIBRATION_K).log2(),
         None => 0.0,
-    }
-}
-
-// Temporary private copy until crate::colour lands; see switch in the colour merge.
-fn xyz_to_linear_srgb(xyz: [f64; 3]) -> [f64; 3] {
-    const M: [[f64; 3]; 3] = [
-        [3.2406, -1.5372, -0.4986],
-        [-0.9689, 1.8758, 0.0415],
-        [0.0557, -0.2040, 1.0570],
-    ];
-    let mut out = [0.0; 3];
-    for (o, row) in out.iter_mut().zip(M.iter()) {
-        *o = row[0] * xyz[0] + row[1] * xyz[1] + row[2] * xyz[2];
-    }
-    out
-}
-
-fn srgb_encode(v: f64) -> f64 {
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
     }
 }
 
