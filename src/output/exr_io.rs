@@ -221,7 +221,13 @@ pub fn write_exr(path: &Path, layers: &Layers) -> Result<(), OutputError> {
     let channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = layers
         .channels
         .iter()
-        .map(|(name, samples)| AnyChannel::new(to_text(name), FlatSamples::F32(samples.clone())))
+        .map(|(name, samples)| {
+            let mut channel = AnyChannel::new(to_text(name), FlatSamples::F32(samples.clone()));
+            // Absolute photometric values are not perceptually linear (a hint for lossy
+            // codecs only, but keep it truthful).
+            channel.quantize_linearly = false;
+            channel
+        })
         .collect();
     let encoding = Encoding {
         compression: Compression::ZIP16,
