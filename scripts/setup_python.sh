@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Create the Python virtual environment used to regenerate data/ and to run the
+# colour-science validation test (tests/colour_science.rs).
+#
+#   scripts/setup_python.sh            # creates <repo>/target/venv if missing, installs pins
+#   PYTHON=python3.11 scripts/setup_python.sh
+#
+# The tests look for the interpreter in $CANDELA_PYTHON, else <repo>/target/venv/bin/python.
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+VENV="$ROOT/target/venv"
+PYTHON="${PYTHON:-python3}"
+
+# Pinned versions: colour-science 0.4.7 and the only dependency it pulls in (numpy).
+# SciPy/matplotlib are optional for colour-science and not needed by candela's scripts.
+PINS=(
+  "colour-science==0.4.7"
+  "numpy==2.4.6"
+)
+
+if [ ! -x "$VENV/bin/python" ]; then
+  echo "creating $VENV with $($PYTHON --version 2>&1)"
+  mkdir -p "$ROOT/target"
+  "$PYTHON" -m venv "$VENV"
+fi
+
+"$VENV/bin/python" -m pip install --quiet --disable-pip-version-check "${PINS[@]}"
+"$VENV/bin/python" - <<'PY'
+import warnings
+warnings.filterwarnings("ignore")
+import colour, numpy
+assert colour.__version__ == "0.4.7", colour.__version__
+print(f"ok: colour-science {colour.__version__}, numpy {numpy.__version__}")
+PY

@@ -1,0 +1,11 @@
+//! Colour science for candela: spectral tables, spectral distributions, colorimetry,
+//! RGB colourspaces, correlated colour temperature and colour rendering.
+//!
+//! Everything here is `f64` and deterministic, and every conversion is validated against
+//! the Python reference library colour-science 0.4.7 (see `tests/colour_science.rs` and
+//! `docs/colour.md`).
+
+pub mod planck;
+pub mod rgb;
+pub mod sd;
+pub mod tables;

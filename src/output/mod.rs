@@ -1,0 +1,211 @@
+//! Writing and reading candela's output images.
+//!
+//! * [`write_exr`] / [`read_exr`]: the measured result, as 32-bit float OpenEXR with named
+//!   channels (absolute CIE 1931 XYZ, `Y` in cd/m², plus its standard error) and text
+//!   header attributes.
+//! * [`write_srgb_png`]: an 8-bit sRGB preview, exposed like a camera at a given (or
+//!   automatically metered) exposure value. See `docs/outputs.md` for the exact mapping.
+//! * [`write_atomic`]: every file this module writes goes through it, so a crash or an error
+//!   never leaves a half-written output behind.
+
+mod exr_io;
+mod png;
+
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+pub use exr_io::{read_exr, write_exr, Layers};
+pub use png::{
+    auto_exposure_ev, ev_to_scale, log_average_luminance, write_srgb_png, PngInfo, PngSettings,
+    CALIBRATION_K, ISO_SPEED, MIDDLE_GREY,
+};
+
+/// Channel name of CIE 1931 X (same units as `Y`).
+pub const CHANNEL_X: &str = "X";
+/// Channel name of CIE 1931 Y, the luminance in cd/m².
+pub const CHANNEL_Y: &str = "Y";
+/// Channel name of CIE 1931 Z (same units as `Y`).
+pub const CHANNEL_Z: &str = "Z";
+/// Channel name of the standard error of the mean of `Y` (cd/m²).
+///
+/// OpenEXR treats the text after the last `.` as the channel and the text before as the
+/// layer, so viewers show this as channel `Y` of a layer `stderr`, next to the main `X`,
+/// `Y`, `Z` layer.
+pub const CHANNEL_Y_STDERR: &str = "stderr.Y";
+/// Header attribute holding the units of the `X`, `Y`, `Z` and `stderr.Y` channels.
+pub const ATTRIBUTE_UNITS: &str = "units";
+/// Value of [`ATTRIBUTE_UNITS`] for candela's absolute photometric images.
+pub const UNITS_CD_PER_M2: &str = "cd/m^2";
+
+/// Everything that can go wrong writing or reading an output file. Every variant names the
+/// file concerned.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The operating system refused a read, write, sync or rename.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file concerned.
+        path: PathBuf,
+        /// What the operating system said.
+        #[source]
+        source: io::Error,
+    },
+    /// The file is not a readable OpenEXR image (corrupt, truncated, unsupported), or the
+    /// EXR encoder refused the image.
+    #[error("{}: not a valid OpenEXR image: {message}", path.display())]
+    Exr {
+        /// The file concerned.
+        path: PathBuf,
+        /// What the EXR library said.
+        message: String,
+    },
+    /// A pixel value is NaN or infinite; such values are never written.
+    #[error(
+        "{}: channel '{channel}' has a non-finite value ({value}) at pixel ({x}, {y}); \
+         refusing to write it",
+        path.display()
+    )]
+    NonFinite {
+        /// The file that was not written.
+        path: PathBuf,
+        /// The channel containing the value.
+        channel: String,
+        /// Column of the pixel (0 = left).
+        x: usize,
+        /// Row of the pixel (0 = top).
+        y: usize,
+        /// The offending value.
+        value: f32,
+    },
+    /// The image description is inconsistent (sizes, names, settings).
+    #[error("{}: {reason}", path.display())]
+    InvalidImage {
+        /// The file that was not written.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The PNG encoder failed.
+    #[error("{}: PNG encoding failed: {message}", path.display())]
+    Png {
+        /// The file that was not written.
+        path: PathBuf,
+        /// What the encoder said.
+        message: String,
+    },
+}
+
+impl OutputError {
+    /// The file this error is about.
+    pub fn path(&self) -> &Path {
+        match self {
+            OutputError::Io { path, .. }
+            | OutputError::Exr { path, .. }
+            | OutputError::NonFinite { path, .. }
+            | OutputError::InvalidImage { path, .. }
+            | OutputError::Png { path, .. } => path,
+        }
+    }
+
+    pub(crate) fn invalid(path: &Path, reason: impl Into<String>) -> Self {
+        OutputError::InvalidImage {
+            path: path.to_path_buf(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// Removes the temporary file when dropped, unless disarmed after the rename. This also
+/// cleans up if the writer closure panics.
+struct TempGuard {
+    path: Option<PathBuf>,
+}
+
+impl Drop for TempGuard {
+    fn drop(&mut self) {
+        if let Some(path) = self.path.take() {
+            let _ = fs::remove_file(path);
+        }
+    }
+}
+
+/// Creates a new, uniquely named temporary file next to `target`.
+fn create_temp_beside(target: &Path) -> Result<(PathBuf, File), OutputError> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let io_err = |source| OutputError::Io {
+        path: target.to_path_buf(),
+        source,
+    };
+    let file_name = target
+        .file_name()
+        .ok_or_else(|| OutputError::invalid(target, "not a file path"))?;
+    let dir = match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.subsec_nanos())
+        .unwrap_or(0);
+    for _ in 0..100 {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let mut name = std::ffi::OsString::from(".");
+        name.push(file_name);
+        name.push(format!(".{}.{n}.{nanos:08x}.tmp", std::process::id()));
+        let temp = dir.join(name);
+        match OpenOptions::new().write(true).create_new(true).open(&temp) {
+            Ok(file) => return Ok((temp, file)),
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(io_err(e)),
+        }
+    }
+    Err(io_err(io::Error::new(
+        io::ErrorKind::AlreadyExists,
+        "could not find a free temporary file name",
+    )))
+}
+
+/// Write bytes atomically: temp file in the same directory (unique name), fsync, rename
+/// over the target. Never leaves a partial target; the temp file is removed on error (and if
+/// `write` panics).
+///
+/// The temporary file is `.<file name>.<pid>.<counter>.<nonce>.tmp` in the target's
+/// directory, so the final rename never crosses file systems. After the rename the
+/// directory is synced too (best effort), so the new name survives a power cut.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> Result<(), OutputError> {
+    let io_err = |source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    if path.is_dir() {
+        return Err(OutputError::invalid(path, "is a directory"));
+    }
+    let (temp, file) = create_temp_beside(path)?;
+    let mut guard = TempGuard {
+        path: Some(temp.clone()),
+    };
+    let mut writer = BufWriter::new(file);
+    write(&mut writer).map_err(io_err)?;
+    let file = writer.into_inner().map_err(|e| io_err(e.into_error()))?;
+    file.sync_all().map_err(io_err)?;
+    drop(file);
+    fs::rename(&temp, path).map_err(io_err)?;
+    guard.path = None;
+    #[cfg(unix)]
+    if let Some(dir) = path.parent() {
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        if let Ok(d) = File::open(dir) {
+            let _ = d.sync_all();
+        }
+    }
+    Ok(())
+}
