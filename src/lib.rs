@@ -2,3 +2,5 @@
 //!
 //! Every pixel is a calibrated photometric quantity (luminance in cd/m², illuminance in lux);
 //! internally everything is spectral radiometry (W·m⁻²·sr⁻¹·nm⁻¹).
+
+pub mod geometry;
