@@ -1,0 +1,499 @@
+//! Primitive storage, ray–primitive intersection, hit construction and sampling.
+//!
+//! Triangles use the watertight test of Woop, Benthin & Wald (2013) as in pbrt-v4, with the
+//! 2×2 edge determinants evaluated exactly-rounded in f64 and pbrt's conservative `t > δt`
+//! check. Spheres, quads and disks are intersected in f64 (their counts are small), which makes
+//! the side-of-surface decisions essentially exact; together with [`super::offset_ray_origin`]
+//! this prevents self-intersection at any scale.
+
+use super::robust::gamma;
+use glam::{DVec3, Vec2, Vec3};
+
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Prim {
+    Triangle([Vec3; 3]),
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    Quad {
+        origin: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+    },
+    /// `normal` is unit length.
+    Disk {
+        center: Vec3,
+        normal: Vec3,
+        radius: f32,
+    },
+}
+
+/// Per-ray precomputation shared by all primitive tests.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RayPre {
+    pub o: Vec3,
+    pub d: Vec3,
+    pub od: DVec3,
+    pub dd: DVec3,
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f32,
+    sy: f32,
+    sz: f32,
+}
+
+impl RayPre {
+    #[inline]
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        let ad = d.abs();
+        let kz = if ad.x > ad.y {
+            if ad.x > ad.z {
+                0
+            } else {
+                2
+            }
+        } else if ad.y > ad.z {
+            1
+        } else {
+            2
+        };
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
+        let sz = 1.0 / d[kz];
+        Self {
+            o,
+            d,
+            od: o.as_dvec3(),
+            dd: d.as_dvec3(),
+            kx,
+            ky,
+            kz,
+            sx: -d[kx] * sz,
+            sy: -d[ky] * sz,
+            sz,
+        }
+    }
+}
+
+/// a·b − c·d, correctly rounded (the f64 products of f32 values are exact), so its sign is exact.
+#[inline(always)]
+fn diff_of_products(a: f32, b: f32, c: f32, d: f32) -> f32 {
+    (a as f64 * b as f64 - c as f64 * d as f64) as f32
+}
+
+/// Result of a primitive test: `t` and two parameters (triangle b1,b2; quad s,t; unused else).
+pub(crate) type PrimT = (f32, f32, f32);
+
+#[inline(always)]
+pub(crate) fn intersect_triangle(r: &RayPre, t_max: f32, p: &[Vec3; 3]) -> Option<PrimT> {
+    let perm = |v: Vec3| Vec3::new(v[r.kx], v[r.ky], v[r.kz]);
+    let mut p0t = perm(p[0] - r.o);
+    let mut p1t = perm(p[1] - r.o);
+    let mut p2t = perm(p[2] - r.o);
+    p0t.x += r.sx * p0t.z;
+    p0t.y += r.sy * p0t.z;
+    p1t.x += r.sx * p1t.z;
+    p1t.y += r.sy * p1t.z;
+    p2t.x += r.sx * p2t.z;
+    p2t.y += r.sy * p2t.z;
+    let e0 = diff_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
+    let e1 = diff_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
+    let e2 = diff_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
+    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 {
+        return None;
+    }
+    p0t.z *= r.sz;
+    p1t.z *= r.sz;
+    p2t.z *= r.sz;
+    let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
+    if det < 0.0 && (t_scaled >= 0.0 || t_scaled <= t_max * det) {
+        return None;
+    }
+    if det > 0.0 && (t_scaled <= 0.0 || t_scaled >= t_max * det) {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let t = t_scaled * inv_det;
+    if t >= t_max || t.is_nan() {
+        return None;
+    }
+    // Conservative check that t is positive despite rounding (pbrt-v4 §6.8.7).
+    let max_zt = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
+    let delta_z = gamma(3) * max_zt;
+    let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
+    let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
+    let delta_x = gamma(5) * (max_xt + max_zt);
+    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+    let delta_t =
+        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    if t <= delta_t {
+        return None;
+    }
+    Some((t, e1 * inv_det, e2 * inv_det))
+}
+
+/// Roots of the ray–sphere quadratic in f64 with the numerically stable discriminant of
+/// Ray Tracing Gems ch. 7. Returns the first root in (0, t_max) with a side-aware rule: a ray
+/// starting outside the sphere and moving away cannot hit it; one starting inside only hits
+/// the far root.
+#[inline]
+pub(crate) fn intersect_sphere(r: &RayPre, t_max: f32, center: Vec3, radius: f32) -> Option<PrimT> {
+    let c = center.as_dvec3();
+    let rad = radius as f64;
+    let f = r.od - c;
+    let a = r.dd.length_squared();
+    let b = -f.dot(r.dd);
+    let cc = f.length_squared() - rad * rad;
+    let l = f + (b / a) * r.dd;
+    let disc = a * (rad * rad - l.length_squared());
+    if disc < 0.0 {
+        return None;
+    }
+    let t = if cc > 0.0 {
+        // Outside: only the near root, and only when moving toward the centre.
+        if b <= 0.0 {
+            return None;
+        }
+        let q = b + disc.sqrt();
+        cc / q
+    } else {
+        // Inside (or exactly on the surface): the far root.
+        let sq = disc.sqrt();
+        if b >= 0.0 {
+            (b + sq) / a
+        } else {
+            cc / (b - sq)
+        }
+    };
+    let t32 = t as f32;
+    (t > 0.0 && t32 > 0.0 && t32 < t_max).then_some((t32, 0.0, 0.0))
+}
+
+#[inline]
+pub(crate) fn intersect_quad(
+    r: &RayPre,
+    t_max: f32,
+    origin: Vec3,
+    eu: Vec3,
+    ev: Vec3,
+) -> Option<PrimT> {
+    let (o, eu, ev) = (origin.as_dvec3(), eu.as_dvec3(), ev.as_dvec3());
+    let n = eu.cross(ev);
+    let den = r.dd.dot(n);
+    if den == 0.0 {
+        return None;
+    }
+    let t = (o - r.od).dot(n) / den;
+    let t32 = t as f32;
+    if !(t > 0.0 && t32 > 0.0 && t32 < t_max) {
+        return None;
+    }
+    let rel = r.od + t * r.dd - o;
+    let nn = n.length_squared();
+    let s = rel.cross(ev).dot(n) / nn;
+    let v = eu.cross(rel).dot(n) / nn;
+    if !((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&v)) {
+        return None;
+    }
+    Some((t32, s as f32, v as f32))
+}
+
+#[inline]
+pub(crate) fn intersect_disk(
+    r: &RayPre,
+    t_max: f32,
+    center: Vec3,
+    normal: Vec3,
+    radius: f32,
+) -> Option<PrimT> {
+    let (c, n) = (center.as_dvec3(), normal.as_dvec3().normalize());
+    let den = r.dd.dot(n);
+    if den == 0.0 {
+        return None;
+    }
+    let t = (c - r.od).dot(n) / den;
+    let t32 = t as f32;
+    if !(t > 0.0 && t32 > 0.0 && t32 < t_max) {
+        return None;
+    }
+    let mut rel = r.od + t * r.dd - c;
+    rel -= rel.dot(n) * n;
+    let rad = radius as f64;
+    if rel.length_squared() > rad * rad {
+        return None;
+    }
+    Some((t32, 0.0, 0.0))
+}
+
+/// Orthonormal basis (t, b) with t × b = n (Duff et al. 2017).
+pub(crate) fn basis(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1.0f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        DVec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
+/// Geometric data of a hit, before shading normals and ids are filled in.
+pub(crate) struct HitGeom {
+    pub p: Vec3,
+    pub ng: Vec3,
+    pub uv: Vec2,
+    pub error: Vec3,
+    /// Barycentrics (b0, b1, b2) for triangles.
+    pub bary: Vec3,
+}
+
+const F64_REL: f64 = 1.0 / (1u64 << 45) as f64;
+
+/// Error bound of an f64-computed point rounded to f32, whose f64 evaluation involved terms of
+/// magnitude `mag` per axis.
+#[inline]
+fn rounded_error(p: Vec3, mag: DVec3) -> Vec3 {
+    p.abs() * gamma(2) + (mag * F64_REL).as_vec3() + Vec3::splat(f32::MIN_POSITIVE)
+}
+
+impl Prim {
+    #[inline(always)]
+    pub fn intersect(&self, r: &RayPre, t_max: f32) -> Option<PrimT> {
+        match self {
+            Prim::Triangle(p) => intersect_triangle(r, t_max, p),
+            Prim::Sphere { center, radius } => intersect_sphere(r, t_max, *center, *radius),
+            Prim::Quad {
+                origin,
+                edge_u,
+                edge_v,
+            } => intersect_quad(r, t_max, *origin, *edge_u, *edge_v),
+            Prim::Disk {
+                center,
+                normal,
+                radius,
+            } => intersect_disk(r, t_max, *center, *normal, *radius),
+        }
+    }
+
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        match *self {
+            Prim::Triangle([a, b, c]) => (a.min(b).min(c), a.max(b).max(c)),
+            Prim::Sphere { center, radius } => (center - radius, center + radius),
+            Prim::Quad {
+                origin,
+                edge_u,
+                edge_v,
+            } => {
+                let pts = [
+                    origin,
+                    origin + edge_u,
+                    origin + edge_v,
+                    origin + edge_u + edge_v,
+                ];
+                let mut lo = pts[0];
+                let mut hi = pts[0];
+                for q in pts {
+                    lo = lo.min(q);
+                    hi = hi.max(q);
+                }
+                (lo, hi)
+            }
+            Prim::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                let n2 = normal * normal;
+                let e = (Vec3::ONE - n2).max(Vec3::ZERO).sqrt() * radius;
+                (center - e, center + e)
+            }
+        }
+    }
+
+    pub fn area(&self) -> f32 {
+        match *self {
+            Prim::Triangle([a, b, c]) => {
+                let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+                (0.5 * (b - a).cross(c - a).length()) as f32
+            }
+            Prim::Sphere { radius, .. } => {
+                (4.0 * std::f64::consts::PI * radius as f64 * radius as f64) as f32
+            }
+            Prim::Quad { edge_u, edge_v, .. } => {
+                edge_u.as_dvec3().cross(edge_v.as_dvec3()).length() as f32
+            }
+            Prim::Disk { radius, .. } => {
+                (std::f64::consts::PI * radius as f64 * radius as f64) as f32
+            }
+        }
+    }
+
+    /// Unit front-face normal (for flat primitives; spheres: at `p`).
+    pub fn normal_at(&self, p: Vec3) -> Vec3 {
+        match *self {
+            Prim::Triangle([a, b, c]) => {
+                let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+                (b - a).cross(c - a).normalize().as_vec3()
+            }
+            Prim::Sphere { center, .. } => (p.as_dvec3() - center.as_dvec3()).normalize().as_vec3(),
+            Prim::Quad { edge_u, edge_v, .. } => edge_u
+                .as_dvec3()
+                .cross(edge_v.as_dvec3())
+                .normalize()
+                .as_vec3(),
+            Prim::Disk { normal, .. } => normal.as_dvec3().normalize().as_vec3(),
+        }
+    }
+
+    /// Full hit geometry for a hit found by [`Prim::intersect`].
+    pub fn hit_geom(&self, r: &RayPre, t: f32, a: f32, b: f32) -> HitGeom {
+        match *self {
+            Prim::Triangle([p0, p1, p2]) => {
+                let b0 = 1.0 - a - b;
+                let p = b0 * p0 + a * p1 + b * p2;
+                let error = gamma(7) * ((b0 * p0).abs() + (a * p1).abs() + (b * p2).abs());
+                HitGeom {
+                    p,
+                    ng: self.normal_at(p),
+                    uv: Vec2::new(a, b),
+                    error,
+                    bary: Vec3::new(b0, a, b),
+                }
+            }
+            Prim::Sphere { center, radius } => {
+                let c = center.as_dvec3();
+                let ph = r.od + t as f64 * r.dd;
+                let mut n = (ph - c).normalize();
+                if !n.is_finite() {
+                    n = DVec3::Z;
+                }
+                let p = (c + n * radius as f64).as_vec3();
+                let theta = n.z.clamp(-1.0, 1.0).acos();
+                let mut phi = n.y.atan2(n.x);
+                if phi < 0.0 {
+                    phi += std::f64::consts::TAU;
+                }
+                HitGeom {
+                    p,
+                    ng: n.as_vec3(),
+                    uv: Vec2::new(
+                        (phi / std::f64::consts::TAU) as f32,
+                        (theta / std::f64::consts::PI) as f32,
+                    ),
+                    error: rounded_error(p, c.abs() + DVec3::splat(radius as f64)),
+                    bary: Vec3::ZERO,
+                }
+            }
+            Prim::Quad {
+                origin,
+                edge_u,
+                edge_v,
+            } => {
+                let (o, eu, ev) = (origin.as_dvec3(), edge_u.as_dvec3(), edge_v.as_dvec3());
+                let (s, v) = (a as f64, b as f64);
+                let p = (o + s * eu + v * ev).as_vec3();
+                HitGeom {
+                    p,
+                    ng: self.normal_at(p),
+                    uv: Vec2::new(a, b),
+                    error: rounded_error(p, o.abs() + eu.abs() + ev.abs()),
+                    bary: Vec3::ZERO,
+                }
+            }
+            Prim::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                let (c, n) = (center.as_dvec3(), normal.as_dvec3().normalize());
+                let mut rel = r.od + t as f64 * r.dd - c;
+                rel -= rel.dot(n) * n;
+                let p = (c + rel).as_vec3();
+                let (tu, tv) = basis(n);
+                let mut phi = rel.dot(tv).atan2(rel.dot(tu));
+                if phi < 0.0 {
+                    phi += std::f64::consts::TAU;
+                }
+                HitGeom {
+                    p,
+                    ng: n.as_vec3(),
+                    uv: Vec2::new(
+                        (rel.length() / radius as f64) as f32,
+                        (phi / std::f64::consts::TAU) as f32,
+                    ),
+                    error: rounded_error(p, c.abs() + DVec3::splat(radius as f64)),
+                    bary: Vec3::ZERO,
+                }
+            }
+        }
+    }
+
+    /// Uniform-by-area sample: (point, unit front-face normal). Computed in f64, so the point
+    /// is accurate to f32 rounding (error bound: [`super::point_error_bound`]).
+    pub fn sample_area(&self, u: Vec2) -> (Vec3, Vec3) {
+        let (u0, u1) = (u.x as f64, u.y as f64);
+        match *self {
+            Prim::Triangle([p0, p1, p2]) => {
+                // Heitz 2019, "A Low-Distortion Map Between Triangle and Square".
+                let (b0, b1) = if u0 < u1 {
+                    let b0 = u0 / 2.0;
+                    (b0, u1 - b0)
+                } else {
+                    let b1 = u1 / 2.0;
+                    (u0 - b1, b1)
+                };
+                let b2 = 1.0 - b0 - b1;
+                let p = b0 * p0.as_dvec3() + b1 * p1.as_dvec3() + b2 * p2.as_dvec3();
+                let p = p.as_vec3();
+                (p, self.normal_at(p))
+            }
+            Prim::Sphere { center, radius } => {
+                let z = 1.0 - 2.0 * u0;
+                let rr = (1.0 - z * z).max(0.0).sqrt();
+                let phi = std::f64::consts::TAU * u1;
+                let n = DVec3::new(rr * phi.cos(), rr * phi.sin(), z);
+                let p = center.as_dvec3() + n * radius as f64;
+                (p.as_vec3(), n.as_vec3())
+            }
+            Prim::Quad {
+                origin,
+                edge_u,
+                edge_v,
+            } => {
+                let p = origin.as_dvec3() + u0 * edge_u.as_dvec3() + u1 * edge_v.as_dvec3();
+                let p = p.as_vec3();
+                (p, self.normal_at(p))
+            }
+            Prim::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                // Shirley–Chiu concentric mapping.
+                let (a, b) = (2.0 * u0 - 1.0, 2.0 * u1 - 1.0);
+                let (r, phi) = if a == 0.0 && b == 0.0 {
+                    (0.0, 0.0)
+                } else if a.abs() > b.abs() {
+                    (a, std::f64::consts::FRAC_PI_4 * (b / a))
+                } else {
+                    (
+                        b,
+                        std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (a / b),
+                    )
+                };
+                let n = normal.as_dvec3().normalize();
+                let (tu, tv) = basis(n);
+                let rad = radius as f64 * r;
+                let p = center.as_dvec3() + rad * (phi.cos() * tu + phi.sin() * tv);
+                (p.as_vec3(), n.as_vec3())
+            }
+        }
+    }
+}

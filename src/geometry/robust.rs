@@ -1,0 +1,143 @@
+//! Floating-point error bounds and robust ray spawning (pbrt-v4 §6.8 style).
+
+use super::Hit;
+use glam::Vec3;
+
+/// Unit roundoff of f32 (half an ulp of 1).
+pub const MACHINE_EPSILON: f32 = f32::EPSILON * 0.5;
+
+/// Fraction by which [`shadow_ray`] shortens the segment toward the target (relative, pbrt's
+/// `ShadowEpsilon`), on top of offsetting both ends.
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
+/// γ(n) = nε / (1 − nε), the classic bound on the relative error of n rounded operations.
+#[inline]
+pub fn gamma(n: i32) -> f32 {
+    let ne = n as f32 * MACHINE_EPSILON;
+    ne / (1.0 - ne)
+}
+
+/// Smallest float strictly greater than `v` (for finite `v`; +∞ stays +∞).
+#[inline]
+pub fn next_float_up(v: f32) -> f32 {
+    if v.is_infinite() && v > 0.0 {
+        return v;
+    }
+    let v = if v == -0.0 { 0.0 } else { v };
+    let bits = v.to_bits();
+    let bits = if v >= 0.0 { bits + 1 } else { bits - 1 };
+    f32::from_bits(bits)
+}
+
+/// Largest float strictly smaller than `v`.
+#[inline]
+pub fn next_float_down(v: f32) -> f32 {
+    if v.is_infinite() && v < 0.0 {
+        return v;
+    }
+    let v = if v == 0.0 { -0.0 } else { v };
+    let bits = v.to_bits();
+    let bits = if v > 0.0 { bits - 1 } else { bits + 1 };
+    f32::from_bits(bits)
+}
+
+/// A conservative per-axis error bound for a point that was computed to (near) full f32
+/// precision from f64 arithmetic, e.g. the points returned by `SceneGeometry::sample_prim`,
+/// or a point given by the caller without a known error. Scale-independent (relative).
+#[inline]
+pub fn point_error_bound(p: Vec3) -> Vec3 {
+    p.abs() * gamma(8) + Vec3::splat(f32::MIN_POSITIVE)
+}
+
+/// Robust origin for a ray leaving surface point `p` (with per-axis absolute error bound
+/// `error`, e.g. [`Hit::error`]) whose geometric normal is `ng` (unit, either orientation), in
+/// direction `w`.
+///
+/// The point is pushed along ±`ng` (to the side `w` points to) just far enough to leave the
+/// box of uncertainty around `p`, then rounded away from `p`, so that a ray from the returned
+/// origin cannot re-intersect the surface it starts on (no acne) — at any scene scale, since
+/// the offset is proportional to the floating-point error of `p` (Ray Tracing Gems ch. 6 /
+/// pbrt-v4 `OffsetRayOrigin`). The offset is tiny (≈ 1e-6 relative to |p|), so contact
+/// shadows are preserved. A ray into the surface (`dot(w, ng) < 0`) starts just below it.
+#[inline]
+pub fn offset_ray_origin(p: Vec3, error: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
+    let d = ng.abs().dot(error);
+    let mut offset = ng * d;
+    if w.dot(ng) < 0.0 {
+        offset = -offset;
+    }
+    let mut po = p + offset;
+    for i in 0..3 {
+        if offset[i] > 0.0 {
+            po[i] = next_float_up(po[i]);
+        } else if offset[i] < 0.0 {
+            po[i] = next_float_down(po[i]);
+        }
+    }
+    po
+}
+
+/// A shadow ray from a hit to a target surface point (`to_point` with unit normal `to_normal`,
+/// e.g. a light sample from `SceneGeometry::sample_prim`). Both ends are offset (the target
+/// with [`point_error_bound`]) and the segment is additionally shortened by
+/// [`SHADOW_EPSILON`] (relative), so neither surface occludes the ray.
+///
+/// Returns `(origin, unit direction, t_max)` for `SceneGeometry::occluded`. If the two points
+/// coincide, `t_max` is 0 (never occluded).
+pub fn shadow_ray(from: &Hit, to_point: Vec3, to_normal: Vec3) -> (Vec3, Vec3, f32) {
+    shadow_ray_between(
+        from.p,
+        from.error,
+        from.ng,
+        to_point,
+        point_error_bound(to_point),
+        to_normal,
+    )
+}
+
+/// General form of [`shadow_ray`] with explicit error bounds at both ends. A zero normal at
+/// either end means "a point not on a surface" (no offset at that end).
+pub fn shadow_ray_between(
+    from_p: Vec3,
+    from_error: Vec3,
+    from_n: Vec3,
+    to_p: Vec3,
+    to_error: Vec3,
+    to_n: Vec3,
+) -> (Vec3, Vec3, f32) {
+    let o = offset_ray_origin(from_p, from_error, from_n, to_p - from_p);
+    let pt = offset_ray_origin(to_p, to_error, to_n, o - to_p);
+    let d = pt - o;
+    let len = d.length();
+    if !(len > 0.0 && len.is_finite()) {
+        return (o, Vec3::Z, 0.0);
+    }
+    (o, d / len, len * (1.0 - SHADOW_EPSILON))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn next_float() {
+        assert!(next_float_up(1.0) > 1.0);
+        assert!(next_float_down(1.0) < 1.0);
+        assert!(next_float_up(0.0) > 0.0);
+        assert!(next_float_up(-0.0) > 0.0);
+        assert!(next_float_down(0.0) < 0.0);
+        assert!(next_float_up(-1.0) > -1.0);
+        assert!(next_float_down(-1.0) < -1.0);
+        assert_eq!(next_float_up(f32::INFINITY), f32::INFINITY);
+    }
+
+    #[test]
+    fn offset_side() {
+        let p = Vec3::new(1e3, 2e3, 0.0);
+        let e = point_error_bound(p);
+        let o = offset_ray_origin(p, e, Vec3::Z, Vec3::new(0.3, 0.0, 1.0));
+        assert!(o.z > 0.0);
+        let o = offset_ray_origin(p, e, Vec3::Z, Vec3::new(0.3, 0.0, -1.0));
+        assert!(o.z < 0.0);
+    }
+}

@@ -1,0 +1,681 @@
+//! The scene BVH: all primitives in one obvhs CWBVH (8-wide, compressed nodes), laid out in
+//! leaf order, with our own traversal node test.
+//!
+//! obvhs's own `CwBvhNode::intersect_ray` clamps the box entry distance to a hard-coded
+//! `1e-4` and ignores `ray.tmin`, which silently culls every node lying entirely closer than
+//! 0.1 mm to the ray origin (and every node for rays shorter than 0.1 mm); it also replaces
+//! direction components below `f32::EPSILON` by ±1/ε, which can cull valid boxes for nearly
+//! axis-parallel rays. We therefore keep obvhs as the builder, node layout and traversal loop
+//! (`obvhs::traverse!`) but supply our own node test ([`node_hitmask`]): entry clamped to 0,
+//! exact reciprocal directions, and per-node conservative padding of the slab distances by
+//! their floating-point error bound, so no box containing a valid hit is ever culled.
+
+use super::prim::{Prim, RayPre};
+use super::robust::gamma;
+use super::{GeometryError, Hit, Shape, SurfacePoint};
+use glam::{UVec2, Vec2, Vec3, Vec3A};
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::node::CwBvhNode;
+use obvhs::cwbvh::CwBvh;
+use obvhs::BvhBuildParams;
+use std::time::Duration;
+
+/// All primitives of the scene in one BVH.
+pub struct SceneGeometry {
+    bvh: CwBvh,
+    /// Primitives in BVH leaf order; the primitive id is the index into this array.
+    prims: Vec<Prim>,
+    prim_object: Vec<u32>,
+    /// Per primitive vertex-normal indices into `normals` (`u32::MAX` = none). Empty when no
+    /// primitive has vertex normals.
+    prim_normals: Vec<[u32; 3]>,
+    normals: Vec<Vec3>,
+    /// (object id, primitive ids), sorted by object id.
+    object_prims: Vec<(u32, Vec<u32>)>,
+    bounds: (Vec3, Vec3),
+}
+
+/// Ray data for the node test.
+struct NodeRay {
+    o: Vec3A,
+    inv: Vec3A,
+    neg: [bool; 3],
+}
+
+const INV_LIMIT: f32 = 1e30;
+
+impl NodeRay {
+    #[inline(always)]
+    fn new(o: Vec3, d: Vec3) -> Self {
+        let inv1 = |x: f32| {
+            let i = 1.0 / x;
+            if i.is_finite() && i.abs() <= INV_LIMIT {
+                i
+            } else if x < 0.0 {
+                -INV_LIMIT
+            } else {
+                INV_LIMIT
+            }
+        };
+        Self {
+            o: o.into(),
+            inv: Vec3A::new(inv1(d.x), inv1(d.y), inv1(d.z)),
+            neg: [d.x < 0.0, d.y < 0.0, d.z < 0.0],
+        }
+    }
+}
+
+/// Slab test of the 8 children of `node` against the ray segment [0, t_max]; returns obvhs's
+/// hitmask. The plane distances are computed as `q·(e/d) + (p−o)/d` (q = quantized plane) and
+/// widened by a bound on their rounding error, so the test is conservative.
+#[inline(always)]
+fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32 {
+    let e = node.compute_extent();
+    let rel = Vec3A::from(node.p) - r.o;
+    let scale = e * r.inv;
+    let base = rel * r.inv;
+    let pad = gamma(7) * (rel.abs() + 255.0 * e) * r.inv.abs();
+    let base_near = base - pad;
+    let base_far = base + pad;
+    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
+    let mut hit_mask = 0u32;
+
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        use std::arch::x86_64::*;
+        #[inline(always)]
+        fn get_q(v: &[u8; 8], i: usize) -> __m128 {
+            unsafe {
+                _mm_set_ps(
+                    *v.get_unchecked(i * 4 + 3) as f32,
+                    *v.get_unchecked(i * 4 + 2) as f32,
+                    *v.get_unchecked(i * 4 + 1) as f32,
+                    *v.get_unchecked(i * 4) as f32,
+                )
+            }
+        }
+        let sx = _mm_set1_ps(scale.x);
+        let sy = _mm_set1_ps(scale.y);
+        let sz = _mm_set1_ps(scale.z);
+        let bnx = _mm_set1_ps(base_near.x);
+        let bny = _mm_set1_ps(base_near.y);
+        let bnz = _mm_set1_ps(base_near.z);
+        let bfx = _mm_set1_ps(base_far.x);
+        let bfy = _mm_set1_ps(base_far.y);
+        let bfz = _mm_set1_ps(base_far.z);
+        let zero = _mm_setzero_ps();
+        let tm = _mm_set1_ps(t_max);
+        for i in 0..2 {
+            let (lo, hi) = (get_q(&node.child_min_x, i), get_q(&node.child_max_x, i));
+            let (qn, qf) = if r.neg[0] { (hi, lo) } else { (lo, hi) };
+            let tnx = _mm_add_ps(_mm_mul_ps(qn, sx), bnx);
+            let tfx = _mm_add_ps(_mm_mul_ps(qf, sx), bfx);
+            let (lo, hi) = (get_q(&node.child_min_y, i), get_q(&node.child_max_y, i));
+            let (qn, qf) = if r.neg[1] { (hi, lo) } else { (lo, hi) };
+            let tny = _mm_add_ps(_mm_mul_ps(qn, sy), bny);
+            let tfy = _mm_add_ps(_mm_mul_ps(qf, sy), bfy);
+            let (lo, hi) = (get_q(&node.child_min_z, i), get_q(&node.child_max_z, i));
+            let (qn, qf) = if r.neg[2] { (hi, lo) } else { (lo, hi) };
+            let tnz = _mm_add_ps(_mm_mul_ps(qn, sz), bnz);
+            let tfz = _mm_add_ps(_mm_mul_ps(qf, sz), bfz);
+            let tmin = _mm_max_ps(_mm_max_ps(tnx, tny), _mm_max_ps(tnz, zero));
+            let tmax = _mm_min_ps(_mm_min_ps(tfx, tfy), _mm_min_ps(tfz, tm));
+            let mask = _mm_movemask_ps(_mm_cmple_ps(tmin, tmax));
+            for j in 0..4 {
+                if mask & (1 << j) != 0 {
+                    let k = i * 4 + j;
+                    let child_bits = ((child_bits8 >> (k * 8)) as u32) & 0xff;
+                    let bit_index = ((bit_index8 >> (k * 8)) as u32) & 0xff;
+                    hit_mask |= child_bits << bit_index;
+                }
+            }
+        }
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
+    for k in 0..8 {
+        let q = |lo: u8, hi: u8, neg: bool| {
+            if neg {
+                (hi as f32, lo as f32)
+            } else {
+                (lo as f32, hi as f32)
+            }
+        };
+        let (nx, fx) = q(node.child_min_x[k], node.child_max_x[k], r.neg[0]);
+        let (ny, fy) = q(node.child_min_y[k], node.child_max_y[k], r.neg[1]);
+        let (nz, fz) = q(node.child_min_z[k], node.child_max_z[k], r.neg[2]);
+        let tmin = (nx * scale.x + base_near.x)
+            .max(ny * scale.y + base_near.y)
+            .max(nz * scale.z + base_near.z)
+            .max(0.0);
+        let tmax = (fx * scale.x + base_far.x)
+            .min(fy * scale.y + base_far.y)
+            .min(fz * scale.z + base_far.z)
+            .min(t_max);
+        if tmin <= tmax {
+            let child_bits = ((child_bits8 >> (k * 8)) as u32) & 0xff;
+            let bit_index = ((bit_index8 >> (k * 8)) as u32) & 0xff;
+            hit_mask |= child_bits << bit_index;
+        }
+    }
+    hit_mask
+}
+
+fn invalid(shape: &Shape, object: u32, message: impl Into<String>) -> GeometryError {
+    GeometryError::InvalidShape {
+        shape: shape.name(),
+        object,
+        message: message.into(),
+    }
+}
+
+fn finite3(v: Vec3) -> bool {
+    v.is_finite()
+}
+
+impl SceneGeometry {
+    /// Builds the BVH over all primitives of `shapes` (already in world space), each tagged
+    /// with the caller's object id.
+    ///
+    /// Triangles with exactly zero area (collinear or repeated vertices) are dropped: they can
+    /// never be hit and cannot be sampled. Invalid shapes (non-finite coordinates,
+    /// non-positive radius, degenerate quad edges, zero disk normal, mesh indices out of range,
+    /// vertex-normal count different from the vertex count) give an error naming the object.
+    /// An empty scene is allowed (every ray misses).
+    pub fn build(shapes: &[(Shape, u32)]) -> Result<SceneGeometry, GeometryError> {
+        Self::build_with_params(shapes, BvhBuildParams::medium_build())
+    }
+
+    /// [`SceneGeometry::build`] with explicit obvhs build parameters (spatial pre-splits are
+    /// always disabled).
+    pub fn build_with_params(
+        shapes: &[(Shape, u32)],
+        mut params: BvhBuildParams,
+    ) -> Result<SceneGeometry, GeometryError> {
+        params.pre_split = false;
+        let mut prims: Vec<Prim> = Vec::new();
+        let mut objects: Vec<u32> = Vec::new();
+        let mut prim_normals: Vec<[u32; 3]> = Vec::new();
+        let mut normals: Vec<Vec3> = Vec::new();
+        let any_normals = shapes
+            .iter()
+            .any(|(s, _)| matches!(s, Shape::Mesh(m) if m.normals.is_some()));
+        let no_n = [u32::MAX; 3];
+        for (shape, object) in shapes {
+            let object = *object;
+            match shape {
+                Shape::Sphere { center, radius } => {
+                    if !(finite3(*center) && radius.is_finite() && *radius > 0.0) {
+                        return Err(invalid(
+                            shape,
+                            object,
+                            format!("center {center} and radius {radius} must be finite with radius > 0"),
+                        ));
+                    }
+                    prims.push(Prim::Sphere {
+                        center: *center,
+                        radius: *radius,
+                    });
+                }
+                Shape::Quad {
+                    origin,
+                    edge_u,
+                    edge_v,
+                } => {
+                    let area = edge_u.as_dvec3().cross(edge_v.as_dvec3()).length();
+                    if !(finite3(*origin)
+                        && finite3(*edge_u)
+                        && finite3(*edge_v)
+                        && area > 0.0
+                        && area.is_finite())
+                    {
+                        return Err(invalid(
+                            shape,
+                            object,
+                            format!("origin {origin}, edges {edge_u} and {edge_v} must be finite and not parallel (the quad has zero area)"),
+                        ));
+                    }
+                    prims.push(Prim::Quad {
+                        origin: *origin,
+                        edge_u: *edge_u,
+                        edge_v: *edge_v,
+                    });
+                }
+                Shape::Disk {
+                    center,
+                    normal,
+                    radius,
+                } => {
+                    let n = normal.as_dvec3().normalize_or_zero();
+                    if !(finite3(*center) && radius.is_finite() && *radius > 0.0)
+                        || n == glam::DVec3::ZERO
+                    {
+                        return Err(invalid(
+                            shape,
+                            object,
+                            format!("center {center}, normal {normal} and radius {radius} must be finite with radius > 0 and a non-zero normal"),
+                        ));
+                    }
+                    prims.push(Prim::Disk {
+                        center: *center,
+                        normal: n.as_vec3(),
+                        radius: *radius,
+                    });
+                }
+                Shape::Mesh(m) => {
+                    if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
+                        return Err(invalid(
+                            shape,
+                            object,
+                            format!("vertex {i} has a non-finite position {}", m.positions[i]),
+                        ));
+                    }
+                    let nbase = normals.len() as u32;
+                    let has_n = match &m.normals {
+                        Some(ns) => {
+                            if ns.len() != m.positions.len() {
+                                return Err(invalid(
+                                    shape,
+                                    object,
+                                    format!(
+                                        "it has {} vertex normals for {} vertices",
+                                        ns.len(),
+                                        m.positions.len()
+                                    ),
+                                ));
+                            }
+                            normals.extend(ns.iter().map(|n| n.normalize_or_zero()));
+                            true
+                        }
+                        None => false,
+                    };
+                    let nv = m.positions.len();
+                    for (f, tri) in m.indices.iter().enumerate() {
+                        if let Some(&bad) = tri.iter().find(|&&i| i as usize >= nv) {
+                            return Err(invalid(
+                                shape,
+                                object,
+                                format!("triangle {f} refers to vertex {bad}, but the mesh has only {nv} vertices"),
+                            ));
+                        }
+                        let v = tri.map(|i| m.positions[i as usize]);
+                        let (a, b, c) = (v[0].as_dvec3(), v[1].as_dvec3(), v[2].as_dvec3());
+                        if (b - a).cross(c - a).length_squared() == 0.0 {
+                            continue; // zero area: dropped
+                        }
+                        prims.push(Prim::Triangle(v));
+                        if any_normals {
+                            prim_normals.push(if has_n { tri.map(|i| nbase + i) } else { no_n });
+                        }
+                        objects.push(object);
+                    }
+                    continue;
+                }
+            }
+            objects.push(object);
+            if any_normals {
+                prim_normals.push(no_n);
+            }
+        }
+        if prims.len() >= u32::MAX as usize {
+            return Err(GeometryError::InvalidShape {
+                shape: "scene",
+                object: 0,
+                message: "too many primitives (at most 2^32 − 1)".into(),
+            });
+        }
+
+        let mut lo = Vec3::INFINITY;
+        let mut hi = Vec3::NEG_INFINITY;
+        let aabbs: Vec<Aabb> = prims
+            .iter()
+            .map(|p| {
+                let (a, b) = p.bounds();
+                lo = lo.min(a);
+                hi = hi.max(b);
+                // Pad by a few ulps so rounding in bounds/quantization can never exclude the
+                // primitive's surface.
+                let pad = (a.abs().max(b.abs()) * gamma(4)) + Vec3::splat(f32::MIN_POSITIVE);
+                Aabb::new((a - pad).into(), (b + pad).into())
+            })
+            .collect();
+        let bounds = if prims.is_empty() {
+            (Vec3::ZERO, Vec3::ZERO)
+        } else {
+            (lo, hi)
+        };
+        let bvh = if prims.is_empty() {
+            CwBvh::default()
+        } else {
+            obvhs::cwbvh::builder::build_cwbvh(&aabbs, params, &mut Duration::default())
+        };
+        drop(aabbs);
+
+        // Lay primitives out in leaf order so the traversal indexes them directly.
+        let order = &bvh.primitive_indices;
+        let prims: Vec<Prim> = order.iter().map(|&i| prims[i as usize]).collect();
+        let prim_object: Vec<u32> = order.iter().map(|&i| objects[i as usize]).collect();
+        let prim_normals: Vec<[u32; 3]> = if any_normals {
+            order.iter().map(|&i| prim_normals[i as usize]).collect()
+        } else {
+            Vec::new()
+        };
+        let mut by_obj: Vec<(u32, u32)> = prim_object
+            .iter()
+            .enumerate()
+            .map(|(i, &o)| (o, i as u32))
+            .collect();
+        by_obj.sort_unstable();
+        let mut object_prims: Vec<(u32, Vec<u32>)> = Vec::new();
+        for (o, i) in by_obj {
+            match object_prims.last_mut() {
+                Some((lo, v)) if *lo == o => v.push(i),
+                _ => object_prims.push((o, vec![i])),
+            }
+        }
+        Ok(SceneGeometry {
+            bvh,
+            prims,
+            prim_object,
+            prim_normals,
+            normals,
+            object_prims,
+            bounds,
+        })
+    }
+
+    #[inline]
+    fn ray_ok(origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO && t_max > 0.0
+    }
+
+    /// Closest hit with `t` in `(0, t_max)` (`t_max` may be `f32::INFINITY`). `dir` need not be
+    /// normalized (any finite non-zero vector); `t` is in units of `|dir|`. Returns `None` for
+    /// a miss or an invalid ray (non-finite, zero direction).
+    pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
+        if self.prims.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+            return None;
+        }
+        let nr = NodeRay::new(origin, dir);
+        let pre = RayPre::new(origin, dir);
+        let mut tmax = t_max;
+        let mut best = u32::MAX;
+        let (mut ba, mut bb) = (0.0f32, 0.0f32);
+        let prims = &self.prims[..];
+        let mut state = self.bvh.new_traversal(Vec3A::from(dir));
+        let mut node;
+        obvhs::traverse!(
+            self.bvh,
+            node,
+            state,
+            node_hitmask(node, &nr, state.oct_inv4, tmax),
+            {
+                let id = state.primitive_id;
+                // SAFETY: primitive ids from the traversal index `primitive_indices`, which has
+                // the same length as `prims`.
+                let prim = unsafe { prims.get_unchecked(id as usize) };
+                if let Some((t, a, b)) = prim.intersect(&pre, tmax) {
+                    tmax = t;
+                    best = id;
+                    ba = a;
+                    bb = b;
+                }
+            }
+        );
+        (best != u32::MAX).then(|| self.make_hit(best, &pre, tmax, ba, bb))
+    }
+
+    /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
+    /// brute-force tests).
+    fn make_hit(&self, prim: u32, pre: &RayPre, t: f32, a: f32, b: f32) -> Hit {
+        let p = &self.prims[prim as usize];
+        let g = p.hit_geom(pre, t, a, b);
+        let mut ns = g.ng;
+        if let Some(idx) = self.prim_normals.get(prim as usize) {
+            if idx[0] != u32::MAX {
+                let n = g.bary.x * self.normals[idx[0] as usize]
+                    + g.bary.y * self.normals[idx[1] as usize]
+                    + g.bary.z * self.normals[idx[2] as usize];
+                let n = n.normalize_or_zero();
+                if n != Vec3::ZERO {
+                    ns = if n.dot(g.ng) < 0.0 { -n } else { n };
+                }
+            }
+        }
+        Hit {
+            t,
+            p: g.p,
+            ng: g.ng,
+            ns,
+            uv: g.uv,
+            prim,
+            object: self.prim_object[prim as usize],
+            front_face: pre.d.dot(g.ng) < 0.0,
+            error: g.error,
+        }
+    }
+
+    /// True if anything is hit with `t` in `(0, t_max)` (any-hit traversal, for shadow rays).
+    /// Same ray conventions as [`SceneGeometry::intersect`].
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        if self.prims.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+            return false;
+        }
+        let nr = NodeRay::new(origin, dir);
+        let pre = RayPre::new(origin, dir);
+        let prims = &self.prims[..];
+        let mut state = self.bvh.new_traversal(Vec3A::from(dir));
+        let mut node;
+        let mut hit = false;
+        'outer: {
+            obvhs::traverse!(
+                self.bvh,
+                node,
+                state,
+                node_hitmask(node, &nr, state.oct_inv4, t_max),
+                {
+                    // SAFETY: see `intersect`.
+                    let prim = unsafe { prims.get_unchecked(state.primitive_id as usize) };
+                    if prim.intersect(&pre, t_max).is_some() {
+                        hit = true;
+                        break 'outer;
+                    }
+                }
+            );
+        }
+        hit
+    }
+
+    /// Brute force closest hit over all primitives (no BVH) — for tests and debugging.
+    pub fn intersect_brute_force(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
+        if !Self::ray_ok(origin, dir, t_max) {
+            return None;
+        }
+        let pre = RayPre::new(origin, dir);
+        let mut tmax = t_max;
+        let mut best = None;
+        for (i, p) in self.prims.iter().enumerate() {
+            if let Some((t, a, b)) = p.intersect(&pre, tmax) {
+                tmax = t;
+                best = Some((i as u32, a, b));
+            }
+        }
+        best.map(|(i, a, b)| self.make_hit(i, &pre, tmax, a, b))
+    }
+
+    /// Primitive ids (as used in [`Hit::prim`]) of that object; empty if unknown.
+    pub fn primitives_of_object(&self, object: u32) -> &[u32] {
+        match self.object_prims.binary_search_by_key(&object, |(o, _)| *o) {
+            Ok(i) => &self.object_prims[i].1,
+            Err(_) => &[],
+        }
+    }
+
+    /// Object ids present in the scene (sorted).
+    pub fn objects(&self) -> impl Iterator<Item = u32> + '_ {
+        self.object_prims.iter().map(|(o, _)| *o)
+    }
+
+    /// The object id of a primitive.
+    pub fn object_of_prim(&self, prim: u32) -> u32 {
+        self.prim_object[prim as usize]
+    }
+
+    /// Surface area of a primitive (m²).
+    pub fn prim_area(&self, prim: u32) -> f32 {
+        self.prims[prim as usize].area()
+    }
+
+    /// Uniform by area on the primitive: point, unit front-face geometric normal; the pdf
+    /// w.r.t. area is `1 / prim_area(prim)`. `u` ∈ [0,1)². The point's error bound is
+    /// [`super::point_error_bound`] (it is computed in f64).
+    pub fn sample_prim(&self, prim: u32, u: Vec2) -> SurfacePoint {
+        let (p, n) = self.prims[prim as usize].sample_area(u);
+        SurfacePoint { p, n }
+    }
+
+    /// For a sphere seen from outside: (sinθmax², 1 − cosθmax) of the cone it subtends.
+    fn sphere_cone(center: Vec3, radius: f32, reference: Vec3) -> Option<(f64, f64)> {
+        let dc2 = (reference.as_dvec3() - center.as_dvec3()).length_squared();
+        let r2 = radius as f64 * radius as f64;
+        // Inside or (numerically) on the sphere: use area sampling instead.
+        if dc2 <= r2 * (1.0 + 1e-6) {
+            return None;
+        }
+        let sin2 = r2 / dc2;
+        let one_minus_cos = if sin2 < 0.00068523 {
+            // Taylor expansion for small angles (pbrt-v4).
+            sin2 / 2.0 + sin2 * sin2 / 8.0
+        } else {
+            1.0 - (1.0 - sin2).max(0.0).sqrt()
+        };
+        Some((sin2, one_minus_cos))
+    }
+
+    /// Solid-angle sampling as seen from `reference`: spheres seen from outside sample the
+    /// subtended cone uniformly; everything else (and a sphere seen from inside) samples area
+    /// uniformly and converts the density. Returns the point (with front-face normal) and its
+    /// pdf w.r.t. solid angle at `reference`, or `None` if that pdf would be 0 / infinite /
+    /// NaN (point at the reference, or seen exactly edge-on). Flat primitives are treated as
+    /// two-sided here (|cos|); emission sidedness is the caller's business.
+    pub fn sample_prim_solid_angle(
+        &self,
+        prim: u32,
+        reference: Vec3,
+        u: Vec2,
+    ) -> Option<(SurfacePoint, f32)> {
+        let pr = &self.prims[prim as usize];
+        if let Prim::Sphere { center, radius } = *pr {
+            if let Some((sin2_max, one_minus_cos_max)) =
+                Self::sphere_cone(center, radius, reference)
+            {
+                // pbrt-v4 Sphere::Sample(ctx, u), in f64.
+                let (u0, u1) = (u.x as f64, u.y as f64);
+                let sin_max = sin2_max.sqrt();
+                let (sin2, cos) = if sin2_max < 0.00068523 {
+                    let s2 = sin2_max * u0;
+                    (s2, (1.0 - s2).sqrt())
+                } else {
+                    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+                    let c = (cos_max - 1.0) * u0 + 1.0;
+                    ((1.0 - c * c).max(0.0), c)
+                };
+                let cos_alpha = sin2 / sin_max + cos * (1.0 - sin2 / sin2_max).max(0.0).sqrt();
+                let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+                let phi = u1 * std::f64::consts::TAU;
+                let c = center.as_dvec3();
+                let wz = (c - reference.as_dvec3()).normalize();
+                let (tx, ty) = super::prim::basis(wz);
+                // Normal at the sampled point, pointing back toward the reference side.
+                let n = -(sin_alpha * phi.cos() * tx + sin_alpha * phi.sin() * ty + cos_alpha * wz);
+                let n = n.normalize();
+                let p = c + n * radius as f64;
+                let pdf = 1.0 / (std::f64::consts::TAU * one_minus_cos_max);
+                let pdf = pdf as f32;
+                if !(pdf.is_finite() && pdf > 0.0) {
+                    return None;
+                }
+                return Some((
+                    SurfacePoint {
+                        p: p.as_vec3(),
+                        n: n.as_vec3(),
+                    },
+                    pdf,
+                ));
+            }
+        }
+        let (p, n) = pr.sample_area(u);
+        let pdf = Self::area_to_solid_angle(pr.area(), reference, p, n);
+        (pdf > 0.0 && pdf.is_finite()).then_some((SurfacePoint { p, n }, pdf))
+    }
+
+    fn area_to_solid_angle(area: f32, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
+        let w = p.as_dvec3() - reference.as_dvec3();
+        let d2 = w.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        let cos = (n.as_dvec3().dot(w) / d2.sqrt()).abs();
+        if cos == 0.0 || area <= 0.0 {
+            return 0.0;
+        }
+        let pdf = (d2 / (cos * area as f64)) as f32;
+        if pdf.is_finite() {
+            pdf
+        } else {
+            0.0
+        }
+    }
+
+    /// The pdf (solid angle at `reference`) that [`SceneGeometry::sample_prim_solid_angle`]
+    /// would have given for the direction that hit `prim` at `hit` (0 when it returns `None`).
+    pub fn pdf_prim_solid_angle(&self, prim: u32, reference: Vec3, hit: &Hit) -> f32 {
+        let pr = &self.prims[prim as usize];
+        if let Prim::Sphere { center, radius } = *pr {
+            if let Some((_, one_minus_cos_max)) = Self::sphere_cone(center, radius, reference) {
+                let pdf = (1.0 / (std::f64::consts::TAU * one_minus_cos_max)) as f32;
+                return if pdf.is_finite() { pdf } else { 0.0 };
+            }
+        }
+        Self::area_to_solid_angle(pr.area(), reference, hit.p, hit.ng)
+    }
+
+    /// Solid angle (sr) subtended by a sphere primitive from outside, if `prim` is one and the
+    /// reference is outside it.
+    pub fn sphere_solid_angle(&self, prim: u32, reference: Vec3) -> Option<f32> {
+        if let Prim::Sphere { center, radius } = self.prims[prim as usize] {
+            let (_, omc) = Self::sphere_cone(center, radius, reference)?;
+            return Some((std::f64::consts::TAU * omc) as f32);
+        }
+        None
+    }
+
+    /// World-space bounds of all primitives (`(0, 0)` for an empty scene).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+
+    pub fn primitive_count(&self) -> usize {
+        self.prims.len()
+    }
+
+    /// Number of CWBVH nodes (80 bytes each).
+    pub fn node_count(&self) -> usize {
+        self.bvh.nodes.len()
+    }
+
+    /// Approximate heap memory in bytes (BVH nodes, primitive data, per-primitive ids, normals).
+    pub fn memory_bytes(&self) -> usize {
+        self.bvh.nodes.capacity() * std::mem::size_of::<CwBvhNode>()
+            + self.bvh.primitive_indices.capacity() * 4
+            + self.prims.capacity() * std::mem::size_of::<Prim>()
+            + self.prim_object.capacity() * 4
+            + self.prim_normals.capacity() * 12
+            + self.normals.capacity() * 12
+            + self
+                .object_prims
+                .iter()
+                .map(|(_, v)| v.capacity() * 4 + 32)
+                .sum::<usize>()
+    }
+}
