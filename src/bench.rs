@@ -33,7 +33,8 @@ pub fn run(threads: Option<usize>, spp: u32, triangles: usize) -> anyhow::Result
 
     // A displaced sphere of ~`triangles` triangles on a floor, under a sky and a sun.
     let t0 = Instant::now();
-    let mesh = crate::geometry::generate::bumpy_sphere_with_triangles(triangles);
+    let subdivisions = ((triangles as f64 / 12.0).sqrt().ceil() as u32).max(1);
+    let mesh = crate::geometry::generate::bumpy_sphere(subdivisions);
     let n_tris = mesh.indices.len();
     let scene = SceneFile {
         camera: CameraDesc {

@@ -17,7 +17,11 @@ pub enum PixelFilter {
     /// Tent (triangle) of the given radius in pixels.
     Tent { radius: f32 },
     /// Gaussian of standard deviation `sigma` px truncated at `radius` px.
-    Gaussian { sigma: f32, radius: f32, table: GaussianTable },
+    Gaussian {
+        sigma: f32,
+        radius: f32,
+        table: GaussianTable,
+    },
 }
 
 /// Inverse CDF of a truncated Gaussian, tabulated.
@@ -100,6 +104,13 @@ pub struct CameraRay {
     pub dir: Vec3,
 }
 
+/// A thin lens: aperture radius and focus distance, metres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    pub radius: f32,
+    pub focus_distance: f32,
+}
+
 /// Pinhole or thin-lens perspective camera.
 #[derive(Clone, Debug)]
 pub struct Camera {
@@ -124,11 +135,16 @@ impl Camera {
         look_at: Vec3,
         up: Vec3,
         vfov_deg: f32,
-        width: usize,
-        height: usize,
-        lens_radius: f32,
-        focus_distance: f32,
+        (width, height): (usize, usize),
+        lens: Option<ThinLens>,
     ) -> Self {
+        let ThinLens {
+            radius: lens_radius,
+            focus_distance,
+        } = lens.unwrap_or(ThinLens {
+            radius: 0.0,
+            focus_distance: 1.0,
+        });
         let forward = (look_at - position).normalize();
         // With a right-handed world (+y up, camera looking along +z) +x appears on the left.
         let right = forward.cross(up).normalize();
@@ -197,10 +213,8 @@ mod tests {
             Vec3::ZERO,
             Vec3::Y,
             40.0,
-            100,
-            100,
-            0.0,
-            1.0,
+            (100, 100),
+            None,
         );
         let r = c.generate_ray(50.0, 50.0, Vec2::ZERO);
         assert!((r.dir - Vec3::Z).length() < 1e-6);
@@ -217,7 +231,11 @@ mod tests {
         let f = PixelFilter::gaussian(0.5, 1.5);
         let n = 20_000;
         let var: f32 = (0..n)
-            .map(|i| f.sample(Vec2::new((i as f32 + 0.5) / n as f32, 0.5)).x.powi(2))
+            .map(|i| {
+                f.sample(Vec2::new((i as f32 + 0.5) / n as f32, 0.5))
+                    .x
+                    .powi(2)
+            })
             .sum::<f32>()
             / n as f32;
         // Truncation at 3σ reduces the variance by ~2.7 %.

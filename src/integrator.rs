@@ -5,7 +5,7 @@
 //! lights through [`crate::light::Light`]'s, so new families slot in without touching it.
 
 use crate::bxdf::Frame;
-use crate::geometry::{offset_ray_origin, Hit};
+use crate::geometry::{shadow_ray, Hit};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
@@ -94,8 +94,8 @@ pub fn radiance(
                 if prev_specular {
                     l += beta * le;
                 } else {
-                    let p_light =
-                        world.light_sampler.pmf(li as usize) * light.pdf_li_hit(&world.geometry, prev_p, &hit);
+                    let p_light = world.light_sampler.pmf(li as usize)
+                        * light.pdf_li_hit(&world.geometry, prev_p, &hit);
                     l += beta * le * power_heuristic(prev_pdf, p_light);
                 }
             }
@@ -148,7 +148,7 @@ pub fn radiance(
         let Some(bs) = material.sample(wo, uc, u, wl) else {
             break;
         };
-        if !(bs.pdf > 0.0) {
+        if bs.pdf.is_nan() || bs.pdf <= 0.0 {
             break;
         }
         beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
@@ -159,7 +159,7 @@ pub fn radiance(
         prev_pdf = bs.pdf;
         prev_p = hit.p;
         let wi_world = frame.to_world(bs.wi);
-        ray_o = offset_ray_origin(&hit, wi_world);
+        ray_o = hit.spawn_origin(wi_world);
         ray_d = wi_world.normalize();
         stats.bounce_rays += 1;
         depth += 1;
@@ -182,26 +182,17 @@ pub fn radiance(
 
 /// Shadow test between a shading point and a light sample.
 fn unoccluded(world: &World, hit: &Hit, ls: &crate::light::LightSample) -> bool {
-    let origin = offset_ray_origin(hit, ls.wi);
-    match ls.point {
-        Some((p, n)) => {
-            let target = crate::geometry::offset_point(p, n, -ls.wi);
-            let d = target - origin;
-            let dist = d.length();
-            if dist <= 0.0 {
-                return true;
-            }
-            !world.geometry.occluded(origin, d / dist, dist)
-        }
+    let (origin, dir, t_max) = match ls.point {
+        Some((p, n)) => shadow_ray(hit, p, n),
         None => {
+            let origin = hit.spawn_origin(ls.wi);
             let t_max = if ls.dist.is_finite() {
-                // Distance from the offset origin to the light.
-                let to = hit.p + ls.wi * ls.dist;
-                (to - origin).length()
+                (hit.p + ls.wi * ls.dist - origin).length()
             } else {
                 f32::INFINITY
             };
-            !world.geometry.occluded(origin, ls.wi, t_max)
+            (origin, ls.wi, t_max)
         }
-    }
+    };
+    t_max <= 0.0 || !world.geometry.occluded(origin, dir, t_max)
 }

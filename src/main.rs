@@ -11,7 +11,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "candela", version, about = "A spectral path tracer whose output is measured light (cd/m², lux).")]
+#[command(
+    name = "candela",
+    version,
+    about = "A spectral path tracer whose output is measured light (cd/m², lux)."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -246,7 +250,8 @@ fn write_outputs(
             ("spp".into(), (film.total_samples() / (film.width * film.height) as u64).to_string()),
         ],
     };
-    output::write_exr(exr_path, &layers).with_context(|| format!("writing {}", exr_path.display()))?;
+    output::write_exr(exr_path, &layers)
+        .with_context(|| format!("writing {}", exr_path.display()))?;
     output::write_srgb_png(
         png_path,
         film.width,

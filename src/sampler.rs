@@ -49,7 +49,10 @@ impl Sampler {
         let (dim, seed) = if d < DIMS {
             (d, self.block_seed)
         } else {
-            (d % DIMS, mix64(self.seed ^ ((d / DIMS) as u64) << 40 ^ self.block_seed as u64) as u32)
+            (
+                d % DIMS,
+                mix64(self.seed ^ ((d / DIMS) as u64) << 40 ^ self.block_seed as u64) as u32,
+            )
         };
         sobol_burley::sample(self.index, dim, seed).min(ONE_MINUS_EPSILON)
     }

@@ -43,8 +43,14 @@ fn expect_error(text: &str, extra: &[(&str, &[u8])], needles: &[&str]) {
     let (code, stderr, files) = run(text, extra);
     assert_eq!(code, 1, "exit code {code}, stderr:\n{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
-    assert!(files.is_empty(), "output written despite the error: {files:?}");
-    assert!(stderr.contains("scene.ron"), "message does not name the file:\n{stderr}");
+    assert!(
+        files.is_empty(),
+        "output written despite the error: {files:?}"
+    );
+    assert!(
+        stderr.contains("scene.ron"),
+        "message does not name the file:\n{stderr}"
+    );
     for n in needles {
         assert!(stderr.contains(n), "message lacks {n:?}:\n{stderr}");
     }
@@ -54,7 +60,10 @@ fn expect_error(text: &str, extra: &[(&str, &[u8])], needles: &[&str]) {
 fn good_scene_renders_both_outputs() {
     let (code, stderr, files) = run(GOOD, &[]);
     assert_eq!(code, 0, "{stderr}");
-    assert_eq!(files, vec!["scene.exr".to_string(), "scene.png".to_string()]);
+    assert_eq!(
+        files,
+        vec!["scene.exr".to_string(), "scene.png".to_string()]
+    );
 }
 
 #[test]
@@ -113,7 +122,10 @@ fn unknown_material() {
 
 #[test]
 fn missing_mesh_file() {
-    let text = GOOD.replace("Sphere(center: (0, 0, 3), radius: 1)", "Obj(\"nowhere.obj\")");
+    let text = GOOD.replace(
+        "Sphere(center: (0, 0, 3), radius: 1)",
+        "Obj(\"nowhere.obj\")",
+    );
     expect_error(&text, &[], &["objects[0].shape", "nowhere.obj"]);
 }
 
@@ -157,7 +169,11 @@ fn out_file_name_is_respected() {
         .arg(&scene)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(Path::new(&dir.path().join("named.exr")).exists());
     assert!(Path::new(&dir.path().join("named.png")).exists());
 }

@@ -115,7 +115,12 @@ mod tests {
 
     #[test]
     fn frame_is_orthonormal() {
-        for n in [Vec3::Z, -Vec3::Z, Vec3::new(0.3, -0.4, 0.866).normalize(), Vec3::X] {
+        for n in [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(0.3, -0.4, 0.866).normalize(),
+            Vec3::X,
+        ] {
             let f = Frame::from_normal(n);
             assert!(f.t.dot(f.b).abs() < 1e-6 && f.t.dot(f.n).abs() < 1e-6);
             assert!((f.t.length() - 1.0).abs() < 1e-6 && (f.b.length() - 1.0).abs() < 1e-6);

@@ -30,7 +30,7 @@ pub fn luminous_integral(s: &DenseSpectrum) -> f64 {
 /// `amount / (K_m ∫ S V dλ)`. Errors if the spectrum has no visible content.
 pub fn photometric_scale(s: &DenseSpectrum, amount: f64) -> Result<f32, String> {
     let k = luminous_integral(s);
-    if !(k > 0.0) || !k.is_finite() {
+    if k.is_nan() || k <= 0.0 || !k.is_finite() {
         return Err("the spectrum has no luminous content (K_m ∫ S V dλ = 0), so a photometric amount cannot be assigned to it".into());
     }
     Ok((amount / k) as f32)
@@ -219,7 +219,7 @@ impl Light {
                 let (sp, pdf_sa) = geom.sample_prim_solid_angle(prim, p, u)?;
                 let d = sp.p - p;
                 let dist = d.length();
-                if dist == 0.0 || !(pdf_sa > 0.0) || !pdf_sa.is_finite() {
+                if dist == 0.0 || pdf_sa.is_nan() || pdf_sa <= 0.0 || !pdf_sa.is_finite() {
                     return None;
                 }
                 let wi = d / dist;

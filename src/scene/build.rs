@@ -4,7 +4,7 @@
 use super::schema::*;
 use super::SceneError;
 use crate::bxdf::{Diffuse, Frame, Material};
-use crate::camera::{Camera, PixelFilter};
+use crate::camera::{Camera, PixelFilter, ThinLens};
 use crate::colour::sd::SpectralDistribution;
 use crate::colour::{planck::planck_law, tables};
 use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
@@ -203,7 +203,10 @@ fn build_shape(ctx: &Ctx, field: &str, desc: &ShapeDesc) -> Result<Shape, SceneE
             let eu = ctx.vec3(&f("edge_u"), *edge_u)?;
             let ev = ctx.vec3(&f("edge_v"), *edge_v)?;
             if eu.cross(ev).length_squared() == 0.0 {
-                return Err(ctx.err(field, "the quad has zero area (edge_u and edge_v are parallel or zero)"));
+                return Err(ctx.err(
+                    field,
+                    "the quad has zero area (edge_u and edge_v are parallel or zero)",
+                ));
             }
             Shape::Quad {
                 origin: ctx.vec3(&f("origin"), *origin)?,
@@ -266,7 +269,10 @@ fn build_shape(ctx: &Ctx, field: &str, desc: &ShapeDesc) -> Result<Shape, SceneE
                 }
                 let mut v = Vec::with_capacity(ns.len());
                 for (k, n) in ns.iter().enumerate() {
-                    v.push(ctx.vec3(&format!("{field}.normals[{k}]"), *n)?.normalize_or_zero());
+                    v.push(
+                        ctx.vec3(&format!("{field}.normals[{k}]"), *n)?
+                            .normalize_or_zero(),
+                    );
                 }
                 mesh.normals = Some(v);
             }
@@ -304,11 +310,7 @@ fn build_transform(ctx: &Ctx, field: &str, t: &TransformDesc) -> Result<Transfor
 }
 
 /// Check one scene and build the world.
-pub fn build(
-    scene: &SceneFile,
-    path: &Path,
-    overrides: &Overrides,
-) -> Result<World, SceneError> {
+pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<World, SceneError> {
     let ctx = Ctx {
         path,
         dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
@@ -349,8 +351,8 @@ pub fn build(
             ),
         ));
     }
-    let (lens_radius, focus) = match &c.lens {
-        None => (0.0, 1.0),
+    let lens = match &c.lens {
+        None => None,
         Some(l) => {
             let r = ctx.finite("camera.lens.aperture_radius", l.aperture_radius as f64)?;
             if r < 0.0 {
@@ -360,7 +362,10 @@ pub fn build(
                 ));
             }
             let f = ctx.positive("camera.lens.focus_distance", l.focus_distance as f64)?;
-            (r as f32, f as f32)
+            Some(ThinLens {
+                radius: r as f32,
+                focus_distance: f as f32,
+            })
         }
     };
     let camera = Camera::new(
@@ -368,10 +373,8 @@ pub fn build(
         look_at,
         up,
         vfov as f32,
-        w as usize,
-        h as usize,
-        lens_radius,
-        focus,
+        (w as usize, h as usize),
+        lens,
     );
 
     // Render settings.
@@ -382,7 +385,10 @@ pub fn build(
     }
     let max_depth = overrides.max_depth.unwrap_or(r.max_depth);
     if max_depth > 10_000 {
-        return Err(ctx.err("render.max_depth", format!("{max_depth} is unreasonably deep (limit 10000)")));
+        return Err(ctx.err(
+            "render.max_depth",
+            format!("{max_depth} is unreasonably deep (limit 10000)"),
+        ));
     }
     let filter = match r.filter {
         FilterDesc::Box => PixelFilter::Box,
@@ -480,9 +486,12 @@ pub fn build(
     let mut infinite_lights = Vec::new();
     for (object, field, s, amount, two_sided) in pending_area {
         let prims = geometry.primitives_of_object(object).to_vec();
-        let areas: Vec<f64> = prims.iter().map(|&p| geometry.prim_area(p) as f64).collect();
+        let areas: Vec<f64> = prims
+            .iter()
+            .map(|&p| geometry.prim_area(p) as f64)
+            .collect();
         let total: f64 = areas.iter().sum();
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return Err(ctx.err(
                 format!("{field}.emission"),
                 "the emitting shape has zero area",
@@ -549,7 +558,10 @@ pub fn build(
 fn nonneg(ctx: &Ctx, field: &str, v: f64) -> Result<f64, SceneError> {
     ctx.finite(field, v)?;
     if v < 0.0 {
-        return Err(ctx.err(field, format!("a photometric amount cannot be negative, got {v}")));
+        return Err(ctx.err(
+            field,
+            format!("a photometric amount cannot be negative, got {v}"),
+        ));
     }
     Ok(v)
 }
@@ -599,7 +611,9 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
             }
             let inner = ctx.finite(&format!("{field}.inner_deg"), *inner_deg as f64)?;
             let outer = ctx.finite(&format!("{field}.outer_deg"), *outer_deg as f64)?;
-            if !(0.0..=180.0).contains(&inner) || !(outer > 0.0 && outer <= 180.0) || inner > outer {
+            let valid =
+                (0.0..=180.0).contains(&inner) && outer > 0.0 && outer <= 180.0 && inner <= outer;
+            if !valid {
                 return Err(ctx.err(
                     format!("{field}.outer_deg"),
                     format!("cone half-angles must satisfy 0 ≤ inner ≤ outer ≤ 180 and outer > 0, got inner {inner}, outer {outer}"),
@@ -630,7 +644,10 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
         } => {
             let d = ctx.vec3(&format!("{field}.direction"), *direction)?;
             if d.length_squared() == 0.0 {
-                return Err(ctx.err(format!("{field}.direction"), "the direction is the zero vector"));
+                return Err(ctx.err(
+                    format!("{field}.direction"),
+                    "the direction is the zero vector",
+                ));
             }
             let lux = match amount {
                 Amount::Illuminance(e) => nonneg(ctx, &afield, *e)?,

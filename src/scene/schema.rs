@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 pub type V3 = [f32; 3];
 
 #[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Scene")]
 pub struct SceneFile {
     pub camera: CameraDesc,
     #[serde(default)]
@@ -242,5 +242,8 @@ pub enum LightDesc {
         amount: Amount,
     },
     /// Uniform light from every direction; amount `Luminance(cd/m²)`.
-    Environment { spectrum: SpectrumDesc, amount: Amount },
+    Environment {
+        spectrum: SpectrumDesc,
+        amount: Amount,
+    },
 }

@@ -45,7 +45,11 @@ impl SampledSpectrum {
     pub fn safe_div(self, d: Self) -> Self {
         let mut r = self;
         for i in 0..N_LAMBDA {
-            r.0[i] = if d.0[i] != 0.0 { self.0[i] / d.0[i] } else { 0.0 };
+            r.0[i] = if d.0[i] != 0.0 {
+                self.0[i] / d.0[i]
+            } else {
+                0.0
+            };
         }
         r
     }
@@ -56,7 +60,7 @@ impl SampledSpectrum {
 }
 
 macro_rules! lanewise {
-    ($tr:ident, $f:ident, $op:tt, $tra:ident, $fa:ident) => {
+    ($tr:ident, $f:ident, $op:tt, $opa:tt, $tra:ident, $fa:ident) => {
         impl $tr for SampledSpectrum {
             type Output = Self;
             #[inline]
@@ -74,7 +78,7 @@ macro_rules! lanewise {
             fn $f(self, o: f32) -> Self {
                 let mut r = self;
                 for v in r.0.iter_mut() {
-                    *v = *v $op o;
+                    *v $opa o;
                 }
                 r
             }
@@ -87,8 +91,8 @@ macro_rules! lanewise {
         }
     };
 }
-lanewise!(Add, add, +, AddAssign, add_assign);
-lanewise!(Mul, mul, *, MulAssign, mul_assign);
+lanewise!(Add, add, +, +=, AddAssign, add_assign);
+lanewise!(Mul, mul, *, *=, MulAssign, mul_assign);
 
 impl Sub for SampledSpectrum {
     type Output = Self;
