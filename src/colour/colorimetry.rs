@@ -62,8 +62,9 @@ fn weighted_sums(w: impl Fn(usize) -> f64, observer: Observer, method: XyzMethod
 /// (for irradiance in W·m⁻²·nm⁻¹, Y is illuminance in lx).  No colorimetric normalisation.
 ///
 /// Reference: CIE 15:2018 §7.1 (k = K_m for photometric Y); colour-science
-/// `sd_to_XYZ(sd, cmfs, k=683, method="Integration")` × 100 (colour-science divides by
-/// 100 whenever `k` is given, treating the result as a percentage).
+/// `sd_to_XYZ(sd, cmfs, k=683, method="Integration")` (for 1 nm data; note that
+/// colour-science's default ASTM E308 path divides by 100 when `k` is given for intervals
+/// other than 1 nm).
 pub fn sd_to_xyz_absolute(spectrum: &[f64; LEN], observer: Observer) -> [f64; 3] {
     sd_to_xyz_absolute_with(spectrum, observer, XyzMethod::Integration)
 }
