@@ -3,5 +3,6 @@
 //! Every pixel is a calibrated photometric quantity (luminance in cd/m², illuminance in lux);
 //! internally everything is spectral radiometry (W·m⁻²·sr⁻¹·nm⁻¹).
 
+pub mod cli_colour;
 pub mod colour;
 pub mod photometry;
