@@ -296,6 +296,21 @@ pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow:
     Ok(out)
 }
 
+/// Parses the `--observer` value: "1931" / "2" / "cie1931" → CIE 1931 2°, "1964" / "10" /
+/// "cie1964" → CIE 1964 10°.
+pub fn parse_observer(s: &str) -> anyhow::Result<Observer> {
+    match s
+        .trim()
+        .to_lowercase()
+        .replace([' ', '-', '_', '°'], "")
+        .as_str()
+    {
+        "1931" | "2" | "cie1931" | "cie19312" => Ok(Observer::Cie1931_2),
+        "1964" | "10" | "cie1964" | "cie196410" => Ok(Observer::Cie1964_10),
+        _ => bail!("unknown observer '{s}': use 1931 (CIE 1931 2°) or 1964 (CIE 1964 10°)"),
+    }
+}
+
 /// `candela convert VALUE FROM TO`: photometric unit conversion (see
 /// [`crate::photometry::convert`] and the unit table in `docs/colour.md`).  Returns one
 /// line, e.g. `100 footcandle = 1076.391041670972 lux`.
@@ -371,6 +386,13 @@ mod tests {
         assert!(spectrum_command(p.to_str().unwrap(), Observer::Cie1931_2, false).is_err());
         std::fs::write(&p, "400,1\n500,1\n600,1\n").unwrap();
         assert!(spectrum_command(p.to_str().unwrap(), Observer::Cie1931_2, false).is_ok());
+    }
+
+    #[test]
+    fn observers() {
+        assert_eq!(parse_observer("1931").unwrap(), Observer::Cie1931_2);
+        assert_eq!(parse_observer("1964").unwrap(), Observer::Cie1964_10);
+        assert!(parse_observer("1976").is_err());
     }
 
     #[test]

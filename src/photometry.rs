@@ -123,6 +123,14 @@ pub fn blackbody_scotopic_luminous_efficacy(temperature_k: f64) -> f64 {
     scotopic_luminous_flux(&l) / blackbody_total_radiance(temperature_k)
 }
 
+/// Luminance (cd/m²) of a Lambertian surface of diffuse reflectance `rho` under
+/// illuminance `lux`: L = ρE/π.
+///
+/// Reference: closed-forms.md §2.5 (ρ = 0.5 under 1000 lx → 159.15 cd/m²).
+pub fn lambertian_luminance(rho: f64, lux: f64) -> f64 {
+    rho * lux / std::f64::consts::PI
+}
+
 /// Physical quantity of a photometric unit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Quantity {
@@ -396,6 +404,11 @@ mod tests {
             assert!((kp - p).abs() <= 1.5e-4 * p + 5e-4, "{t}: {kp} vs {p}");
             assert!((ks - s).abs() <= 1.5e-4 * s + 5e-4, "{t}: {ks} vs {s}");
         }
+    }
+
+    #[test]
+    fn lambertian() {
+        assert!((lambertian_luminance(0.5, 1000.0) - 159.15).abs() < 5e-3);
     }
 
     #[test]

@@ -40,10 +40,49 @@ pub fn sd_cie_daylight(cct_k: f64) -> [f64; LEN] {
     sd_cie_illuminant_d_series(cct_to_xy_cie_d(cct_k))
 }
 
+/// Relative spectral power of CIE standard illuminant A at `nm`:
+/// S_A(λ) = 100 (560/λ)⁵ (exp(1.435e7/(2848·560)) − 1) / (exp(1.435e7/(2848 λ)) − 1).
+///
+/// Reference: CIE 15:2018 eq. 4.1 (ISO 11664-2); colour-science
+/// `sd_CIE_standard_illuminant_A`.
+pub fn cie_illuminant_a(nm: f64) -> f64 {
+    let c2: f64 = 1.435e7;
+    100.0 * (560.0 / nm).powi(5) * ((c2 / (2848.0 * 560.0)).exp() - 1.0)
+        / ((c2 / (2848.0 * nm)).exp() - 1.0)
+}
+
+/// [`cie_illuminant_a`] evaluated at 360–830 nm every 1 nm.  Unlike the tabulated `A` from
+/// `data/illuminants.csv` (colour-science's 300–780 nm table, constant beyond 780 nm as
+/// colour-science's `align` extrapolates it), this follows the formula up to 830 nm.
+pub fn sd_cie_standard_illuminant_a() -> [f64; LEN] {
+    let mut out = [0.0; LEN];
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = cie_illuminant_a(360.0 + i as f64);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::colour::tables::named_spectrum;
+
+    #[test]
+    fn illuminant_a_closed_form() {
+        // closed-forms.md §2.9: S_A(560) = 100, S_A(300) = 0.930483, S_A(830) = 261.602.
+        assert!((cie_illuminant_a(560.0) - 100.0).abs() < 1e-12);
+        assert!((cie_illuminant_a(300.0) - 0.930483).abs() < 5e-7);
+        assert!((cie_illuminant_a(830.0) - 261.602).abs() < 5e-4);
+        // The tabulated A agrees with the formula at its 5 nm nodes (6 significant digits).
+        let a = named_spectrum("A").unwrap();
+        for nm in (360..=780).step_by(5) {
+            let f = cie_illuminant_a(nm as f64);
+            assert!((a.value(nm as f64) - f).abs() / f < 1e-5, "{nm}");
+        }
+        // Beyond 780 nm the table is colour-science's constant extrapolation.
+        assert_eq!(a.value(830.0), a.value(780.0));
+        assert!((sd_cie_standard_illuminant_a()[830 - 360] - 261.602).abs() < 5e-4);
+    }
 
     #[test]
     fn d65_from_its_chromaticity() {
