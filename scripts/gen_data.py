@@ -59,9 +59,11 @@ def fmt(v: float) -> str:
     return repr(v)
 
 
-def aligned(sd, zero_extrapolation=False):
+def aligned(sd, zero_extrapolation=False, linear=False):
     sd = sd.copy()
-    if zero_extrapolation:
+    if linear:
+        sd = sd.align(SHAPE, interpolator=colour.LinearInterpolator)
+    elif zero_extrapolation:
         sd = sd.align(SHAPE, extrapolator_kwargs={"method": "Constant", "left": 0, "right": 0})
     else:
         sd = sd.align(SHAPE)
@@ -147,20 +149,26 @@ def main() -> int:
     )
 
     # --- daylight basis --------------------------------------------------------------
+    # colour-science's sd_CIE_illuminant_D_series combines S0 + M1 S1 + M2 S2 at the basis'
+    # native 5 nm and returns a spectrum with LinearInterpolator, so a 1 nm D-series
+    # illuminant is the *linear* interpolation of the 5 nm combination.  Linear interpolation
+    # commutes with the linear combination, so the basis is aligned with LinearInterpolator
+    # here (not with the basis' own Sprague default) to reproduce that exactly.
     basis = colour.colorimetry.SDS_BASIS_FUNCTIONS_CIE_ILLUMINANT_D_SERIES
     write(
         "daylight-basis.csv",
         "# CIE daylight basis functions S0, S1, S2\n"
         f"# source: colour-science {VERSION}, "
         "colour.colorimetry.SDS_BASIS_FUNCTIONS_CIE_ILLUMINANT_D_SERIES[S0|S1|S2]"
-        ".copy().align(SpectralShape(360, 830, 1))\n"
+        ".copy().align(SpectralShape(360, 830, 1), interpolator=LinearInterpolator)\n"
         + "".join(
-            f"#   {k}: native {s.shape.start:g}-{s.shape.end:g} nm every {s.shape.interval:g} nm, "
-            f"{s.interpolator.__name__}\n"
+            f"#   {k}: native {s.shape.start:g}-{s.shape.end:g} nm every {s.shape.interval:g} nm\n"
             for k, s in basis.items()
         )
+        + "#   linear interpolation, as colour.sd_CIE_illuminant_D_series(xy).align(shape)\n"
+        "#   interpolates the 5 nm D-series spectrum it builds from these functions\n"
         + LICENCE_CIE,
-        {k: aligned(s) for k, s in basis.items()},
+        {k: aligned(s, linear=True) for k, s in basis.items()},
     )
 
     # --- ColorChecker ---------------------------------------------------------------

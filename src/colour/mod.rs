@@ -5,7 +5,13 @@
 //! the Python reference library colour-science 0.4.7 (see `tests/colour_science.rs` and
 //! `docs/colour.md`).
 
+pub mod adaptation;
+pub mod colorimetry;
+pub mod cri;
+pub mod illuminants;
+pub mod models;
 pub mod planck;
 pub mod rgb;
 pub mod sd;
 pub mod tables;
+pub mod temperature;

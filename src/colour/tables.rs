@@ -40,6 +40,38 @@ pub struct Cmfs {
     pub z: [f64; LEN],
 }
 
+impl Cmfs {
+    /// x̄, ȳ, z̄ at wavelength `nm` (linear interpolation between the 1 nm samples, 0 outside
+    /// 360–830 nm) — for Monte Carlo wavelength sampling in the renderer.
+    pub fn at(&self, nm: f64) -> [f64; 3] {
+        [
+            interp_table(&self.x, nm),
+            interp_table(&self.y, nm),
+            interp_table(&self.z, nm),
+        ]
+    }
+}
+
+/// Value of a 1 nm table (index `i` ↔ `360 + i` nm) at wavelength `nm`: linear interpolation,
+/// exact at integer nm, 0 outside 360–830 nm (same rule as
+/// [`SpectralDistribution::value`]).
+pub fn interp_table(table: &[f64; LEN], nm: f64) -> f64 {
+    let x = nm - START_NM as f64;
+    if !(x >= 0.0 && x <= (LEN - 1) as f64) {
+        return 0.0;
+    }
+    let i = x.floor() as usize;
+    if i >= LEN - 1 {
+        return table[LEN - 1];
+    }
+    let t = x - i as f64;
+    if t == 0.0 {
+        table[i]
+    } else {
+        table[i] + t * (table[i + 1] - table[i])
+    }
+}
+
 /// A parsed multi-column table: column names and, per column, optional values per row.
 pub(crate) struct Table {
     pub names: Vec<String>,
@@ -283,7 +315,17 @@ mod tests {
         assert_eq!(scotopic_v()[0], 0.0);
         assert!(scotopic_v()[507 - 360] > 0.999);
         assert_eq!(cmfs(Observer::Cie1964_10).y.len(), LEN);
-        assert!(daylight_basis()[0][560 - 360] > 100.0);
+        assert!((daylight_basis()[0][560 - 360] - 100.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn table_interpolation_matches_sd() {
+        let d65 = named_spectrum("D65").unwrap();
+        let t = d65.to_table();
+        for nm in [359.0, 360.0, 360.25, 555.5, 829.9, 830.0, 830.1] {
+            assert!((interp_table(&t, nm) - d65.value(nm)).abs() < 1e-12, "{nm}");
+        }
+        assert_eq!(cmfs(Observer::Cie1931_2).at(555.0)[1], 1.0);
     }
 
     #[test]
