@@ -10,20 +10,18 @@
 pub mod sampler;
 
 use crate::bxdf::Frame;
-use crate::colour::tables::photopic_v;
 use crate::geometry::{Hit, SceneGeometry};
-use crate::photometry::K_M;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
 pub use sampler::LightSampler;
 
-/// K_m ∫ S(λ) V(λ) dλ over 360–830 nm at 1 nm (the colour library's V(λ) table), i.e. the
-/// photometric amount one unit of the radiometric spectrum `s` carries (lm per W, cd per
-/// W·sr⁻¹, …).
+/// K_m ∫ S(λ) V(λ) dλ over 360–830 nm at 1 nm, computed by the colour library
+/// ([`crate::photometry::luminance`]), i.e. the photometric amount one unit of the radiometric
+/// spectrum `s` carries (lm per W, cd per W·sr⁻¹, …).
 pub fn luminous_integral(s: &DenseSpectrum) -> f64 {
-    K_M * s.weighted_sum(photopic_v())
+    crate::photometry::luminance(&s.to_f64_array())
 }
 
 /// Factor that scales spectrum `s` so that it carries `amount` photometric units:

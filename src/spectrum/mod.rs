@@ -278,13 +278,9 @@ impl DenseSpectrum {
         }
         s
     }
-    /// Σ value(λᵢ)·w(λᵢ)·1 nm over the 471 samples, in f64 (the colour library's integration).
-    pub fn weighted_sum(&self, w: &[f64; DENSE_LEN]) -> f64 {
-        self.values
-            .iter()
-            .zip(w.iter())
-            .map(|(&v, &w)| v as f64 * w)
-            .sum()
+    /// The 1 nm samples as f64, the colour library's table layout (index i ↔ 360 + i nm).
+    pub fn to_f64_array(&self) -> [f64; DENSE_LEN] {
+        self.values.map(|v| v as f64)
     }
 }
 
