@@ -26,7 +26,9 @@ fn sphere_outside_inside() {
         center: Vec3::ZERO,
         radius: 2.0,
     }]);
-    let h = g.intersect(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, f32::INFINITY)
+        .unwrap();
     assert!(close(h.t, 3.0, 1e-6));
     assert!(close3(h.p, Vec3::new(0.0, 0.0, -2.0), 1e-6));
     assert!(close3(h.ng, -Vec3::Z, 1e-6));
@@ -34,22 +36,36 @@ fn sphere_outside_inside() {
     assert_eq!(h.object, 100);
     assert_eq!(g.primitives_of_object(100), &[h.prim]);
     // Off-centre.
-    let h = g.intersect(Vec3::new(1.0, 0.0, -5.0), Vec3::Z, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(1.0, 0.0, -5.0), Vec3::Z, f32::INFINITY)
+        .unwrap();
     assert!(close(h.t, 5.0 - 3f32.sqrt(), 1e-6));
     assert!(close3(h.ng, Vec3::new(0.5, 0.0, -3f32.sqrt() / 2.0), 1e-6));
     // From inside: far side, back face.
-    let h = g.intersect(Vec3::new(0.0, 0.0, 0.0), Vec3::Z, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(0.0, 0.0, 0.0), Vec3::Z, f32::INFINITY)
+        .unwrap();
     assert!(close(h.t, 2.0, 1e-6));
     assert!(close3(h.ng, Vec3::Z, 1e-6));
     assert!(!h.front_face);
     // t_max is exclusive; unnormalised directions give parametric t.
-    assert!(g.intersect(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 3.0).is_none());
-    assert!(g.intersect(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 3.0001).is_some());
-    let h = g.intersect(Vec3::new(0.0, 0.0, -5.0), 2.0 * Vec3::Z, f32::INFINITY).unwrap();
+    assert!(g
+        .intersect(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 3.0)
+        .is_none());
+    assert!(g
+        .intersect(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 3.0001)
+        .is_some());
+    let h = g
+        .intersect(Vec3::new(0.0, 0.0, -5.0), 2.0 * Vec3::Z, f32::INFINITY)
+        .unwrap();
     assert!(close(h.t, 1.5, 1e-6));
     // Pointing away / missing.
-    assert!(g.intersect(Vec3::new(0.0, 0.0, -5.0), -Vec3::Z, f32::INFINITY).is_none());
-    assert!(g.intersect(Vec3::new(2.01, 0.0, -5.0), Vec3::Z, f32::INFINITY).is_none());
+    assert!(g
+        .intersect(Vec3::new(0.0, 0.0, -5.0), -Vec3::Z, f32::INFINITY)
+        .is_none());
+    assert!(g
+        .intersect(Vec3::new(2.01, 0.0, -5.0), Vec3::Z, f32::INFINITY)
+        .is_none());
     assert!(g.occluded(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 3.5));
     assert!(!g.occluded(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 2.5));
 }
@@ -61,23 +77,33 @@ fn quad_both_sides() {
         edge_u: Vec3::new(2.0, 0.0, 0.0),
         edge_v: Vec3::new(0.0, 2.0, 0.0),
     }]);
-    let h = g.intersect(Vec3::new(0.5, 0.25, 3.0), -Vec3::Z, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(0.5, 0.25, 3.0), -Vec3::Z, f32::INFINITY)
+        .unwrap();
     assert!(close(h.t, 3.0, 1e-6));
     assert!(close3(h.p, Vec3::new(0.5, 0.25, 0.0), 1e-6));
     assert!(close3(h.ng, Vec3::Z, 1e-6));
     assert!(close(h.uv.x, 0.75, 1e-6) && close(h.uv.y, 0.625, 1e-6));
     assert!(h.front_face);
-    let h = g.intersect(Vec3::new(0.5, 0.25, -3.0), Vec3::Z, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(0.5, 0.25, -3.0), Vec3::Z, f32::INFINITY)
+        .unwrap();
     assert!(close3(h.ng, Vec3::Z, 1e-6));
     assert!(!h.front_face);
     // Oblique.
     let d = Vec3::new(1.0, 0.0, -1.0);
-    let h = g.intersect(Vec3::new(-0.5, 0.0, 1.0), d, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(-0.5, 0.0, 1.0), d, f32::INFINITY)
+        .unwrap();
     assert!(close(h.t, 1.0, 1e-6));
     assert!(close3(h.p, Vec3::new(0.5, 0.0, 0.0), 1e-6));
     // Misses outside the parallelogram, parallel rays miss.
-    assert!(g.intersect(Vec3::new(1.5, 0.0, 3.0), -Vec3::Z, f32::INFINITY).is_none());
-    assert!(g.intersect(Vec3::new(0.0, 0.0, 1.0), Vec3::X, f32::INFINITY).is_none());
+    assert!(g
+        .intersect(Vec3::new(1.5, 0.0, 3.0), -Vec3::Z, f32::INFINITY)
+        .is_none());
+    assert!(g
+        .intersect(Vec3::new(0.0, 0.0, 1.0), Vec3::X, f32::INFINITY)
+        .is_none());
 }
 
 #[test]
@@ -87,16 +113,24 @@ fn disk() {
         normal: Vec3::new(0.0, 2.0, 0.0),
         radius: 0.5,
     }]);
-    let h = g.intersect(Vec3::new(1.3, 10.0, 3.0), -Vec3::Y, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(1.3, 10.0, 3.0), -Vec3::Y, f32::INFINITY)
+        .unwrap();
     assert!(close(h.t, 8.0, 1e-6));
     assert!(close3(h.p, Vec3::new(1.3, 2.0, 3.0), 1e-6));
     assert!(close3(h.ng, Vec3::Y, 1e-6));
     assert!(h.front_face);
     assert!(close(h.uv.x, 0.6, 1e-5));
-    let h = g.intersect(Vec3::new(1.3, -10.0, 3.0), Vec3::Y, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(1.3, -10.0, 3.0), Vec3::Y, f32::INFINITY)
+        .unwrap();
     assert!(!h.front_face);
-    assert!(g.intersect(Vec3::new(1.6, 10.0, 3.0), -Vec3::Y, f32::INFINITY).is_none());
-    assert!(g.intersect(Vec3::new(1.0, 10.0, 3.51), -Vec3::Y, f32::INFINITY).is_none());
+    assert!(g
+        .intersect(Vec3::new(1.6, 10.0, 3.0), -Vec3::Y, f32::INFINITY)
+        .is_none());
+    assert!(g
+        .intersect(Vec3::new(1.0, 10.0, 3.51), -Vec3::Y, f32::INFINITY)
+        .is_none());
 }
 
 #[test]
@@ -114,17 +148,21 @@ fn triangle_edges_and_normals() {
     let g = scene(vec![Shape::Mesh(mesh)]);
     assert_eq!(g.primitive_count(), 2);
     // Interior hit.
-    let h = g.intersect(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, f32::INFINITY)
+        .unwrap();
     assert!(close(h.t, 1.0, 1e-6));
     assert!(close3(h.ng, Vec3::Z, 1e-6));
     assert!(h.front_face);
     assert!(close(h.uv.x, 0.25, 1e-6) && close(h.uv.y, 0.25, 1e-6));
-    let expect = (0.5 * Vec3::Z + 0.25 * Vec3::new(1.0, 0.0, 1.0).normalize() + 0.25 * Vec3::Z)
-        .normalize();
+    let expect =
+        (0.5 * Vec3::Z + 0.25 * Vec3::new(1.0, 0.0, 1.0).normalize() + 0.25 * Vec3::Z).normalize();
     assert!(close3(h.ns, expect, 1e-5));
     assert!(h.ns.dot(h.ng) > 0.0);
     // Back side.
-    let h = g.intersect(Vec3::new(0.25, 0.25, -1.0), Vec3::Z, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(0.25, 0.25, -1.0), Vec3::Z, f32::INFINITY)
+        .unwrap();
     assert!(!h.front_face);
     assert!(close3(h.ng, Vec3::Z, 1e-6));
     // Exactly on the shared edge and on shared vertices: always hit (watertight).
@@ -146,7 +184,9 @@ fn triangle_edges_and_normals() {
         .intersect(Vec3::new(1.0001, 0.5, 1.0), -Vec3::Z, f32::INFINITY)
         .is_none());
     // Vertex normal flipped at vertex 3: ns still in ng's hemisphere.
-    let h = g.intersect(Vec3::new(0.9, 0.9, 1.0), -Vec3::Z, f32::INFINITY).unwrap();
+    let h = g
+        .intersect(Vec3::new(0.9, 0.9, 1.0), -Vec3::Z, f32::INFINITY)
+        .unwrap();
     assert!(h.ns.dot(h.ng) > 0.0);
 }
 
@@ -186,7 +226,8 @@ fn random_scene(rng: &mut Rng, scale: f32, offset: Vec3) -> Vec<(Shape, u32)> {
         let s = rng.range(0.01, 0.2);
         let base = mesh.positions.len() as u32;
         for _ in 0..3 {
-            mesh.positions.push((c + s * rng.unit_vector()) * scale + offset);
+            mesh.positions
+                .push((c + s * rng.unit_vector()) * scale + offset);
         }
         mesh.indices.push([base, base + 1, base + 2]);
     }
@@ -256,7 +297,11 @@ fn bvh_vs_brute(scale: f32, offset: Vec3, seed: u64) {
             }
             (a, b) => panic!("ray {i} (scale {scale}): BVH {a:?} vs brute force {b:?}"),
         }
-        assert_eq!(g.occluded(o, d, t_max), b.is_some(), "ray {i}: occluded mismatch");
+        assert_eq!(
+            g.occluded(o, d, t_max),
+            b.is_some(),
+            "ray {i}: occluded mismatch"
+        );
     }
     assert!(hits > 1000, "too few hits ({hits}) to be a meaningful test");
 }
@@ -286,7 +331,9 @@ fn short_rays_near_hits() {
         edge_u: Vec3::new(2.0, 0.0, 0.0),
         edge_v: Vec3::new(0.0, 2.0, 0.0),
     }]);
-    let h = g.intersect(Vec3::new(0.1, 0.1, 1e-7), -Vec3::Z, 1e-6).unwrap();
+    let h = g
+        .intersect(Vec3::new(0.1, 0.1, 1e-7), -Vec3::Z, 1e-6)
+        .unwrap();
     assert!(close(h.t, 1e-7, 1e-5));
     assert!(g.occluded(Vec3::new(0.1, 0.1, 1e-7), -Vec3::Z, 2e-7));
     assert!(!g.occluded(Vec3::new(0.1, 0.1, 1e-7), -Vec3::Z, 0.5e-7));
@@ -303,9 +350,15 @@ fn empty_scene_and_invalid_rays() {
         center: Vec3::ZERO,
         radius: 1.0,
     }]);
-    assert!(g.intersect(Vec3::new(0.0, 0.0, -3.0), Vec3::ZERO, 10.0).is_none());
-    assert!(g.intersect(Vec3::new(f32::NAN, 0.0, -3.0), Vec3::Z, 10.0).is_none());
-    assert!(g.intersect(Vec3::new(0.0, 0.0, -3.0), Vec3::Z, 0.0).is_none());
+    assert!(g
+        .intersect(Vec3::new(0.0, 0.0, -3.0), Vec3::ZERO, 10.0)
+        .is_none());
+    assert!(g
+        .intersect(Vec3::new(f32::NAN, 0.0, -3.0), Vec3::Z, 10.0)
+        .is_none());
+    assert!(g
+        .intersect(Vec3::new(0.0, 0.0, -3.0), Vec3::Z, 0.0)
+        .is_none());
 }
 
 #[test]
@@ -349,15 +402,33 @@ fn zero_area_triangles_dropped_and_invalid_shapes_rejected() {
 
 #[test]
 fn transforms() {
-    let t = Transform::from_trs(Vec3::new(10.0, 0.0, 0.0), Vec3::new(90.0, 0.0, 90.0), Vec3::ONE);
+    let t = Transform::from_trs(
+        Vec3::new(10.0, 0.0, 0.0),
+        Vec3::new(90.0, 0.0, 90.0),
+        Vec3::ONE,
+    );
     // X is untouched by Rx, then Rz maps it to Y; Y goes to Z by Rx, Z is kept by Rz.
-    assert!(close3(t.transform_point(Vec3::X), Vec3::new(10.0, 1.0, 0.0), 1e-6));
-    assert!(close3(t.transform_point(Vec3::Y), Vec3::new(10.0, 0.0, 1.0), 1e-6));
+    assert!(close3(
+        t.transform_point(Vec3::X),
+        Vec3::new(10.0, 1.0, 0.0),
+        1e-6
+    ));
+    assert!(close3(
+        t.transform_point(Vec3::Y),
+        Vec3::new(10.0, 0.0, 1.0),
+        1e-6
+    ));
     let t2 = Transform::from_trs(Vec3::ZERO, Vec3::ZERO, Vec3::new(2.0, 3.0, 4.0));
-    assert!(close3(t2.transform_point(Vec3::ONE), Vec3::new(2.0, 3.0, 4.0), 1e-6));
+    assert!(close3(
+        t2.transform_point(Vec3::ONE),
+        Vec3::new(2.0, 3.0, 4.0),
+        1e-6
+    ));
     assert!(!t2.is_uniform_scale());
-    assert!(Transform::from_trs(Vec3::ONE, Vec3::new(10.0, 20.0, 30.0), Vec3::splat(3.0))
-        .is_uniform_scale());
+    assert!(
+        Transform::from_trs(Vec3::ONE, Vec3::new(10.0, 20.0, 30.0), Vec3::splat(3.0))
+            .is_uniform_scale()
+    );
     let sphere = Shape::Sphere {
         center: Vec3::X,
         radius: 1.0,
@@ -376,7 +447,11 @@ fn transforms() {
         edge_v: Vec3::Y,
     };
     assert!(quad.to_world(&singular).is_err());
-    let ts = Transform::from_trs(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 90.0, 0.0), Vec3::splat(2.0));
+    let ts = Transform::from_trs(
+        Vec3::new(0.0, 0.0, 5.0),
+        Vec3::new(0.0, 90.0, 0.0),
+        Vec3::splat(2.0),
+    );
     match sphere.to_world(&ts).unwrap() {
         Shape::Sphere { center, radius } => {
             assert!(close3(center, Vec3::new(0.0, 0.0, 3.0), 1e-6));

@@ -78,9 +78,15 @@ fn check_closed_convex(
         let w = dir_around(rng, h.ng, 0.0);
         let o = h.spawn_origin(w);
         if let Some(x) = g.intersect(o, w, f32::INFINITY) {
-            panic!("{label}: outward ray {k} from {} re-hit at t = {} (prim {} vs {})", h.p, x.t, x.prim, h.prim);
+            panic!(
+                "{label}: outward ray {k} from {} re-hit at t = {} (prim {} vs {})",
+                h.p, x.t, x.prim, h.prim
+            );
         }
-        assert!(!g.occluded(o, w, f32::INFINITY), "{label}: outward shadow ray {k} occluded");
+        assert!(
+            !g.occluded(o, w, f32::INFINITY),
+            "{label}: outward shadow ray {k} occluded"
+        );
         // Inward: must reach the far side.
         let w = dir_around(rng, -h.ng, 0.05);
         let o = h.spawn_origin(w);
@@ -100,7 +106,10 @@ fn check_closed_convex(
                 x.t
             );
         }
-        assert!(!x.front_face, "{label}: inward ray {k} must hit a back face");
+        assert!(
+            !x.front_face,
+            "{label}: inward ray {k} must hit a back face"
+        );
     }
 }
 
@@ -110,18 +119,37 @@ fn sphere_no_self_intersection() {
     for s in SCALES {
         for offset in [Vec3::ZERO, Vec3::new(37.0, -11.0, 5.0) * s] {
             let c = offset + Vec3::new(0.3, 0.2, -0.1) * s;
-            let g = SceneGeometry::build(&[(Shape::Sphere { center: c, radius: s }, 0)]).unwrap();
+            let g = SceneGeometry::build(&[(
+                Shape::Sphere {
+                    center: c,
+                    radius: s,
+                },
+                0,
+            )])
+            .unwrap();
             let hits = surface_hits(&g, &mut rng, c, s, RAYS / 4);
-            check_closed_convex(&g, &hits, &mut rng, s, false, &format!("sphere scale {s} offset {offset}"));
+            check_closed_convex(
+                &g,
+                &hits,
+                &mut rng,
+                s,
+                false,
+                &format!("sphere scale {s} offset {offset}"),
+            );
             // Also from area samples (points without a hit record).
             for k in 0..RAYS / 4 {
                 let sp = g.sample_prim(0, rng.vec2());
                 let w = dir_around(&mut rng, sp.n, 0.0);
                 let o = offset_ray_origin(sp.p, point_error_bound(sp.p), sp.n, w);
-                assert!(g.intersect(o, w, f32::INFINITY).is_none(), "sampled point {k} re-hit");
+                assert!(
+                    g.intersect(o, w, f32::INFINITY).is_none(),
+                    "sampled point {k} re-hit"
+                );
                 let w = dir_around(&mut rng, -sp.n, 0.05);
                 let o = offset_ray_origin(sp.p, point_error_bound(sp.p), sp.n, w);
-                let x = g.intersect(o, w, f32::INFINITY).expect("inward ray escaped");
+                let x = g
+                    .intersect(o, w, f32::INFINITY)
+                    .expect("inward ray escaped");
                 assert!(x.t > 0.01 * s);
             }
         }
@@ -137,7 +165,14 @@ fn mesh_no_self_intersection() {
             let mesh = Shape::Mesh(subdivided_cube(12)).to_world(&t).unwrap();
             let g = SceneGeometry::build(&[(mesh, 0)]).unwrap();
             let hits = surface_hits(&g, &mut rng, offset, s, RAYS / 2);
-            check_closed_convex(&g, &hits, &mut rng, s, true, &format!("mesh scale {s} offset {offset}"));
+            check_closed_convex(
+                &g,
+                &hits,
+                &mut rng,
+                s,
+                true,
+                &format!("mesh scale {s} offset {offset}"),
+            );
             // Aim exactly at vertices / shared edges of the subdivided faces, then spawn.
             let m = match Shape::Mesh(subdivided_cube(12)).to_world(&t).unwrap() {
                 Shape::Mesh(m) => m,
@@ -189,7 +224,11 @@ fn quad_and_disk_no_self_intersection() {
                 for k in 0..RAYS / 4 {
                     // From a hit on this primitive...
                     let sp = g.sample_prim(prim, rng.vec2());
-                    let o = sp.p + dir_around(&mut rng, sp.n, 0.2) * 3.0 * s * if k % 2 == 0 { 1.0 } else { -1.0 };
+                    let o = sp.p
+                        + dir_around(&mut rng, sp.n, 0.2)
+                            * 3.0
+                            * s
+                            * if k % 2 == 0 { 1.0 } else { -1.0 };
                     let Some(h) = g.intersect(o, sp.p - o, f32::INFINITY) else {
                         continue;
                     };
@@ -200,7 +239,11 @@ fn quad_and_disk_no_self_intersection() {
                     for side in [1.0, -1.0] {
                         let w = dir_around(&mut rng, side * h.ng, 0.0);
                         if let Some(x) = g.intersect(h.spawn_origin(w), w, f32::INFINITY) {
-                            assert_ne!(x.prim, prim, "scale {s}: primitive {prim} re-hit itself at t={}", x.t);
+                            assert_ne!(
+                                x.prim, prim,
+                                "scale {s}: primitive {prim} re-hit itself at t={}",
+                                x.t
+                            );
                         }
                     }
                     // Grazing directions, too.
@@ -265,7 +308,9 @@ fn shadow_rays_between_surfaces_are_unoccluded() {
             }
         }
         // And a real occluder between them is detected.
-        let h = g.intersect(Vec3::new(0.0, 0.0, 1.0) * s, -Vec3::Z, f32::INFINITY).unwrap();
+        let h = g
+            .intersect(Vec3::new(0.0, 0.0, 1.0) * s, -Vec3::Z, f32::INFINITY)
+            .unwrap();
         let (ro, rd, tmax) = shadow_ray(&h, Vec3::new(0.0, 0.0, 10.0) * s, -Vec3::Z);
         assert!(g.occluded(ro, rd, tmax));
     }
