@@ -344,11 +344,12 @@ impl SceneGeometry {
         } else {
             (lo, hi)
         };
-        let bvh = if prims.is_empty() {
+        let mut bvh = if prims.is_empty() {
             CwBvh::default()
         } else {
             obvhs::cwbvh::builder::build_cwbvh(&aabbs, params, &mut Duration::default())
         };
+        bvh.nodes.shrink_to_fit();
         drop(aabbs);
 
         // Lay primitives out in leaf order so the traversal indexes them directly.
@@ -360,6 +361,9 @@ impl SceneGeometry {
         } else {
             Vec::new()
         };
+        // Traversal only needs the node array once the primitives are in leaf order.
+        bvh.primitive_indices = Vec::new();
+        bvh.exact_node_aabbs = None;
         let mut by_obj: Vec<(u32, u32)> = prim_object
             .iter()
             .enumerate()
@@ -396,8 +400,18 @@ impl SceneGeometry {
         if self.prims.is_empty() || !Self::ray_ok(origin, dir, t_max) {
             return None;
         }
-        let nr = NodeRay::new(origin, dir);
         let pre = RayPre::new(origin, dir);
+        match pre.kz {
+            0 => self.closest::<0>(&pre, t_max),
+            1 => self.closest::<1>(&pre, t_max),
+            _ => self.closest::<2>(&pre, t_max),
+        }
+    }
+
+    #[inline(always)]
+    fn closest<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> Option<Hit> {
+        let (origin, dir) = (pre.o, pre.d);
+        let nr = NodeRay::new(origin, dir);
         let mut tmax = t_max;
         let mut best = u32::MAX;
         let (mut ba, mut bb) = (0.0f32, 0.0f32);
@@ -414,7 +428,7 @@ impl SceneGeometry {
                 // SAFETY: primitive ids from the traversal index `primitive_indices`, which has
                 // the same length as `prims`.
                 let prim = unsafe { prims.get_unchecked(id as usize) };
-                if let Some((t, a, b)) = prim.intersect(&pre, tmax) {
+                if let Some((t, a, b)) = prim.intersect::<KZ>(pre, tmax) {
                     tmax = t;
                     best = id;
                     ba = a;
@@ -422,7 +436,7 @@ impl SceneGeometry {
                 }
             }
         );
-        (best != u32::MAX).then(|| self.make_hit(best, &pre, tmax, ba, bb))
+        (best != u32::MAX).then(|| self.make_hit(best, pre, tmax, ba, bb))
     }
 
     /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
@@ -461,8 +475,18 @@ impl SceneGeometry {
         if self.prims.is_empty() || !Self::ray_ok(origin, dir, t_max) {
             return false;
         }
-        let nr = NodeRay::new(origin, dir);
         let pre = RayPre::new(origin, dir);
+        match pre.kz {
+            0 => self.any_hit::<0>(&pre, t_max),
+            1 => self.any_hit::<1>(&pre, t_max),
+            _ => self.any_hit::<2>(&pre, t_max),
+        }
+    }
+
+    #[inline(always)]
+    fn any_hit<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> bool {
+        let (origin, dir) = (pre.o, pre.d);
+        let nr = NodeRay::new(origin, dir);
         let prims = &self.prims[..];
         let mut state = self.bvh.new_traversal(Vec3A::from(dir));
         let mut node;
@@ -476,7 +500,7 @@ impl SceneGeometry {
                 {
                     // SAFETY: see `intersect`.
                     let prim = unsafe { prims.get_unchecked(state.primitive_id as usize) };
-                    if prim.intersect(&pre, t_max).is_some() {
+                    if prim.intersect::<KZ>(pre, t_max).is_some() {
                         hit = true;
                         break 'outer;
                     }
@@ -495,7 +519,7 @@ impl SceneGeometry {
         let mut tmax = t_max;
         let mut best = None;
         for (i, p) in self.prims.iter().enumerate() {
-            if let Some((t, a, b)) = p.intersect(&pre, tmax) {
+            if let Some((t, a, b)) = p.intersect_dyn(&pre, tmax) {
                 tmax = t;
                 best = Some((i as u32, a, b));
             }
