@@ -483,3 +483,65 @@ fn transforms() {
     }
     let _ = Vec2::ZERO;
 }
+
+#[test]
+fn degenerate_scenes_build_and_trace() {
+    // 300 coincident copies of a triangle plus a huge and a tiny primitive.
+    let mut mesh = TriangleMesh::default();
+    for i in 0..300u32 {
+        mesh.positions.extend([Vec3::ZERO, Vec3::X, Vec3::Y]);
+        mesh.indices.push([3 * i, 3 * i + 1, 3 * i + 2]);
+    }
+    let shapes = vec![
+        (Shape::Mesh(mesh), 0),
+        (
+            Shape::Sphere {
+                center: Vec3::new(0.0, 0.0, -1e6),
+                radius: 5e5,
+            },
+            1,
+        ),
+        (
+            Shape::Sphere {
+                center: Vec3::new(0.2, 0.2, 5.0),
+                radius: 1e-6,
+            },
+            2,
+        ),
+    ];
+    let g = SceneGeometry::build(&shapes).unwrap();
+    println!("depth {}", g.bvh_depth());
+    assert!(g.bvh_depth() < 64);
+    let h = g
+        .intersect(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, f32::INFINITY)
+        .unwrap();
+    assert_eq!(h.object, 0);
+    assert!((h.t - 1.0).abs() < 1e-6);
+    let h = g
+        .intersect(Vec3::new(0.2, 0.2, 10.0), -Vec3::Z, f32::INFINITY)
+        .unwrap();
+    assert_eq!(h.object, 2);
+    let h = g
+        .intersect(Vec3::new(5.0, 5.0, 1.0), -Vec3::Z, f32::INFINITY)
+        .unwrap();
+    assert_eq!(h.object, 1);
+    let _ = Vec2::ZERO;
+}
+
+#[test]
+fn pathological_scene_is_an_error_not_a_crash() {
+    let mut mesh = TriangleMesh::default();
+    for i in 0..3000u32 {
+        mesh.positions.extend([Vec3::ZERO, Vec3::X, Vec3::Y]);
+        mesh.indices.push([3 * i, 3 * i + 1, 3 * i + 2]);
+    }
+    match SceneGeometry::build(&[(Shape::Mesh(mesh), 0)]) {
+        Ok(g) => {
+            assert!(g.bvh_depth() < 64);
+            assert!(g
+                .intersect(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 2.0)
+                .is_some());
+        }
+        Err(e) => assert!(e.to_string().contains("degenerate"), "{e}"),
+    }
+}
