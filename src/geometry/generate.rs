@@ -83,6 +83,12 @@ pub fn grid_mesh(nx: u32, ny: u32, size: f32, height: impl Fn(f32, f32) -> f32) 
 /// `subdivisions × subdivisions` cells per face projected to the sphere: `12·subdivisions²`
 /// triangles (≥ 1 M for `subdivisions ≥ 289`), outward front faces, no vertex normals.
 pub fn bumpy_sphere(subdivisions: u32) -> TriangleMesh {
+    cube_sphere(subdivisions, 0.05)
+}
+
+/// A closed cube-sphere of radius ≈1 with `12·subdivisions²` triangles and radial bumps of
+/// relative amplitude `bump` (0 gives a convex polyhedron inscribed in the unit sphere).
+pub fn cube_sphere(subdivisions: u32, bump: f32) -> TriangleMesh {
     let n = subdivisions.max(1);
     let mut positions = Vec::with_capacity(6 * ((n + 1) * (n + 1)) as usize);
     let mut indices = Vec::with_capacity((12 * n * n) as usize);
@@ -102,9 +108,9 @@ pub fn bumpy_sphere(subdivisions: u32) -> TriangleMesh {
                 let a = 2.0 * i as f32 / n as f32 - 1.0;
                 let b = 2.0 * j as f32 / n as f32 - 1.0;
                 let dir = (nrm + a * u + b * v).normalize();
-                let bump = 1.0
-                    + 0.05 * (7.0 * dir.x).sin() * (9.0 * dir.y).sin() * (11.0 * dir.z + 1.0).sin();
-                positions.push(dir * bump);
+                let r = 1.0
+                    + bump * (7.0 * dir.x).sin() * (9.0 * dir.y).sin() * (11.0 * dir.z + 1.0).sin();
+                positions.push(dir * r);
             }
         }
         let id = |i: u32, j: u32| base + j * (n + 1) + i;

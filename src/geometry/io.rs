@@ -19,6 +19,17 @@ fn open_check(path: &Path) -> Result<std::fs::File, GeometryError> {
     }
 }
 
+/// Joins a multi-line parser message into one line without a trailing period.
+fn one_paragraph(msg: &str) -> String {
+    let joined = msg
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ");
+    joined.trim_end_matches('.').to_string()
+}
+
 /// Checks indices, finiteness and that there is at least one triangle.
 fn validate(path: &Path, mesh: &TriangleMesh) -> Result<(), GeometryError> {
     let nv = mesh.positions.len();
@@ -51,10 +62,7 @@ fn validate(path: &Path, mesh: &TriangleMesh) -> Result<(), GeometryError> {
     if mesh.indices.is_empty() {
         return Err(GeometryError::NoTriangles {
             path: path.to_path_buf(),
-            detail: format!(
-                "it has {} vertices but no faces with 3 or more vertices",
-                mesh.positions.len()
-            ),
+            detail: "no faces with 3 or more vertices were found".into(),
         });
     }
     Ok(())
@@ -160,7 +168,7 @@ pub fn load_ply(path: &Path) -> Result<TriangleMesh, GeometryError> {
         parser.read_ply(&mut reader)
     }))
     .map_err(|_| parse("the PLY parser failed on malformed input".into()))?
-    .map_err(|e| parse(e.to_string()))?;
+    .map_err(|e| parse(one_paragraph(&e.to_string())))?;
 
     let vertices = ply
         .payload

@@ -379,3 +379,34 @@ impl Hit {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trs_order_is_scale_rotate_translate() {
+        let t = Transform::from_trs(
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::new(0.0, 0.0, 90.0),
+            Vec3::new(2.0, 1.0, 1.0),
+        );
+        // (1,0,0) → scale (2,0,0) → Rz90 (0,2,0) → translate (1,4,3).
+        let p = t.transform_point(Vec3::X);
+        assert!((p - Vec3::new(1.0, 4.0, 3.0)).length() < 1e-6);
+        assert!(!t.is_uniform_scale());
+        assert!(Transform::identity().is_uniform_scale());
+        // X first, then Y: Rx(90) takes Y to Z, then Ry(90) takes Z to X.
+        let t = Transform::from_trs(Vec3::ZERO, Vec3::new(90.0, 90.0, 0.0), Vec3::ONE);
+        assert!((t.transform_point(Vec3::Y) - Vec3::X).length() < 1e-6);
+    }
+
+    #[test]
+    fn normals_transform_with_inverse_transpose() {
+        let t = Transform::from_trs(Vec3::ZERO, Vec3::ZERO, Vec3::new(1.0, 4.0, 1.0));
+        let n = t.transform_normal(Vec3::new(1.0, 1.0, 0.0).normalize());
+        // Tangent (1,-1,0) maps to (1,-4,0); the normal must stay perpendicular to it.
+        assert!(n.dot(Vec3::new(1.0, -4.0, 0.0)).abs() < 1e-6);
+        assert!((n.length() - 1.0).abs() < 1e-6);
+    }
+}

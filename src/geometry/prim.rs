@@ -36,9 +36,8 @@ pub(crate) struct RayPre {
     pub d: Vec3,
     pub od: DVec3,
     pub dd: DVec3,
-    kx: usize,
-    ky: usize,
-    kz: usize,
+    /// Index of the largest |direction| component (the triangle test's permuted z axis).
+    pub kz: usize,
     sx: f32,
     sy: f32,
     sz: f32,
@@ -67,8 +66,6 @@ impl RayPre {
             d,
             od: o.as_dvec3(),
             dd: d.as_dvec3(),
-            kx,
-            ky,
             kz,
             sx: -d[kx] * sz,
             sy: -d[ky] * sz,
@@ -86,9 +83,18 @@ fn diff_of_products(a: f32, b: f32, c: f32, d: f32) -> f32 {
 /// Result of a primitive test: `t` and two parameters (triangle b1,b2; quad s,t; unused else).
 pub(crate) type PrimT = (f32, f32, f32);
 
+/// `KZ` must equal `r.kz` (monomorphised so the axis permutation is free).
 #[inline(always)]
-pub(crate) fn intersect_triangle(r: &RayPre, t_max: f32, p: &[Vec3; 3]) -> Option<PrimT> {
-    let perm = |v: Vec3| Vec3::new(v[r.kx], v[r.ky], v[r.kz]);
+pub(crate) fn intersect_triangle<const KZ: usize>(
+    r: &RayPre,
+    t_max: f32,
+    p: &[Vec3; 3],
+) -> Option<PrimT> {
+    debug_assert_eq!(KZ, r.kz);
+    let perm = |v: Vec3| {
+        let a = v.to_array();
+        Vec3::new(a[(KZ + 1) % 3], a[(KZ + 2) % 3], a[KZ])
+    };
     let mut p0t = perm(p[0] - r.o);
     let mut p1t = perm(p[1] - r.o);
     let mut p2t = perm(p[2] - r.o);
@@ -264,10 +270,11 @@ fn rounded_error(p: Vec3, mag: DVec3) -> Vec3 {
 }
 
 impl Prim {
+    /// Ray test; `KZ` must equal `r.kz` (see [`Prim::intersect_dyn`]).
     #[inline(always)]
-    pub fn intersect(&self, r: &RayPre, t_max: f32) -> Option<PrimT> {
+    pub fn intersect<const KZ: usize>(&self, r: &RayPre, t_max: f32) -> Option<PrimT> {
         match self {
-            Prim::Triangle(p) => intersect_triangle(r, t_max, p),
+            Prim::Triangle(p) => intersect_triangle::<KZ>(r, t_max, p),
             Prim::Sphere { center, radius } => intersect_sphere(r, t_max, *center, *radius),
             Prim::Quad {
                 origin,
@@ -279,6 +286,15 @@ impl Prim {
                 normal,
                 radius,
             } => intersect_disk(r, t_max, *center, *normal, *radius),
+        }
+    }
+
+    /// [`Prim::intersect`] dispatching on the ray's dominant axis at run time.
+    pub fn intersect_dyn(&self, r: &RayPre, t_max: f32) -> Option<PrimT> {
+        match r.kz {
+            0 => self.intersect::<0>(r, t_max),
+            1 => self.intersect::<1>(r, t_max),
+            _ => self.intersect::<2>(r, t_max),
         }
     }
 
@@ -495,5 +511,101 @@ impl Prim {
                 (p.as_vec3(), n.as_vec3())
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ray(o: Vec3, d: Vec3) -> RayPre {
+        RayPre::new(o, d)
+    }
+
+    #[test]
+    fn triangle_barycentrics_and_t() {
+        let tri = Prim::Triangle([
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ]);
+        let r = ray(Vec3::new(0.5, 0.5, 2.0), Vec3::new(0.0, 0.0, -1.0));
+        let (t, b1, b2) = tri.intersect_dyn(&r, f32::INFINITY).unwrap();
+        assert_eq!(t, 2.0);
+        assert!((b1 - 0.25).abs() < 1e-7 && (b2 - 0.25).abs() < 1e-7);
+        // Every dominant axis (monomorphised variants) gives the same answer.
+        for d in [
+            Vec3::new(-0.1, 0.0, -1.0),
+            Vec3::new(0.6, 0.5, -0.5),
+            Vec3::new(0.3, 0.8, -0.4),
+        ] {
+            let o = Vec3::new(0.5, 0.5, 0.0) - d * 3.0;
+            let (t, ..) = tri.intersect_dyn(&ray(o, d), f32::INFINITY).unwrap();
+            assert!((t - 3.0).abs() < 1e-5, "{d}: t = {t}");
+        }
+        // Behind the origin, beyond t_max: no hit.
+        assert!(tri.intersect_dyn(&r, 2.0).is_none());
+        let r = ray(Vec3::new(0.5, 0.5, 2.0), Vec3::new(0.0, 0.0, 1.0));
+        assert!(tri.intersect_dyn(&r, f32::INFINITY).is_none());
+        // Ray in the triangle's plane: no hit.
+        let r = ray(Vec3::new(-1.0, 0.5, 0.0), Vec3::X);
+        assert!(tri.intersect_dyn(&r, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn triangle_origin_on_surface_is_not_a_hit() {
+        // A ray starting exactly on the triangle must not report t ≈ 0 (pbrt's δt check).
+        let tri = Prim::Triangle([
+            Vec3::new(100.0, 0.0, 0.0),
+            Vec3::new(101.0, 0.0, 0.3),
+            Vec3::new(100.0, 1.0, 0.7),
+        ]);
+        let (p, n) = tri.sample_area(Vec2::new(0.3, 0.4));
+        for w in [n, -n, (n + Vec3::X).normalize()] {
+            if let Some((t, ..)) = tri.intersect_dyn(&ray(p, w), f32::INFINITY) {
+                panic!("self hit at t = {t}");
+            }
+        }
+    }
+
+    #[test]
+    fn sphere_roots() {
+        let s = Prim::Sphere {
+            center: Vec3::new(0.0, 0.0, 10.0),
+            radius: 1.0,
+        };
+        let (t, ..) = s
+            .intersect_dyn(&ray(Vec3::ZERO, Vec3::Z), f32::INFINITY)
+            .unwrap();
+        assert_eq!(t, 9.0);
+        let (t, ..) = s
+            .intersect_dyn(&ray(Vec3::new(0.0, 0.0, 10.5), Vec3::Z), f32::INFINITY)
+            .unwrap();
+        assert_eq!(t, 0.5);
+        let (t, ..) = s
+            .intersect_dyn(&ray(Vec3::new(0.0, 0.0, 10.5), -Vec3::Z), f32::INFINITY)
+            .unwrap();
+        assert_eq!(t, 1.5);
+        // Tiny sphere far away: the stable discriminant still finds it.
+        let s = Prim::Sphere {
+            center: Vec3::new(0.0, 0.0, 1e4),
+            radius: 1e-3,
+        };
+        let (t, ..) = s
+            .intersect_dyn(&ray(Vec3::ZERO, Vec3::Z), f32::INFINITY)
+            .unwrap();
+        assert!((t - (1e4 - 1e-3)).abs() < 1e-3);
+    }
+
+    #[test]
+    fn disk_bounds_are_tight() {
+        let d = Prim::Disk {
+            center: Vec3::ZERO,
+            normal: Vec3::Z,
+            radius: 2.0,
+        };
+        let (lo, hi) = d.bounds();
+        assert_eq!(lo, Vec3::new(-2.0, -2.0, 0.0));
+        assert_eq!(hi, Vec3::new(2.0, 2.0, 0.0));
     }
 }

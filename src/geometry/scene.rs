@@ -5,8 +5,10 @@
 //! `1e-4` and ignores `ray.tmin`, which silently culls every node lying entirely closer than
 //! 0.1 mm to the ray origin (and every node for rays shorter than 0.1 mm); it also replaces
 //! direction components below `f32::EPSILON` by ±1/ε, which can cull valid boxes for nearly
-//! axis-parallel rays. We therefore keep obvhs as the builder, node layout and traversal loop
-//! (`obvhs::traverse!`) but supply our own node test ([`node_hitmask`]): entry clamped to 0,
+//! axis-parallel rays; and its traversal stack (32 entries) is not bounds-checked in release
+//! builds. We therefore keep obvhs as the builder and node layout but traverse its nodes with
+//! our own loop ([`traverse`], the same algorithm as `obvhs::traverse!`, with a 64-entry stack
+//! whose bound the build checks) and our own node test ([`node_hitmask`]): entry clamped to 0,
 //! exact reciprocal directions, and per-node conservative padding of the slab distances by
 //! their floating-point error bound, so no box containing a valid hit is ever culled.
 
@@ -18,7 +20,6 @@ use obvhs::aabb::Aabb;
 use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 use obvhs::BvhBuildParams;
-use std::time::Duration;
 
 /// All primitives of the scene in one BVH.
 pub struct SceneGeometry {
@@ -159,6 +160,100 @@ fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32
         }
     }
     hit_mask
+}
+
+/// Maximum supported BVH depth (our traversal stack size).
+const MAX_DEPTH: usize = 64;
+
+#[inline(always)]
+fn firstbithigh(v: u32) -> u32 {
+    31 - v.leading_zeros()
+}
+
+#[inline(always)]
+fn octant_inv4(d: Vec3) -> u32 {
+    (if d.x < 0.0 { 0 } else { 0x04040404 })
+        | (if d.y < 0.0 { 0 } else { 0x02020202 })
+        | (if d.z < 0.0 { 0 } else { 0x01010101 })
+}
+
+/// CWBVH traversal (the loop of `obvhs::traverse!`, Ylitie et al. 2017) with our node test and
+/// a 64-entry stack. `prim_fn(id, t_max)` tests primitive `id` and returns the new t_max
+/// (smaller on a closer hit) or `None` to stop traversal (any-hit).
+#[inline(always)]
+fn traverse(
+    bvh: &CwBvh,
+    origin: Vec3,
+    dir: Vec3,
+    mut t_max: f32,
+    mut prim_fn: impl FnMut(u32, f32) -> Option<f32>,
+) {
+    if bvh.nodes.is_empty() {
+        return;
+    }
+    let r = NodeRay::new(origin, dir);
+    let oct_inv4 = octant_inv4(dir);
+    let mut stack = [UVec2::ZERO; MAX_DEPTH];
+    let mut sp = 0usize;
+    let mut current = UVec2::new(0, 0x8000_0000);
+    let mut prims = UVec2::ZERO;
+    loop {
+        while prims.y != 0 {
+            let local = firstbithigh(prims.y);
+            prims.y &= !(1u32 << local);
+            match prim_fn(prims.x + local, t_max) {
+                Some(t) => t_max = t,
+                None => return,
+            }
+        }
+        if current.y & 0xff00_0000 != 0 {
+            let hits_imask = current.y;
+            let child_offset = firstbithigh(hits_imask);
+            let child_base = current.x;
+            current.y &= !(1u32 << child_offset);
+            if current.y & 0xff00_0000 != 0 {
+                // SAFETY: the stack holds one entry per level and the build rejects BVHs
+                // deeper than MAX_DEPTH.
+                unsafe { *stack.get_unchecked_mut(sp) = current };
+                sp += 1;
+            }
+            let slot = (child_offset - 24) ^ (oct_inv4 & 0xff);
+            let relative = (hits_imask & !(0xffff_ffffu32 << slot)).count_ones();
+            let node = &bvh.nodes[(child_base + relative) as usize];
+            let hitmask = node_hitmask(node, &r, oct_inv4, t_max);
+            current = UVec2::new(
+                node.child_base_idx,
+                (hitmask & 0xff00_0000) | node.imask as u32,
+            );
+            prims = UVec2::new(node.primitive_base_idx, hitmask & 0x00ff_ffff);
+        } else {
+            current = UVec2::ZERO;
+        }
+        if prims.y == 0 && current.y & 0xff00_0000 == 0 {
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            current = stack[sp];
+        }
+    }
+}
+
+/// Depth of a CWBVH (1 for a single root node; 0 if empty).
+fn cwbvh_depth(bvh: &CwBvh) -> u32 {
+    if bvh.nodes.is_empty() {
+        return 0;
+    }
+    let mut max = 0;
+    let mut stack = vec![(0u32, 1u32)];
+    while let Some((n, d)) = stack.pop() {
+        max = max.max(d);
+        let node = &bvh.nodes[n as usize];
+        for k in 0..node.imask.count_ones() {
+            stack.push((node.child_base_idx + k, d + 1));
+        }
+    }
+    max
 }
 
 fn invalid(shape: &Shape, object: u32, message: impl Into<String>) -> GeometryError {
@@ -344,11 +439,44 @@ impl SceneGeometry {
         } else {
             (lo, hi)
         };
-        let bvh = if prims.is_empty() {
+        let mut bvh = if prims.is_empty() {
             CwBvh::default()
         } else {
-            obvhs::cwbvh::builder::build_cwbvh(&aabbs, params, &mut Duration::default())
+            // Same steps as `obvhs::cwbvh::builder::build_cwbvh`, minus its debug-build
+            // validation, which asserts a depth < 32 that degenerate scenes can exceed (we
+            // check the depth ourselves below).
+            let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(aabbs.len()).build(
+                params.ploc_search_distance,
+                &aabbs,
+                (0..aabbs.len() as u32).collect(),
+                params.sort_precision,
+                params.search_depth_threshold,
+            );
+            obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
+                &mut bvh2,
+                params.reinsertion_batch_ratio,
+                None,
+            );
+            obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
+                &bvh2,
+                params.max_prims_per_leaf.clamp(1, 3),
+                true,
+                false,
+            )
         };
+        bvh.nodes.shrink_to_fit();
+        // Our traversal stack holds MAX_DEPTH entries; refuse a pathological BVH deeper than that.
+        let depth = cwbvh_depth(&bvh);
+        if depth as usize >= MAX_DEPTH {
+            return Err(GeometryError::InvalidShape {
+                shape: "scene",
+                object: 0,
+                message: format!(
+                    "the BVH over {} primitives is {depth} levels deep (at most 63 supported); the scene is probably degenerate (e.g. millions of coincident primitives)",
+                    prims.len()
+                ),
+            });
+        }
         drop(aabbs);
 
         // Lay primitives out in leaf order so the traversal indexes them directly.
@@ -360,6 +488,9 @@ impl SceneGeometry {
         } else {
             Vec::new()
         };
+        // Traversal only needs the node array once the primitives are in leaf order.
+        bvh.primitive_indices = Vec::new();
+        bvh.exact_node_aabbs = None;
         let mut by_obj: Vec<(u32, u32)> = prim_object
             .iter()
             .enumerate()
@@ -396,33 +527,30 @@ impl SceneGeometry {
         if self.prims.is_empty() || !Self::ray_ok(origin, dir, t_max) {
             return None;
         }
-        let nr = NodeRay::new(origin, dir);
         let pre = RayPre::new(origin, dir);
-        let mut tmax = t_max;
-        let mut best = u32::MAX;
-        let (mut ba, mut bb) = (0.0f32, 0.0f32);
+        match pre.kz {
+            0 => self.closest::<0>(&pre, t_max),
+            1 => self.closest::<1>(&pre, t_max),
+            _ => self.closest::<2>(&pre, t_max),
+        }
+    }
+
+    #[inline(always)]
+    fn closest<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> Option<Hit> {
         let prims = &self.prims[..];
-        let mut state = self.bvh.new_traversal(Vec3A::from(dir));
-        let mut node;
-        obvhs::traverse!(
-            self.bvh,
-            node,
-            state,
-            node_hitmask(node, &nr, state.oct_inv4, tmax),
-            {
-                let id = state.primitive_id;
-                // SAFETY: primitive ids from the traversal index `primitive_indices`, which has
-                // the same length as `prims`.
-                let prim = unsafe { prims.get_unchecked(id as usize) };
-                if let Some((t, a, b)) = prim.intersect(&pre, tmax) {
-                    tmax = t;
-                    best = id;
-                    ba = a;
-                    bb = b;
-                }
+        let mut best = u32::MAX;
+        let (mut tbest, mut ba, mut bb) = (t_max, 0.0f32, 0.0f32);
+        traverse(&self.bvh, pre.o, pre.d, t_max, |id, tmax| {
+            // SAFETY: leaf primitive ids index `prims` (same length as the builder's input).
+            let prim = unsafe { prims.get_unchecked(id as usize) };
+            if let Some((t, a, b)) = prim.intersect::<KZ>(pre, tmax) {
+                best = id;
+                (tbest, ba, bb) = (t, a, b);
+                return Some(t);
             }
-        );
-        (best != u32::MAX).then(|| self.make_hit(best, &pre, tmax, ba, bb))
+            Some(tmax)
+        });
+        (best != u32::MAX).then(|| self.make_hit(best, pre, tbest, ba, bb))
     }
 
     /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
@@ -461,28 +589,27 @@ impl SceneGeometry {
         if self.prims.is_empty() || !Self::ray_ok(origin, dir, t_max) {
             return false;
         }
-        let nr = NodeRay::new(origin, dir);
         let pre = RayPre::new(origin, dir);
-        let prims = &self.prims[..];
-        let mut state = self.bvh.new_traversal(Vec3A::from(dir));
-        let mut node;
-        let mut hit = false;
-        'outer: {
-            obvhs::traverse!(
-                self.bvh,
-                node,
-                state,
-                node_hitmask(node, &nr, state.oct_inv4, t_max),
-                {
-                    // SAFETY: see `intersect`.
-                    let prim = unsafe { prims.get_unchecked(state.primitive_id as usize) };
-                    if prim.intersect(&pre, t_max).is_some() {
-                        hit = true;
-                        break 'outer;
-                    }
-                }
-            );
+        match pre.kz {
+            0 => self.any_hit::<0>(&pre, t_max),
+            1 => self.any_hit::<1>(&pre, t_max),
+            _ => self.any_hit::<2>(&pre, t_max),
         }
+    }
+
+    #[inline(always)]
+    fn any_hit<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> bool {
+        let prims = &self.prims[..];
+        let mut hit = false;
+        traverse(&self.bvh, pre.o, pre.d, t_max, |id, tmax| {
+            // SAFETY: see `closest`.
+            let prim = unsafe { prims.get_unchecked(id as usize) };
+            if prim.intersect::<KZ>(pre, tmax).is_some() {
+                hit = true;
+                return None;
+            }
+            Some(tmax)
+        });
         hit
     }
 
@@ -495,7 +622,7 @@ impl SceneGeometry {
         let mut tmax = t_max;
         let mut best = None;
         for (i, p) in self.prims.iter().enumerate() {
-            if let Some((t, a, b)) = p.intersect(&pre, tmax) {
+            if let Some((t, a, b)) = p.intersect_dyn(&pre, tmax) {
                 tmax = t;
                 best = Some((i as u32, a, b));
             }
@@ -657,6 +784,11 @@ impl SceneGeometry {
 
     pub fn primitive_count(&self) -> usize {
         self.prims.len()
+    }
+
+    /// Depth of the BVH (number of node levels).
+    pub fn bvh_depth(&self) -> u32 {
+        cwbvh_depth(&self.bvh)
     }
 
     /// Number of CWBVH nodes (80 bytes each).
