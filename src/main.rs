@@ -233,23 +233,22 @@ fn write_outputs(
 ) -> Result<()> {
     let film = &result.film;
     let xyz = film.xyz_image();
-    let chan = |k: usize| xyz.iter().map(|p| p[k]).collect::<Vec<f32>>();
-    let layers = Layers {
-        width: film.width,
-        height: film.height,
-        channels: vec![
-            ("X".into(), chan(0)),
-            ("Y".into(), chan(1)),
-            ("Z".into(), chan(2)),
-            ("Y_stderr".into(), film.y_stderr_image()),
-        ],
-        attributes: vec![
-            ("software".into(), format!("candela {}", env!("CARGO_PKG_VERSION"))),
-            ("scene".into(), scene_path.display().to_string()),
-            ("units".into(), "X,Y,Z: absolute CIE 1931 2° tristimulus, Y = luminance in cd/m^2; Y_stderr: standard error of Y in cd/m^2".into()),
-            ("spp".into(), (film.total_samples() / (film.width * film.height) as u64).to_string()),
-        ],
-    };
+    let mut layers = Layers::from_xyz(film.width, film.height, &xyz, &film.y_stderr_image());
+    layers.attributes.extend([
+        (
+            "software".to_string(),
+            format!("candela {}", env!("CARGO_PKG_VERSION")),
+        ),
+        ("scene".to_string(), scene_path.display().to_string()),
+        (
+            "channel_units".to_string(),
+            "X,Y,Z: absolute CIE 1931 2° tristimulus values, Y = luminance in cd/m^2; stderr.Y: standard error of Y in cd/m^2".to_string(),
+        ),
+        (
+            "spp".to_string(),
+            (film.total_samples() / (film.width * film.height) as u64).to_string(),
+        ),
+    ]);
     output::write_exr(exr_path, &layers)
         .with_context(|| format!("writing {}", exr_path.display()))?;
     output::write_srgb_png(

@@ -36,6 +36,16 @@ pub const CHANNEL_Z: &str = "Z";
 pub const CHANNEL_Y_STDERR: &str = "stderr.Y";
 /// Header attribute holding the units of the `X`, `Y`, `Z` and `stderr.Y` channels.
 pub const ATTRIBUTE_UNITS: &str = "units";
+/// Illuminance (lx) on the surface seen through each pixel; [`ILLUMINANCE_SENTINEL`] where the
+/// pixel sees no surface (sky, emitter, nothing), see [`CHANNEL_E_MASK`].
+pub const CHANNEL_E: &str = "E";
+/// Standard error of `E`, lx (0 where `E` is undefined).
+pub const CHANNEL_E_STDERR: &str = "stderr.E";
+/// 1 where every sample of the pixel saw a reflecting surface (E defined), 0 where none did;
+/// fractional where the pixel straddles an edge (E is then the mean over the covered samples).
+pub const CHANNEL_E_MASK: &str = "mask.E";
+/// Value written to `E` where it is undefined (never NaN).
+pub const ILLUMINANCE_SENTINEL: f32 = -1.0;
 /// Value of [`ATTRIBUTE_UNITS`] for candela's absolute photometric images.
 pub const UNITS_CD_PER_M2: &str = "cd/m^2";
 

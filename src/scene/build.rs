@@ -129,20 +129,29 @@ fn resolve_spectrum(
                 .map_err(|e| ctx.err(field, e.to_string()))?;
             DenseSpectrum::from_fn(|nm| sd.value(nm))
         }
-        SpectrumDesc::Rgb(r, g, b) => {
-            let rgb = [*r, *g, *b];
+        SpectrumDesc::Rgb(..) | SpectrumDesc::Srgb(..) => {
+            let (rgb, encoded) = match *desc {
+                SpectrumDesc::Rgb(r, g, b) => ([r, g, b], false),
+                SpectrumDesc::Srgb(r, g, b) => ([r, g, b], true),
+                _ => unreachable!(),
+            };
             for (k, c) in rgb.iter().enumerate() {
                 ctx.finite(field, *c)?;
                 if !(0.0..=1.0).contains(c) {
                     return Err(ctx.err(
                         field,
                         format!(
-                            "RGB component {} is {c}; linear sRGB components must lie in [0, 1]",
+                            "RGB component {} is {c}; sRGB components must lie in [0, 1]",
                             ["r", "g", "b"][k]
                         ),
                     ));
                 }
             }
+            let rgb = if encoded {
+                rgb.map(crate::colour::rgb::srgb_decode)
+            } else {
+                rgb
+            };
             let (sig, _residual) =
                 fit_linear_srgb(rgb).map_err(|e| ctx.err(field, e.to_string()))?;
             match role {

@@ -119,6 +119,9 @@ pub enum SpectrumDesc {
     Csv(String),
     /// A linear-sRGB colour (components in [0, 1]) upsampled to a smooth spectrum.
     Rgb(f64, f64, f64),
+    /// An sRGB colour as encoded in images and colour pickers (IEC 61966-2-1 transfer function,
+    /// components in [0, 1]); decoded to linear sRGB, then as `Rgb`.
+    Srgb(f64, f64, f64),
 }
 
 #[derive(Debug, Clone, Deserialize)]
