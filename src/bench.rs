@@ -96,6 +96,9 @@ pub fn run(threads: Option<usize>, spp: u32, triangles: usize) -> anyhow::Result
                 amount: Amount::Illuminance(50_000.0),
             },
         ],
+        meters: Vec::new(),
+        grids: Vec::new(),
+        measure: MeasureDesc::default(),
     };
     drop(mesh);
     let world = scene::build(&scene, Path::new("<generated>"), &overrides)?;

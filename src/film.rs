@@ -70,6 +70,10 @@ pub struct PixelSums {
     /// Σ Y², for the sample variance of luminance.
     pub sum_y2: f64,
     pub count: u64,
+    /// Σ E (lx) over the samples whose camera ray found a receiving surface.
+    pub sum_e: f64,
+    pub sum_e2: f64,
+    pub count_e: u64,
 }
 
 impl PixelSums {
@@ -81,7 +85,33 @@ impl PixelSums {
         self.sum_y2 += xyz[1] * xyz[1];
         self.count += 1;
     }
+    /// Record one illuminance sample (lx) of the surface seen by a camera sample.
+    #[inline]
+    pub fn add_illuminance(&mut self, e: f64) {
+        self.sum_e += e;
+        self.sum_e2 += e * e;
+        self.count_e += 1;
+    }
+    /// Mean illuminance over the samples that saw a receiving surface.
+    pub fn mean_e(&self) -> Option<f64> {
+        (self.count_e > 0).then(|| self.sum_e / self.count_e as f64)
+    }
+    /// Standard error of [`Self::mean_e`].
+    pub fn e_standard_error(&self) -> f64 {
+        standard_error(self.sum_e, self.sum_e2, self.count_e)
+    }
+    /// Fraction of the pixel's samples whose illuminance is defined.
+    pub fn e_coverage(&self) -> f64 {
+        if self.count == 0 {
+            0.0
+        } else {
+            self.count_e as f64 / self.count as f64
+        }
+    }
     pub fn merge(&mut self, o: &PixelSums) {
+        self.sum_e += o.sum_e;
+        self.sum_e2 += o.sum_e2;
+        self.count_e += o.count_e;
         for k in 0..3 {
             self.sum_xyz[k] += o.sum_xyz[k];
         }
@@ -102,14 +132,19 @@ impl PixelSums {
     }
     /// Standard error of the mean luminance, √(s²/n) with the unbiased sample variance s².
     pub fn y_standard_error(&self) -> f64 {
-        if self.count < 2 {
-            return 0.0;
-        }
-        let n = self.count as f64;
-        let mean = self.sum_xyz[1] / n;
-        let var = ((self.sum_y2 - n * mean * mean) / (n - 1.0)).max(0.0);
-        (var / n).sqrt()
+        standard_error(self.sum_xyz[1], self.sum_y2, self.count)
     }
+}
+
+/// √(s²/n) from Σx, Σx² and n, with the unbiased sample variance s² (0 for n < 2).
+pub fn standard_error(sum: f64, sum2: f64, n: u64) -> f64 {
+    if n < 2 {
+        return 0.0;
+    }
+    let nf = n as f64;
+    let mean = sum / nf;
+    let var = ((sum2 - nf * mean * mean) / (nf - 1.0)).max(0.0);
+    (var / nf).sqrt()
 }
 
 /// The whole image's sums.
@@ -143,6 +178,24 @@ impl Film {
             .iter()
             .map(|p| p.y_standard_error() as f32)
             .collect()
+    }
+    /// Illuminance channels: (E with the sentinel where undefined, its standard error, coverage).
+    pub fn illuminance_images(&self) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+        let e = self
+            .pixels
+            .iter()
+            .map(|p| {
+                p.mean_e()
+                    .map_or(crate::output::ILLUMINANCE_SENTINEL, |v| v as f32)
+            })
+            .collect();
+        let se = self
+            .pixels
+            .iter()
+            .map(|p| p.e_standard_error() as f32)
+            .collect();
+        let cov = self.pixels.iter().map(|p| p.e_coverage() as f32).collect();
+        (e, se, cov)
     }
     pub fn total_samples(&self) -> u64 {
         self.pixels.iter().map(|p| p.count).sum()

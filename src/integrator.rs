@@ -5,7 +5,7 @@
 //! lights through [`crate::light::Light`]'s, so new families slot in without touching it.
 
 use crate::bxdf::Frame;
-use crate::geometry::{shadow_ray, Hit};
+use crate::geometry::{offset_ray_origin, point_error_bound, shadow_ray_between, Hit};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
@@ -55,16 +55,62 @@ pub fn radiance(
     sampler: &mut Sampler,
     stats: &mut RayStats,
 ) -> SampledSpectrum {
+    trace(
+        world,
+        origin,
+        dir,
+        PathStart::camera(origin),
+        wl,
+        sampler,
+        stats,
+    )
+}
+
+/// How the ray being traced was generated, for MIS of the emission it finds first.
+#[derive(Clone, Copy, Debug)]
+pub struct PathStart {
+    /// The direction was not sampled from a density light sampling could also produce
+    /// (camera rays, specular bounces): emission found is counted in full.
+    pub specular: bool,
+    /// Solid-angle density with which the direction was sampled.
+    pub pdf: f32,
+    /// The point the ray leaves (for the light-sampling density of what it hits).
+    pub p: Vec3,
+    /// Scattering events already on the path (0 for a camera ray).
+    pub depth: u32,
+}
+
+impl PathStart {
+    pub fn camera(p: Vec3) -> Self {
+        Self {
+            specular: true,
+            pdf: 0.0,
+            p,
+            depth: 0,
+        }
+    }
+}
+
+/// Radiance arriving along a ray that starts in state `start`.
+pub fn trace(
+    world: &World,
+    origin: Vec3,
+    dir: Vec3,
+    start: PathStart,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+) -> SampledSpectrum {
     let settings = &world.settings;
     let mut l = SampledSpectrum::ZERO;
     let mut beta = SampledSpectrum::ONE;
     let mut ray_o = origin;
     let mut ray_d = dir;
     // For MIS of emission found by BSDF sampling.
-    let mut prev_specular = true;
-    let mut prev_pdf = 0.0f32;
-    let mut prev_p = origin;
-    let mut depth = 0u32;
+    let mut prev_specular = start.specular;
+    let mut prev_pdf = start.pdf;
+    let mut prev_p = start.p;
+    let mut depth = start.depth;
 
     loop {
         let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
@@ -128,7 +174,7 @@ pub fn radiance(
                     let f = material.eval(wo, wi, wl) * wi.z.abs();
                     if !f.is_black() {
                         stats.shadow_rays += 1;
-                        if unoccluded(world, &hit, &ls) {
+                        if unoccluded(world, &RayStart::surface(&hit), &ls) {
                             let pdf = p_select * ls.pdf;
                             let w = if ls.delta {
                                 1.0
@@ -180,14 +226,40 @@ pub fn radiance(
     l
 }
 
-/// Shadow test between a shading point and a light sample.
-fn unoccluded(world: &World, hit: &Hit, ls: &crate::light::LightSample) -> bool {
+/// Where a shadow ray starts: a surface point with its error bound and geometric normal, or a
+/// free-standing point (zero error and zero normal: no offset).
+#[derive(Clone, Copy, Debug)]
+pub struct RayStart {
+    pub p: Vec3,
+    pub error: Vec3,
+    pub ng: Vec3,
+}
+
+impl RayStart {
+    pub fn surface(hit: &Hit) -> Self {
+        Self {
+            p: hit.p,
+            error: hit.error,
+            ng: hit.ng,
+        }
+    }
+    pub fn free(p: Vec3) -> Self {
+        Self {
+            p,
+            error: Vec3::ZERO,
+            ng: Vec3::ZERO,
+        }
+    }
+}
+
+/// Shadow test between a point and a light sample.
+fn unoccluded(world: &World, from: &RayStart, ls: &crate::light::LightSample) -> bool {
     let (origin, dir, t_max) = match ls.point {
-        Some((p, n)) => shadow_ray(hit, p, n),
+        Some((p, n)) => shadow_ray_between(from.p, from.error, from.ng, p, point_error_bound(p), n),
         None => {
-            let origin = hit.spawn_origin(ls.wi);
+            let origin = offset_ray_origin(from.p, from.error, from.ng, ls.wi);
             let t_max = if ls.dist.is_finite() {
-                (hit.p + ls.wi * ls.dist - origin).length()
+                (from.p + ls.wi * ls.dist - origin).length()
             } else {
                 f32::INFINITY
             };
@@ -195,4 +267,59 @@ fn unoccluded(world: &World, hit: &Hit, ls: &crate::light::LightSample) -> bool 
         }
     };
     t_max <= 0.0 || !world.geometry.occluded(origin, dir, t_max)
+}
+
+/// Spectral irradiance (W·m⁻²·nm⁻¹) on the hemisphere around unit normal `n` at `at`: light
+/// sampling and cosine-weighted hemisphere sampling combined by MIS (power heuristic) for
+/// directly visible emitters; light reflected by the scene arrives through the cosine-sampled
+/// path. The receiver counts as the first scattering event of its paths, so with the same
+/// `max_depth` a Lambertian surface's luminance is exactly ρE/π of this estimate.
+pub fn irradiance(
+    world: &World,
+    at: &RayStart,
+    n: Vec3,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+) -> SampledSpectrum {
+    use std::f32::consts::{FRAC_1_PI, PI};
+    let mut e = SampledSpectrum::ZERO;
+    let u_light = sampler.get1d();
+    let u_prim = sampler.get1d();
+    let u_pt = sampler.get2d();
+    if let Some((k, p_select)) = world.light_sampler.sample(u_light) {
+        let light = &world.lights[k];
+        if let Some(ls) = light.sample_li(&world.geometry, at.p, u_prim, u_pt, wl) {
+            let cos = ls.wi.dot(n);
+            if cos > 0.0 && ls.pdf > 0.0 && !ls.li.is_black() {
+                stats.shadow_rays += 1;
+                if unoccluded(world, at, &ls) {
+                    let pdf = p_select * ls.pdf;
+                    let w = if ls.delta {
+                        1.0
+                    } else {
+                        power_heuristic(pdf, cos * FRAC_1_PI)
+                    };
+                    e += ls.li * (cos * w / pdf);
+                }
+            }
+        }
+    }
+    if world.settings.max_depth >= 1 {
+        let local = crate::bxdf::sample_cosine_hemisphere(sampler.get2d());
+        if local.z > 0.0 {
+            let wi = Frame::from_normal(n).to_world(local);
+            let origin = offset_ray_origin(at.p, at.error, at.ng, wi);
+            stats.bounce_rays += 1;
+            let start = PathStart {
+                specular: false,
+                pdf: local.z * FRAC_1_PI,
+                p: at.p,
+                depth: 1,
+            };
+            // cos θ / pdf = π.
+            e += trace(world, origin, wi, start, wl, sampler, stats) * PI;
+        }
+    }
+    e
 }

@@ -4,6 +4,7 @@ use anyhow::{bail, Context, Result};
 use candela::colour::tables::Observer;
 use candela::output::{self, Layers, PngSettings};
 use candela::render::{render, RenderResult};
+use candela::report::json::{grid_csv, grid_csv_path, report_json, write_text, ReportInput, Units};
 use candela::scene::{self, Overrides};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -45,6 +46,12 @@ enum Command {
         /// Exposure of the PNG in EV (ISO 100); default: automatic. Does not affect the EXR.
         #[arg(long, allow_hyphen_values = true)]
         exposure: Option<f64>,
+        /// Also estimate the illuminance (lx) on the surface seen through each pixel (EXR channels E, stderr.E, mask.E).
+        #[arg(long)]
+        illuminance: bool,
+        /// Units of the report: si (lx, cd/m²) or imperial (fc, fL).
+        #[arg(long, default_value = "si", value_parser = ["si", "imperial"])]
+        units: String,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
@@ -92,6 +99,8 @@ fn main() -> ExitCode {
             seed,
             max_depth,
             exposure,
+            illuminance,
+            units,
             quiet,
         } => cmd_render(
             &scene,
@@ -99,10 +108,16 @@ fn main() -> ExitCode {
                 spp,
                 seed,
                 max_depth,
+                illuminance,
             },
             out.as_deref(),
             threads,
             exposure,
+            if units == "imperial" {
+                Units::Imperial
+            } else {
+                Units::Si
+            },
             quiet,
         ),
         Command::Spectrum {
@@ -135,8 +150,8 @@ fn main() -> ExitCode {
     }
 }
 
-/// Where to write: (`stem.exr`, `stem.png`).
-fn output_paths(scene: &Path, out: Option<&Path>) -> (PathBuf, PathBuf) {
+/// Where to write: (`stem`, `stem.exr`, `stem.png`).
+fn output_paths(scene: &Path, out: Option<&Path>) -> (PathBuf, PathBuf, PathBuf) {
     let name = scene
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -151,9 +166,9 @@ fn output_paths(scene: &Path, out: Option<&Path>) -> (PathBuf, PathBuf) {
     };
     let mut exr = stem.clone().into_os_string();
     exr.push(".exr");
-    let mut png = stem.into_os_string();
+    let mut png = stem.clone().into_os_string();
     png.push(".png");
-    (exr.into(), png.into())
+    (stem, exr.into(), png.into())
 }
 
 fn cmd_render(
@@ -162,6 +177,7 @@ fn cmd_render(
     out: Option<&Path>,
     threads: Option<usize>,
     exposure: Option<f64>,
+    units: Units,
     quiet: bool,
 ) -> Result<()> {
     if let Some(0) = threads {
@@ -173,7 +189,7 @@ fn cmd_render(
         }
     }
     let world = scene::load_world(scene_path, &overrides)?;
-    let (exr_path, png_path) = output_paths(scene_path, out);
+    let (stem, exr_path, png_path) = output_paths(scene_path, out);
     if let Some(dir) = exr_path.parent() {
         if !dir.as_os_str().is_empty() && !dir.is_dir() {
             bail!("output directory {} does not exist", dir.display());
@@ -197,7 +213,65 @@ fn cmd_render(
         bar.set_position(done);
     })?;
     bar.finish_and_clear();
-    write_outputs(scene_path, &result, &exr_path, &png_path, exposure)?;
+    let t_measure = std::time::Instant::now();
+    let measurements = candela::meter::measure_all(&world);
+    let measure_seconds = t_measure.elapsed().as_secs_f64();
+    write_outputs(scene_path, &world, &result, &exr_path, &png_path, exposure)?;
+    let mut outputs = vec![
+        exr_path.display().to_string(),
+        png_path.display().to_string(),
+    ];
+    for (k, (g, est)) in world.grids.iter().zip(&measurements.grids).enumerate() {
+        let path = grid_csv_path(&stem, &g.name);
+        write_text(&path, &grid_csv(&world, k, est, units))?;
+        outputs.push(path.display().to_string());
+    }
+    let report_path = {
+        let mut p = stem.clone().into_os_string();
+        p.push(".report.json");
+        PathBuf::from(p)
+    };
+    let report = report_json(&ReportInput {
+        scene_path,
+        world: &world,
+        render: &result,
+        measurements: &measurements,
+        measure_seconds,
+        units,
+        outputs,
+    });
+    write_text(&report_path, &serde_json::to_string_pretty(&report)?)?;
+    for (m, e) in world.meters.iter().zip(&measurements.meters) {
+        let (k, unit) = match m.kind {
+            candela::meter::MeterKind::Illuminance { .. } => {
+                (units.illuminance_factor(), units.illuminance_symbol())
+            }
+            candela::meter::MeterKind::Luminance { .. } => {
+                (units.luminance_factor(), units.luminance_symbol())
+            }
+        };
+        println!(
+            "meter {:?}: {:.4} ± {:.4} {unit} (95 %, {} samples)",
+            m.name,
+            e.mean * k,
+            e.ci95() * k,
+            e.samples
+        );
+    }
+    for (g, est) in world.grids.iter().zip(&measurements.grids) {
+        let s = candela::meter::grid_stats(est);
+        let (k, u) = (units.illuminance_factor(), units.illuminance_symbol());
+        println!(
+            "grid {:?} ({}×{}): E_min {:.2} {u}, E_avg {:.2} {u}, E_max {:.2} {u}, U0 {:.3}",
+            g.name,
+            g.nx,
+            g.ny,
+            s.min * k,
+            s.avg * k,
+            s.max * k,
+            s.u0
+        );
+    }
     let mean_y = result
         .film
         .pixels
@@ -226,6 +300,7 @@ fn cmd_render(
 
 fn write_outputs(
     scene_path: &Path,
+    world: &candela::world::World,
     result: &RenderResult,
     exr_path: &Path,
     png_path: &Path,
@@ -249,6 +324,21 @@ fn write_outputs(
             (film.total_samples() / (film.width * film.height) as u64).to_string(),
         ),
     ]);
+    if world.settings.illuminance {
+        let (e, se, mask) = film.illuminance_images();
+        layers.channels.extend([
+            (output::CHANNEL_E.to_string(), e),
+            (output::CHANNEL_E_STDERR.to_string(), se),
+            (output::CHANNEL_E_MASK.to_string(), mask),
+        ]);
+        layers.attributes.push((
+            "illuminance".to_string(),
+            format!(
+                "E: illuminance in lx on the surface seen through the pixel (hemisphere facing the camera), {} where the pixel sees no receiving surface; stderr.E: its standard error; mask.E: fraction of samples that saw a receiving surface",
+                output::ILLUMINANCE_SENTINEL
+            ),
+        ));
+    }
     output::write_exr(exr_path, &layers)
         .with_context(|| format!("writing {}", exr_path.display()))?;
     output::write_srgb_png(

@@ -49,6 +49,11 @@ pub fn render_pixel(
         let ray = cam.generate_ray(x as f32 + 0.5 + off.x, y as f32 + 0.5 + off.y, u_lens);
         stats.camera_rays += 1;
         let l = radiance(world, ray.origin, ray.dir, &mut wl, &mut sampler, stats);
+        if world.settings.illuminance {
+            if let Some(e) = surface_illuminance(world, ray.origin, ray.dir, pixel, s, stats) {
+                sums.add_illuminance(e);
+            }
+        }
         let xyz = radiance_to_xyz(&l, &wl);
         if xyz.iter().all(|v| v.is_finite()) {
             sums.add(xyz);
@@ -56,6 +61,43 @@ pub fn render_pixel(
             stats.non_finite += 1;
             sums.add([0.0; 3]);
         }
+    }
+}
+
+/// Stream id of the illuminance estimates (independent of the radiance samples).
+const ILLUMINANCE_STREAM: u64 = 0x11_1c_e5_7a_u64 << 20;
+
+/// Illuminance (lx) on the surface a camera ray sees, or None if it sees no receiving surface
+/// (nothing, the sky, or an emitter).
+fn surface_illuminance(
+    world: &World,
+    origin: glam::Vec3,
+    dir: glam::Vec3,
+    pixel: u64,
+    sample: u64,
+    stats: &mut RayStats,
+) -> Option<f64> {
+    let hit = world.geometry.intersect(origin, dir, f32::INFINITY)?;
+    stats.camera_rays += 1;
+    if world.objects[hit.object as usize].light.is_some() {
+        return None;
+    }
+    // The hemisphere on the side of the surface facing the camera.
+    let n = if hit.ng.dot(dir) > 0.0 {
+        -hit.ng
+    } else {
+        hit.ng
+    };
+    let mut sampler = Sampler::new(world.settings.seed ^ ILLUMINANCE_STREAM, pixel, sample);
+    let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
+    let at = crate::integrator::RayStart::surface(&hit);
+    let e = crate::integrator::irradiance(world, &at, n, &mut wl, &mut sampler, stats);
+    let lux = radiance_to_xyz(&e, &wl)[1];
+    if lux.is_finite() {
+        Some(lux)
+    } else {
+        stats.non_finite += 1;
+        Some(0.0)
     }
 }
 

@@ -26,6 +26,8 @@ pub struct RenderSettings {
     pub rr_depth: u32,
     pub seed: u64,
     pub filter: PixelFilter,
+    /// Also estimate the illuminance (lx) on the surface seen through each pixel.
+    pub illuminance: bool,
 }
 
 impl Default for RenderSettings {
@@ -36,6 +38,7 @@ impl Default for RenderSettings {
             rr_depth: 3,
             seed: 0,
             filter: PixelFilter::Box,
+            illuminance: false,
         }
     }
 }
@@ -50,4 +53,7 @@ pub struct World {
     pub infinite_lights: Vec<u32>,
     pub camera: Camera,
     pub settings: RenderSettings,
+    pub meters: Vec<crate::meter::Meter>,
+    pub grids: Vec<crate::meter::Grid>,
+    pub measure: crate::meter::MeasureSettings,
 }

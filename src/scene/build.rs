@@ -9,6 +9,7 @@ use crate::colour::sd::SpectralDistribution;
 use crate::colour::{planck::planck_law, tables};
 use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
 use crate::light::{photometric_scale, Light, LightSampler};
+use crate::meter::{Grid, MeasureSettings, Meter, MeterKind};
 use crate::spectrum::rgb_upsample::fit_linear_srgb;
 use crate::spectrum::DenseSpectrum;
 use crate::world::{Object, RenderSettings, World};
@@ -22,6 +23,8 @@ pub struct Overrides {
     pub spp: Option<u32>,
     pub seed: Option<u64>,
     pub max_depth: Option<u32>,
+    /// Force per-pixel illuminance on.
+    pub illuminance: bool,
 }
 
 /// Largest image the renderer accepts (pixels), so a typo cannot exhaust memory.
@@ -415,6 +418,7 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         rr_depth: r.rr_depth,
         seed: overrides.seed.unwrap_or(r.seed),
         filter,
+        illuminance: r.illuminance || overrides.illuminance,
     };
 
     // Materials.
@@ -551,6 +555,7 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         lights.push(light);
     }
     let light_sampler = LightSampler::new(&lights, &geometry, scene_radius);
+    let (meters, grids, measure) = build_meters(&ctx, scene)?;
 
     Ok(World {
         geometry,
@@ -561,7 +566,128 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         infinite_lights,
         camera,
         settings,
+        meters,
+        grids,
+        measure,
     })
+}
+
+fn unit(ctx: &Ctx, field: &str, v: V3) -> Result<Vec3, SceneError> {
+    let v = ctx.vec3(field, v)?;
+    if v.length_squared() == 0.0 {
+        return Err(ctx.err(field, "the direction is the zero vector"));
+    }
+    Ok(v.normalize())
+}
+
+fn build_meters(
+    ctx: &Ctx,
+    scene: &SceneFile,
+) -> Result<(Vec<Meter>, Vec<Grid>, MeasureSettings), SceneError> {
+    let mut names = std::collections::HashSet::new();
+    let mut meters = Vec::new();
+    for (i, m) in scene.meters.iter().enumerate() {
+        let field = format!("meters[{i}]");
+        let (name, kind) = match m {
+            MeterDesc::Illuminance {
+                name,
+                position,
+                normal,
+            } => (
+                name,
+                MeterKind::Illuminance {
+                    position: ctx.vec3(&format!("{field}.position"), *position)?,
+                    normal: unit(ctx, &format!("{field}.normal"), *normal)?,
+                },
+            ),
+            MeterDesc::Luminance {
+                name,
+                position,
+                direction,
+                half_angle_deg,
+            } => {
+                let a = ctx.finite(&format!("{field}.half_angle_deg"), *half_angle_deg as f64)?;
+                if !(0.0..90.0).contains(&a) {
+                    return Err(ctx.err(
+                        format!("{field}.half_angle_deg"),
+                        format!("the acceptance half-angle must lie in [0, 90) degrees, got {a}"),
+                    ));
+                }
+                (
+                    name,
+                    MeterKind::Luminance {
+                        position: ctx.vec3(&format!("{field}.position"), *position)?,
+                        direction: unit(ctx, &format!("{field}.direction"), *direction)?,
+                        half_angle_rad: (a as f32).to_radians(),
+                    },
+                )
+            }
+        };
+        if !names.insert(name.clone()) {
+            return Err(ctx.err(
+                format!("{field}.name"),
+                format!("the name {name:?} is used twice"),
+            ));
+        }
+        meters.push(Meter {
+            name: name.clone(),
+            kind,
+        });
+    }
+    let mut grids = Vec::new();
+    for (i, g) in scene.grids.iter().enumerate() {
+        let field = format!("grids[{i}]");
+        if g.nx == 0 || g.ny == 0 || g.nx as u64 * g.ny as u64 > 1_000_000 {
+            return Err(ctx.err(
+                format!("{field}.nx"),
+                format!("a grid needs 1 to 1 000 000 points, got {}×{}", g.nx, g.ny),
+            ));
+        }
+        let eu = ctx.vec3(&format!("{field}.edge_u"), g.edge_u)?;
+        let ev = ctx.vec3(&format!("{field}.edge_v"), g.edge_v)?;
+        if eu.cross(ev).length_squared() == 0.0 {
+            return Err(ctx.err(
+                &field,
+                "the grid has zero area (edge_u and edge_v are parallel or zero)",
+            ));
+        }
+        if !names.insert(g.name.clone()) {
+            return Err(ctx.err(
+                format!("{field}.name"),
+                format!("the name {:?} is used twice", g.name),
+            ));
+        }
+        grids.push(Grid {
+            name: g.name.clone(),
+            origin: ctx.vec3(&format!("{field}.origin"), g.origin)?,
+            edge_u: eu,
+            edge_v: ev,
+            nx: g.nx,
+            ny: g.ny,
+            normal: unit(ctx, &format!("{field}.normal"), g.normal)?,
+        });
+    }
+    let m = &scene.measure;
+    if m.samples == 0 {
+        return Err(ctx.err("measure.samples", "meters need at least 1 sample"));
+    }
+    if let Some(t) = m.target_relative_error {
+        if !(t.is_finite() && t > 0.0 && t < 1.0) {
+            return Err(ctx.err(
+                "measure.target_relative_error",
+                format!("the target relative error must lie in (0, 1), e.g. 0.01 for 1 %, got {t}"),
+            ));
+        }
+    }
+    Ok((
+        meters,
+        grids,
+        MeasureSettings {
+            samples: m.samples,
+            target_relative_error: m.target_relative_error,
+            max_samples: m.max_samples.max(m.samples),
+        },
+    ))
 }
 
 fn nonneg(ctx: &Ctx, field: &str, v: f64) -> Result<f64, SceneError> {

@@ -19,6 +19,84 @@ pub struct SceneFile {
     pub objects: Vec<ObjectDesc>,
     #[serde(default)]
     pub lights: Vec<LightDesc>,
+    /// Point meters (illuminance or luminance), reported in NAME.report.json.
+    #[serde(default)]
+    pub meters: Vec<MeterDesc>,
+    /// Calculation grids of illuminance meters (e.g. a work plane), reported in the JSON report
+    /// and one CSV each.
+    #[serde(default)]
+    pub grids: Vec<GridDesc>,
+    /// Sample budget of meters and grids.
+    #[serde(default)]
+    pub measure: MeasureDesc,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MeterDesc {
+    /// Illuminance (lx) on a small receiver at `position` facing `normal`, from the whole
+    /// hemisphere around the normal (a cosine-corrected lux meter).
+    Illuminance {
+        name: String,
+        position: V3,
+        normal: V3,
+    },
+    /// Mean luminance (cd/m²) seen from `position` looking along `direction`, within a cone
+    /// of half-angle `half_angle_deg` (a spot luminance meter; 0 = a single direction).
+    Luminance {
+        name: String,
+        position: V3,
+        direction: V3,
+        #[serde(default)]
+        half_angle_deg: f32,
+    },
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridDesc {
+    pub name: String,
+    /// Corner of the grid's rectangle, m.
+    pub origin: V3,
+    /// The rectangle's two sides, m (nx points along edge_u, ny along edge_v).
+    pub edge_u: V3,
+    pub edge_v: V3,
+    pub nx: u32,
+    pub ny: u32,
+    /// Direction the meters face (default up, (0, 1, 0): a horizontal work plane).
+    #[serde(default = "default_up")]
+    pub normal: V3,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeasureDesc {
+    /// Samples per meter (and per grid point) when no target error is set, or the minimum
+    /// before the target is checked.
+    #[serde(default = "default_meter_samples")]
+    pub samples: u64,
+    /// Stop each meter when its standard error is below this fraction of its value
+    /// (e.g. 0.005 for 0.5 %), up to `max_samples`.
+    #[serde(default)]
+    pub target_relative_error: Option<f64>,
+    #[serde(default = "default_meter_max_samples")]
+    pub max_samples: u64,
+}
+
+impl Default for MeasureDesc {
+    fn default() -> Self {
+        Self {
+            samples: default_meter_samples(),
+            target_relative_error: None,
+            max_samples: default_meter_max_samples(),
+        }
+    }
+}
+fn default_meter_samples() -> u64 {
+    4096
+}
+fn default_meter_max_samples() -> u64 {
+    1 << 22
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -65,6 +143,9 @@ pub struct RenderDesc {
     pub seed: u64,
     #[serde(default)]
     pub filter: FilterDesc,
+    /// Also write per-pixel illuminance (lx) of the surface seen (`--illuminance`).
+    #[serde(default)]
+    pub illuminance: bool,
 }
 
 impl Default for RenderDesc {
@@ -75,6 +156,7 @@ impl Default for RenderDesc {
             rr_depth: default_rr_depth(),
             seed: 0,
             filter: FilterDesc::Box,
+            illuminance: false,
         }
     }
 }

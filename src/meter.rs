@@ -1,0 +1,257 @@
+//! Meters: illuminance at a point, luminance in a cone of directions, and calculation grids of
+//! illuminance meters (a work plane). Each result carries its standard error; each meter runs
+//! its own sample budget, or samples until a target relative error is reached.
+//!
+//! Every meter point has its own random stream, so results do not depend on the thread count.
+
+use crate::film::{radiance_to_xyz, standard_error};
+use crate::integrator::{irradiance, radiance, RayStart, RayStats};
+use crate::sampler::{mix64, Sampler};
+use crate::spectrum::SampledWavelengths;
+use crate::world::World;
+use glam::Vec3;
+use rayon::prelude::*;
+
+#[derive(Clone, Debug)]
+pub enum MeterKind {
+    /// Illuminance (lx) on the hemisphere around the unit `normal`.
+    Illuminance { position: Vec3, normal: Vec3 },
+    /// Mean luminance (cd/m²) over a cone of directions around the unit `direction`.
+    Luminance {
+        position: Vec3,
+        direction: Vec3,
+        half_angle_rad: f32,
+    },
+}
+
+#[derive(Clone, Debug)]
+pub struct Meter {
+    pub name: String,
+    pub kind: MeterKind,
+}
+
+#[derive(Clone, Debug)]
+pub struct Grid {
+    pub name: String,
+    pub origin: Vec3,
+    pub edge_u: Vec3,
+    pub edge_v: Vec3,
+    pub nx: u32,
+    pub ny: u32,
+    pub normal: Vec3,
+}
+
+impl Grid {
+    /// The meter point of cell (i, j): the cell centre.
+    pub fn point(&self, i: u32, j: u32) -> Vec3 {
+        self.origin
+            + self.edge_u * ((i as f32 + 0.5) / self.nx as f32)
+            + self.edge_v * ((j as f32 + 0.5) / self.ny as f32)
+    }
+}
+
+/// Sample budget of meters.
+#[derive(Clone, Debug)]
+pub struct MeasureSettings {
+    pub samples: u64,
+    pub target_relative_error: Option<f64>,
+    pub max_samples: u64,
+}
+
+impl Default for MeasureSettings {
+    fn default() -> Self {
+        Self {
+            samples: 4096,
+            target_relative_error: None,
+            max_samples: 1 << 22,
+        }
+    }
+}
+
+/// A measured value with its standard error.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Estimate {
+    pub mean: f64,
+    pub stderr: f64,
+    pub samples: u64,
+}
+
+impl Estimate {
+    /// Half-width of the 95 % confidence interval (normal approximation).
+    pub fn ci95(&self) -> f64 {
+        1.959_963_984_540_054 * self.stderr
+    }
+    pub fn relative_error(&self) -> f64 {
+        if self.mean != 0.0 {
+            self.stderr / self.mean.abs()
+        } else if self.stderr == 0.0 {
+            0.0
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+const BATCH: u64 = 1024;
+
+/// One sample of a meter (lx or cd/m²).
+fn sample_meter(world: &World, kind: &MeterKind, stream: u64, s: u64, stats: &mut RayStats) -> f64 {
+    let mut sampler = Sampler::new(world.settings.seed, stream, s);
+    let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
+    let v = match kind {
+        MeterKind::Illuminance { position, normal } => {
+            let e = irradiance(
+                world,
+                &RayStart::free(*position),
+                *normal,
+                &mut wl,
+                &mut sampler,
+                stats,
+            );
+            radiance_to_xyz(&e, &wl)[1]
+        }
+        MeterKind::Luminance {
+            position,
+            direction,
+            half_angle_rad,
+        } => {
+            let u = sampler.get2d();
+            // Uniform in solid angle within the cone.
+            let cos_max = half_angle_rad.cos();
+            let cos_t = 1.0 - u.x * (1.0 - cos_max);
+            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+            let phi = 2.0 * std::f32::consts::PI * u.y;
+            let local = Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+            let dir = crate::bxdf::Frame::from_normal(*direction)
+                .to_world(local)
+                .normalize();
+            stats.camera_rays += 1;
+            let l = radiance(world, *position, dir, &mut wl, &mut sampler, stats);
+            radiance_to_xyz(&l, &wl)[1]
+        }
+    };
+    if v.is_finite() {
+        v
+    } else {
+        stats.non_finite += 1;
+        0.0
+    }
+}
+
+/// Measure one meter with its own stream.
+pub fn measure(
+    world: &World,
+    kind: &MeterKind,
+    stream: u64,
+    settings: &MeasureSettings,
+    stats: &mut RayStats,
+) -> Estimate {
+    let (mut sum, mut sum2, mut n) = (0.0f64, 0.0f64, 0u64);
+    let min = settings.samples.max(2);
+    let max = settings.max_samples.max(min);
+    loop {
+        let target = match settings.target_relative_error {
+            None => min,
+            Some(_) if n < min => min,
+            Some(_) => (n + BATCH).min(max),
+        };
+        while n < target {
+            let v = sample_meter(world, kind, stream, n, stats);
+            sum += v;
+            sum2 += v * v;
+            n += 1;
+        }
+        let est = Estimate {
+            mean: sum / n as f64,
+            stderr: standard_error(sum, sum2, n),
+            samples: n,
+        };
+        match settings.target_relative_error {
+            Some(t) if n < max && est.relative_error() > t => continue,
+            _ => return est,
+        }
+    }
+}
+
+/// Results of all meters and grids of a world.
+#[derive(Clone, Debug, Default)]
+pub struct Measurements {
+    pub meters: Vec<Estimate>,
+    /// Per grid, row-major (j·nx + i).
+    pub grids: Vec<Vec<Estimate>>,
+    pub stats: RayStats,
+}
+
+/// Measure every meter and grid point in parallel (each with its own stream).
+pub fn measure_all(world: &World) -> Measurements {
+    let mut jobs: Vec<(MeterKind, u64)> = Vec::new();
+    for (k, m) in world.meters.iter().enumerate() {
+        jobs.push((m.kind.clone(), mix64(0x6d65_7465_7200 ^ k as u64)));
+    }
+    for (g, grid) in world.grids.iter().enumerate() {
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                jobs.push((
+                    MeterKind::Illuminance {
+                        position: grid.point(i, j),
+                        normal: grid.normal,
+                    },
+                    mix64(((g as u64) << 40) ^ ((j as u64) << 20) ^ i as u64 ^ 0x6772_6964),
+                ));
+            }
+        }
+    }
+    let results: Vec<(Estimate, RayStats)> = jobs
+        .par_iter()
+        .map(|(kind, stream)| {
+            let mut stats = RayStats::default();
+            let e = measure(world, kind, *stream, &world.measure, &mut stats);
+            (e, stats)
+        })
+        .collect();
+    let mut out = Measurements::default();
+    let mut it = results.into_iter();
+    for _ in &world.meters {
+        let (e, s) = it.next().expect("one result per job");
+        out.stats.merge(&s);
+        out.meters.push(e);
+    }
+    for grid in &world.grids {
+        let mut v = Vec::with_capacity((grid.nx * grid.ny) as usize);
+        for _ in 0..grid.nx * grid.ny {
+            let (e, s) = it.next().expect("one result per job");
+            out.stats.merge(&s);
+            v.push(e);
+        }
+        out.grids.push(v);
+    }
+    out
+}
+
+/// E_min, E_avg, E_max, U0 = E_min/E_avg and E_min/E_max of a grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridStats {
+    pub min: f64,
+    pub avg: f64,
+    pub max: f64,
+    pub u0: f64,
+    pub min_over_max: f64,
+}
+
+pub fn grid_stats(values: &[Estimate]) -> GridStats {
+    let n = values.len().max(1) as f64;
+    let min = values.iter().map(|e| e.mean).fold(f64::INFINITY, f64::min);
+    let max = values
+        .iter()
+        .map(|e| e.mean)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let avg = values.iter().map(|e| e.mean).sum::<f64>() / n;
+    let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
+    GridStats {
+        min,
+        avg,
+        max,
+        u0: ratio(min, avg),
+        min_over_max: ratio(min, max),
+    }
+}

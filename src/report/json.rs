@@ -1,0 +1,270 @@
+//! `NAME.report.json` and one CSV per calculation grid. The schema is documented in
+//! docs/reports.md; every value carries its unit in the `units` object.
+
+use crate::meter::{grid_stats, Estimate, Measurements, MeterKind};
+use crate::output::{write_atomic, OutputError};
+use crate::render::RenderResult;
+use crate::world::World;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+
+/// The unit system of reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Units {
+    /// lx and cd/m².
+    #[default]
+    Si,
+    /// footcandles and footlamberts.
+    Imperial,
+}
+
+impl Units {
+    pub fn illuminance_symbol(self) -> &'static str {
+        match self {
+            Units::Si => "lx",
+            Units::Imperial => "fc",
+        }
+    }
+    pub fn luminance_symbol(self) -> &'static str {
+        match self {
+            Units::Si => "cd/m^2",
+            Units::Imperial => "fL",
+        }
+    }
+    /// Factor from lx to this system's illuminance unit.
+    pub fn illuminance_factor(self) -> f64 {
+        match self {
+            Units::Si => 1.0,
+            Units::Imperial => crate::photometry::convert(1.0, "lx", "fc").expect("lx→fc"),
+        }
+    }
+    /// Factor from cd/m² to this system's luminance unit.
+    pub fn luminance_factor(self) -> f64 {
+        match self {
+            Units::Si => 1.0,
+            Units::Imperial => crate::photometry::convert(1.0, "cd/m2", "fL").expect("nit→fL"),
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Units::Si => "si",
+            Units::Imperial => "imperial",
+        }
+    }
+}
+
+fn v3(v: glam::Vec3) -> Value {
+    json!([v.x, v.y, v.z])
+}
+
+fn estimate(e: &Estimate, k: f64) -> Value {
+    json!({
+        "value": e.mean * k,
+        "stderr": e.stderr * k,
+        "ci95_low": (e.mean - e.ci95()) * k,
+        "ci95_high": (e.mean + e.ci95()) * k,
+        "samples": e.samples,
+    })
+}
+
+/// File-name-safe form of a grid name.
+pub fn slug(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
+        .collect();
+    let s = s.trim_matches('-').to_string();
+    if s.is_empty() {
+        "grid".into()
+    } else {
+        s
+    }
+}
+
+/// Path of the CSV of grid `name` next to the report whose outputs share `stem`.
+pub fn grid_csv_path(stem: &Path, name: &str) -> PathBuf {
+    let mut p = stem.as_os_str().to_owned();
+    p.push(format!(".grid-{}.csv", slug(name)));
+    p.into()
+}
+
+/// Everything a report says about one run.
+pub struct ReportInput<'a> {
+    pub scene_path: &'a Path,
+    pub world: &'a World,
+    pub render: &'a RenderResult,
+    pub measurements: &'a Measurements,
+    pub measure_seconds: f64,
+    pub units: Units,
+    /// Output files already written, for reference.
+    pub outputs: Vec<String>,
+}
+
+/// Min, mean and max of defined values.
+fn stats(values: impl Iterator<Item = f64>) -> Value {
+    let (mut min, mut max, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0u64);
+    for v in values {
+        min = min.min(v);
+        max = max.max(v);
+        sum += v;
+        n += 1;
+    }
+    if n == 0 {
+        return Value::Null;
+    }
+    json!({"min": min, "mean": sum / n as f64, "max": max, "pixels": n})
+}
+
+/// Build the JSON report.
+pub fn report_json(r: &ReportInput) -> Value {
+    let ke = r.units.illuminance_factor();
+    let kl = r.units.luminance_factor();
+    let w = r.world;
+    let film = &r.render.film;
+    let luminance = stats(film.pixels.iter().map(|p| p.mean_xyz()[1] * kl));
+    let illuminance = if w.settings.illuminance {
+        stats(
+            film.pixels
+                .iter()
+                .filter_map(|p| p.mean_e())
+                .map(|e| e * ke),
+        )
+    } else {
+        Value::Null
+    };
+    let meters: Vec<Value> = w
+        .meters
+        .iter()
+        .zip(&r.measurements.meters)
+        .map(|(m, e)| match &m.kind {
+            MeterKind::Illuminance { position, normal } => {
+                let mut v = estimate(e, ke);
+                v["name"] = json!(m.name);
+                v["kind"] = json!("illuminance");
+                v["unit"] = json!(r.units.illuminance_symbol());
+                v["position"] = v3(*position);
+                v["normal"] = v3(*normal);
+                v
+            }
+            MeterKind::Luminance {
+                position,
+                direction,
+                half_angle_rad,
+            } => {
+                let mut v = estimate(e, kl);
+                v["name"] = json!(m.name);
+                v["kind"] = json!("luminance");
+                v["unit"] = json!(r.units.luminance_symbol());
+                v["position"] = v3(*position);
+                v["direction"] = v3(*direction);
+                v["half_angle_deg"] = json!(half_angle_rad.to_degrees());
+                v
+            }
+        })
+        .collect();
+    let grids: Vec<Value> = w
+        .grids
+        .iter()
+        .zip(&r.measurements.grids)
+        .map(|(g, est)| {
+            let s = grid_stats(est);
+            let rows = |f: &dyn Fn(&Estimate) -> Value| -> Value {
+                (0..g.ny as usize)
+                    .map(|j| {
+                        (0..g.nx as usize)
+                            .map(|i| f(&est[j * g.nx as usize + i]))
+                            .collect::<Vec<_>>()
+                    })
+                    .collect::<Vec<_>>()
+                    .into()
+            };
+            json!({
+                "name": g.name,
+                "unit": r.units.illuminance_symbol(),
+                "nx": g.nx, "ny": g.ny,
+                "origin": v3(g.origin), "edge_u": v3(g.edge_u), "edge_v": v3(g.edge_v), "normal": v3(g.normal),
+                "values": rows(&|e| json!(e.mean * ke)),
+                "stderr": rows(&|e| json!(e.stderr * ke)),
+                "samples": rows(&|e| json!(e.samples)),
+                "E_min": s.min * ke, "E_avg": s.avg * ke, "E_max": s.max * ke,
+                "U0": s.u0, "E_min_over_E_max": s.min_over_max,
+            })
+        })
+        .collect();
+    let mut stats_all = r.render.stats;
+    stats_all.merge(&r.measurements.stats);
+    json!({
+        "software": "candela",
+        "version": env!("CARGO_PKG_VERSION"),
+        "created_utc": humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
+        "scene": r.scene_path.display().to_string(),
+        "units": {
+            "system": r.units.name(),
+            "luminance": r.units.luminance_symbol(),
+            "illuminance": r.units.illuminance_symbol(),
+            "length": "m",
+        },
+        "settings": {
+            "width": film.width, "height": film.height,
+            "spp": w.settings.spp, "max_depth": w.settings.max_depth, "rr_depth": w.settings.rr_depth,
+            "seed": w.settings.seed, "threads": r.render.threads, "illuminance": w.settings.illuminance,
+            "meter_samples": w.measure.samples,
+            "meter_target_relative_error": w.measure.target_relative_error,
+            "meter_max_samples": w.measure.max_samples,
+        },
+        "timing": {
+            "render_seconds": r.render.elapsed.as_secs_f64(),
+            "measure_seconds": r.measure_seconds,
+            "rays": stats_all.total_rays(),
+            "non_finite_samples": stats_all.non_finite,
+        },
+        "image": { "luminance": luminance, "illuminance": illuminance },
+        "meters": meters,
+        "grids": grids,
+        "outputs": r.outputs,
+    })
+}
+
+/// The CSV of one grid: one row per point.
+pub fn grid_csv(world: &World, grid: usize, est: &[Estimate], units: Units) -> String {
+    let g = &world.grids[grid];
+    let k = units.illuminance_factor();
+    let u = units.illuminance_symbol();
+    let mut s = format!(
+        "# candela {} grid {:?}: illuminance on the plane facing ({}, {}, {}); positions in m\ni,j,x,y,z,E_{u},stderr_{u},ci95_low_{u},ci95_high_{u},samples\n",
+        env!("CARGO_PKG_VERSION"),
+        g.name,
+        g.normal.x,
+        g.normal.y,
+        g.normal.z
+    );
+    for j in 0..g.ny {
+        for i in 0..g.nx {
+            let p = g.point(i, j);
+            let e = &est[(j * g.nx + i) as usize];
+            s.push_str(&format!(
+                "{i},{j},{},{},{},{},{},{},{},{}\n",
+                p.x,
+                p.y,
+                p.z,
+                e.mean * k,
+                e.stderr * k,
+                (e.mean - e.ci95()) * k,
+                (e.mean + e.ci95()) * k,
+                e.samples
+            ));
+        }
+    }
+    s
+}
+
+/// Write text atomically.
+pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
+    write_atomic(path, |w| w.write_all(text.as_bytes()))
+}

@@ -1,0 +1,270 @@
+//! Illuminance (per pixel and from meters and grids) against closed forms
+//! (../shared/reference/closed-forms.md §2.2–2.6), with tolerances from the estimated
+//! standard errors.
+
+mod common;
+use candela::meter::{grid_stats, measure_all};
+use common::*;
+use glam::Vec3;
+use std::f64::consts::PI;
+
+const I_CD: f64 = 250.0;
+const H: f64 = 2.0;
+
+fn point_over_plane(rho: f64, extra: &str) -> candela::world::World {
+    world(&format!(
+        r#"(
+        camera: (position: (0.3, 3.0, -1.0), look_at: (0.5, 0.0, 0.5), vfov_deg: 40, resolution: (12, 12)),
+        render: (spp: 64, illuminance: true),
+        materials: {{ "plane": Diffuse(reflectance: Constant({rho})) }},
+        objects: [(shape: Quad(origin: (-50, 0, -50), edge_u: (0, 0, 100), edge_v: (100, 0, 0)), material: "plane")],
+        lights: [Point(position: (0, {H}, 0), spectrum: Named("D65"), amount: Intensity({I_CD}))],
+        {extra}
+    )"#
+    ))
+}
+
+/// E = I cos θ / d² at a point of the plane y = 0 (or of a receiver at height y facing up).
+fn e_point(p: Vec3) -> f64 {
+    let d = Vec3::new(0.0, H as f32, 0.0) - p;
+    let d2 = d.length_squared() as f64;
+    I_CD * (d.y as f64 / d2.sqrt()) / d2
+}
+
+/// The filter-weighted mean of E over a pixel's footprint on the plane (box filter: the
+/// pixel square), by a 16×16 midpoint quadrature.
+fn e_pixel(w: &candela::world::World, x: usize, y: usize) -> f64 {
+    let n = 16;
+    let mut sum = 0.0;
+    for j in 0..n {
+        for i in 0..n {
+            let r = w.camera.generate_ray(
+                x as f32 + (i as f32 + 0.5) / n as f32,
+                y as f32 + (j as f32 + 0.5) / n as f32,
+                glam::Vec2::ZERO,
+            );
+            let t = -r.origin.y / r.dir.y;
+            sum += e_point(r.origin + r.dir * t);
+        }
+    }
+    sum / (n * n) as f64
+}
+
+#[test]
+fn point_light_illuminance_channel_whatever_the_reflectance() {
+    for rho in [0.0, 0.5, 0.95] {
+        let w = point_over_plane(rho, "");
+        let film = render(&w, 2);
+        for y in 0..film.height {
+            for x in 0..film.width {
+                let p = &film.pixels[y * film.width + x];
+                let e = p.mean_e().expect("every pixel sees the plane");
+                let se = p.e_standard_error();
+                let expected = e_pixel(&w, x, y);
+                assert!(
+                    (e - expected).abs() <= 5.0 * se && se < 0.05 * expected,
+                    "ρ = {rho}, pixel ({x}, {y}): E = {e} ± {se}, expected {expected}"
+                );
+                assert_eq!(p.e_coverage(), 1.0);
+            }
+        }
+    }
+}
+
+#[test]
+fn luminance_is_rho_e_over_pi_of_the_illuminance_channel() {
+    let rho = 0.5;
+    let film = render(&point_over_plane(rho, ""), 2);
+    for (i, p) in film.pixels.iter().enumerate() {
+        let l = p.mean_xyz()[1];
+        let e = p.mean_e().unwrap();
+        let se = (p.y_standard_error().powi(2) + (rho / PI * p.e_standard_error()).powi(2)).sqrt();
+        assert!(
+            (l - rho * e / PI).abs() <= 5.0 * se,
+            "pixel {i}: L = {l}, ρE/π = {} (± {se})",
+            rho * e / PI
+        );
+    }
+}
+
+#[test]
+fn point_light_grid_of_meters() {
+    let w = point_over_plane(
+        0.7,
+        r#"grids: [(name: "g", origin: (-1.5, 0.01, -1.0), edge_u: (3.0, 0, 0), edge_v: (0, 0, 2.5), nx: 4, ny: 3)],
+           meters: [Illuminance(name: "tilted", position: (1.0, 0.5, 0.0), normal: (-0.6, 0.8, 0.0))],
+           measure: (samples: 256),"#,
+    );
+    let m = measure_all(&w);
+    let g = &w.grids[0];
+    for j in 0..g.ny {
+        for i in 0..g.nx {
+            let p = g.point(i, j);
+            let e = m.grids[0][(j * g.nx + i) as usize];
+            let expected = e_point(p);
+            assert!(
+                (e.mean - expected).abs() <= 5.0 * e.stderr.max(1e-9 * expected),
+                "grid point ({i}, {j}) at {p}: E = {} ± {}, expected {expected}",
+                e.mean,
+                e.stderr
+            );
+        }
+    }
+    // A tilted receiver: E = I cos θᵢ / d² with θᵢ between its normal and the light.
+    let p = Vec3::new(1.0, 0.5, 0.0);
+    let to_light = Vec3::new(0.0, H as f32, 0.0) - p;
+    let d2 = to_light.length_squared() as f64;
+    let cos_i = to_light.normalize().dot(Vec3::new(-0.6, 0.8, 0.0)) as f64;
+    let expected = I_CD * cos_i / d2;
+    let e = m.meters[0];
+    assert!(
+        (e.mean - expected).abs() <= 5.0 * e.stderr.max(1e-9 * expected),
+        "tilted meter: {} ± {}, expected {expected}",
+        e.mean,
+        e.stderr
+    );
+    let s = grid_stats(&m.grids[0]);
+    let values: Vec<f64> = m.grids[0].iter().map(|e| e.mean).collect();
+    assert_eq!(s.min, values.iter().cloned().fold(f64::INFINITY, f64::min));
+    assert_eq!(
+        s.max,
+        values.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+    );
+    assert!((s.avg - values.iter().sum::<f64>() / values.len() as f64).abs() < 1e-12 * s.avg);
+    assert!((s.u0 - s.min / s.avg).abs() < 1e-15);
+}
+
+fn meter_under(emitter: &str, position: [f64; 3], samples: u64) -> candela::meter::Estimate {
+    let w = world(&format!(
+        r#"(
+        camera: (position: (0, -5, 0), look_at: (0, 0, 0), up: (0, 0, 1), vfov_deg: 10, resolution: (1, 1)),
+        render: (spp: 1, max_depth: 4),
+        objects: [{emitter}],
+        meters: [Illuminance(name: "m", position: ({}, {}, {}), normal: (0, 1, 0))],
+        measure: (samples: {samples}),
+    )"#,
+        position[0], position[1], position[2]
+    ));
+    measure_all(&w).meters[0]
+}
+
+#[test]
+fn lambertian_disc_on_axis() {
+    // R = 0.5, h = 2, L = 1000 cd/m²: E = π L sin²α = 184.7996 lx.
+    let e = meter_under(
+        r#"(shape: Disk(center: (0, 2, 0), normal: (0, -1, 0), radius: 0.5), material: "black",
+            emission: (spectrum: Named("A"), amount: Luminance(1000.0)))"#,
+        [0.0, 0.0, 0.0],
+        8192,
+    );
+    assert!(
+        (e.mean - 184.7996).abs() <= 5.0 * e.stderr && e.stderr < 0.01 * 184.8,
+        "E = {} ± {}",
+        e.mean,
+        e.stderr
+    );
+}
+
+#[test]
+fn rectangle_source_below_a_corner() {
+    // Parallel rectangle a = 1, b = 2 at h = 3 above the receiver under one corner:
+    // F = 0.0522678, E = π L F.
+    let l = 2000.0;
+    let e = meter_under(
+        r#"(shape: Quad(origin: (0, 3, 0), edge_u: (1, 0, 0), edge_v: (0, 0, 2)), material: "black",
+            emission: (spectrum: Named("D65"), amount: Luminance(2000.0)))"#,
+        [0.0, 0.0, 0.0],
+        8192,
+    );
+    let expected = PI * l * 0.0522678;
+    assert!(
+        (e.mean - expected).abs() <= 5.0 * e.stderr && e.stderr < 0.01 * expected,
+        "E = {} ± {}, expected {expected}",
+        e.mean,
+        e.stderr
+    );
+}
+
+#[test]
+fn integrating_sphere_interreflection() {
+    // Isotropic Φ = 1000 lm at the centre of a closed sphere R = 1, ρ = 0.6:
+    // E = Φ / (A (1 − ρ)) on the wall, everywhere.
+    let (phi, r, rho) = (1000.0, 1.0, 0.6);
+    let expected = phi / (4.0 * PI * r * r * (1.0 - rho));
+    let w = world(&format!(
+        r#"(
+        camera: (position: (0.2, 0.1, -0.3), look_at: (0, 0, 1), vfov_deg: 100, resolution: (8, 8)),
+        render: (spp: 128, max_depth: 64, illuminance: true),
+        materials: {{ "wall": Diffuse(reflectance: Constant({rho})) }},
+        objects: [(shape: Sphere(center: (0, 0, 0), radius: {r}), material: "wall")],
+        lights: [Point(position: (0, 0, 0), spectrum: Named("FL2"), amount: Flux({phi}))],
+        meters: [Illuminance(name: "wall", position: (0, -0.99999, 0), normal: (0, 1, 0))],
+        measure: (samples: 8192),
+    )"#
+    ));
+    let film = render(&w, 2);
+    for (i, p) in film.pixels.iter().enumerate() {
+        let e = p.mean_e().unwrap();
+        let se = p.e_standard_error();
+        assert!(
+            (e - expected).abs() <= 5.0 * se,
+            "pixel {i}: E = {e} ± {se}, expected {expected}"
+        );
+        // The wall's luminance: L = ρ E / π.
+        let l = p.mean_xyz()[1];
+        let lse = p.y_standard_error();
+        assert!(
+            (l - rho * expected / PI).abs() <= 5.0 * lse,
+            "pixel {i}: L = {l} ± {lse}, expected {}",
+            rho * expected / PI
+        );
+    }
+    let m = measure_all(&w).meters[0];
+    assert!(
+        (m.mean - expected).abs() <= 5.0 * m.stderr && m.stderr < 0.02 * expected,
+        "meter: {} ± {}, expected {expected}",
+        m.mean,
+        m.stderr
+    );
+}
+
+#[test]
+fn target_error_stops_when_reached() {
+    let w = world(
+        r#"(
+        camera: (position: (0, -5, 0), look_at: (0, 0, 0), up: (0, 0, 1), vfov_deg: 10, resolution: (1, 1)),
+        render: (spp: 1),
+        objects: [(shape: Disk(center: (0, 2, 0), normal: (0, -1, 0), radius: 0.5), material: "black",
+                   emission: (spectrum: Named("D65"), amount: Luminance(1000.0)))],
+        meters: [Illuminance(name: "m", position: (0, 0, 0), normal: (0, 1, 0))],
+        measure: (samples: 256, target_relative_error: 0.002, max_samples: 1000000),
+    )"#,
+    );
+    let e = measure_all(&w).meters[0];
+    assert!(e.relative_error() <= 0.002, "{e:?}");
+    assert!(e.samples > 256 && e.samples < 1_000_000, "{e:?}");
+    assert!((e.mean - 184.7996).abs() <= 5.0 * e.stderr, "{e:?}");
+}
+
+#[test]
+fn pixels_seeing_the_sky_or_an_emitter_have_no_illuminance() {
+    let w = world(
+        r#"(
+        camera: (position: (0, 1, -3), look_at: (0, 1, 0), vfov_deg: 60, resolution: (8, 8)),
+        render: (spp: 4, illuminance: true),
+        objects: [(shape: Quad(origin: (-1, 0, 0), edge_u: (0, 2, 0), edge_v: (2, 0, 0)), material: "black",
+                   emission: (spectrum: Named("D65"), amount: Luminance(10.0)))],
+        lights: [Environment(spectrum: Named("D65"), amount: Luminance(1.0))],
+    )"#,
+    );
+    let film = render(&w, 2);
+    assert!(film
+        .pixels
+        .iter()
+        .all(|p| p.mean_e().is_none() && p.e_coverage() == 0.0));
+    let (e, se, mask) = film.illuminance_images();
+    assert!(e
+        .iter()
+        .all(|&v| v == candela::output::ILLUMINANCE_SENTINEL));
+    assert!(se.iter().all(|&v| v == 0.0) && mask.iter().all(|&v| v == 0.0));
+}
