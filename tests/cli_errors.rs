@@ -57,13 +57,10 @@ fn expect_error(text: &str, extra: &[(&str, &[u8])], needles: &[&str]) {
 }
 
 #[test]
-fn good_scene_renders_both_outputs() {
+fn good_scene_renders_all_outputs() {
     let (code, stderr, files) = run(GOOD, &[]);
     assert_eq!(code, 0, "{stderr}");
-    assert_eq!(
-        files,
-        vec!["scene.exr".to_string(), "scene.png".to_string()]
-    );
+    assert_eq!(files, vec!["scene.exr", "scene.png", "scene.report.json"]);
 }
 
 #[test]
