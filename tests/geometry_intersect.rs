@@ -556,3 +556,11 @@ fn pathological_scene_is_an_error_not_a_crash() {
         Err(e) => assert!(e.to_string().contains("degenerate"), "{e}"),
     }
 }
+
+#[test]
+fn scene_geometry_is_send_and_sync() {
+    fn check<T: Send + Sync>() {}
+    check::<SceneGeometry>();
+    check::<candela::geometry::Hit>();
+    check::<candela::geometry::GeometryError>();
+}
