@@ -267,6 +267,7 @@ fn bvh_vs_brute(scale: f32, offset: Vec3, seed: u64) {
     let shapes = random_scene(&mut rng, scale, offset);
     let g = SceneGeometry::build(&shapes).unwrap();
     let mut hits = 0;
+    let mut tri_hits = 0;
     for i in 0..6000 {
         let o = rng.in_box(Vec3::splat(-1.5), Vec3::splat(1.5)) * scale + offset;
         let mut d = rng.unit_vector();
@@ -277,17 +278,26 @@ fn bvh_vs_brute(scale: f32, offset: Vec3, seed: u64) {
             2 => d = Vec3::new(1e-9, d.y, d.z).normalize(),
             _ => {}
         }
-        let t_max = if i % 3 == 0 {
+        let mut t_max = if i % 3 == 0 {
             f32::INFINITY
         } else {
             rng.range(0.0, 2.0) * scale
         };
+        // Unnormalised directions (|d| from 1e-3·scale to 1e3·scale): t is parametric.
+        if i % 4 == 3 {
+            let len = scale * 10f32.powf(rng.range(-3.0, 3.0));
+            d *= len;
+            t_max /= len;
+        }
         let a = g.intersect(o, d, t_max);
         let b = g.intersect_brute_force(o, d, t_max);
         match (a, b) {
             (None, None) => {}
             (Some(a), Some(b)) => {
                 hits += 1;
+                if a.object == 0 {
+                    tri_hits += 1;
+                }
                 assert_eq!(a.t, b.t, "ray {i}: BVH t {} vs brute force {}", a.t, b.t);
                 if a.prim != b.prim {
                     // Only a genuine tie may pick a different primitive.
@@ -304,6 +314,7 @@ fn bvh_vs_brute(scale: f32, offset: Vec3, seed: u64) {
         );
     }
     assert!(hits > 1000, "too few hits ({hits}) to be a meaningful test");
+    assert!(tri_hits > 500, "too few triangle hits ({tri_hits})");
 }
 
 #[test]
@@ -544,4 +555,12 @@ fn pathological_scene_is_an_error_not_a_crash() {
         }
         Err(e) => assert!(e.to_string().contains("degenerate"), "{e}"),
     }
+}
+
+#[test]
+fn scene_geometry_is_send_and_sync() {
+    fn check<T: Send + Sync>() {}
+    check::<SceneGeometry>();
+    check::<candela::geometry::Hit>();
+    check::<candela::geometry::GeometryError>();
 }

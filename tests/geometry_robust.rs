@@ -1,5 +1,5 @@
 //! Self-intersection: rays spawned with `offset_ray_origin` never re-hit their own surface,
-//! at scales 1e-3 m, 1 m and 1e3 m (and far from the world origin).
+//! at scales 1e-6 m, 1e-3 m, 1 m, 1e3 m and 1e6 m (and far from the world origin).
 
 use candela::geometry::generate::{grid_mesh, Rng};
 use candela::geometry::{
@@ -8,7 +8,7 @@ use candela::geometry::{
 };
 use glam::Vec3;
 
-const SCALES: [f32; 3] = [1e-3, 1.0, 1e3];
+const SCALES: [f32; 5] = [1e-6, 1e-3, 1.0, 1e3, 1e6];
 const RAYS: usize = 20_000;
 
 /// Direction in the hemisphere around `n` (cosine to n at least `min_cos`).
@@ -27,7 +27,10 @@ fn dir_around(rng: &mut Rng, n: Vec3, min_cos: f32) -> Vec3 {
 /// Hits on the geometry from random rays aimed at it from outside `radius` around `center`.
 fn surface_hits(g: &SceneGeometry, rng: &mut Rng, center: Vec3, radius: f32, n: usize) -> Vec<Hit> {
     let mut hits = Vec::new();
+    let mut tries = 0;
     while hits.len() < n {
+        tries += 1;
+        assert!(tries < 20 * n, "rays aimed at the object keep missing it");
         let o = center + rng.unit_vector() * radius * 3.0;
         let target = center + rng.unit_vector() * radius * rng.f32();
         if let Some(h) = g.intersect(o, target - o, f32::INFINITY) {

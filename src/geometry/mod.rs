@@ -12,6 +12,26 @@
 //! * Every primitive has a *front face*: quads `edge_u × edge_v`, disks `normal`, spheres
 //!   outward, triangles counter-clockwise `(v1−v0)×(v2−v0)`. [`Hit::ng`] is always the front-face
 //!   normal, never flipped toward the ray; [`Hit::front_face`] tells which side was hit.
+//! * Primitive ids ([`Hit::prim`], [`SceneGeometry::primitives_of_object`]) are indices into the
+//!   BVH's leaf-ordered primitive array; they are stable for the lifetime of a
+//!   [`SceneGeometry`] but not across rebuilds.
+//!
+//! Typical integrator usage:
+//!
+//! ```ignore
+//! let geo = SceneGeometry::build(&shapes)?;            // shapes: Vec<(Shape, object_id)>
+//! let hit = geo.intersect(cam_o, cam_d, f32::INFINITY)?;
+//! // Next bounce: offset the origin to the side of the new direction (no acne at any scale).
+//! let o = hit.spawn_origin(wi);                         // = offset_ray_origin(hit.p, hit.error, hit.ng, wi)
+//! let next = geo.intersect(o, wi, f32::INFINITY);
+//! // Next-event estimation on an emitting primitive `lp` of an area light:
+//! if let Some((ls, pdf_w)) = geo.sample_prim_solid_angle(lp, hit.p, u) {
+//!     let (so, sd, st) = shadow_ray(&hit, ls.p, ls.n);  // both ends offset
+//!     if !geo.occluded(so, sd, st) { /* add Le · f · |cos| / pdf_w */ }
+//! }
+//! // MIS weight for a BSDF-sampled ray that hit the light primitive `lp` at `lh`:
+//! let pdf_light = geo.pdf_prim_solid_angle(lp, hit.p, &lh); // same `reference` as when sampling
+//! ```
 
 mod io;
 mod prim;
@@ -23,7 +43,7 @@ pub mod generate;
 pub use io::{load_obj, load_ply};
 pub use robust::{
     gamma, next_float_down, next_float_up, offset_ray_origin, point_error_bound, shadow_ray,
-    shadow_ray_between,
+    shadow_ray_between, MACHINE_EPSILON, SHADOW_EPSILON,
 };
 pub use scene::SceneGeometry;
 
@@ -191,7 +211,7 @@ pub enum Shape {
         center: Vec3,
         radius: f32,
     },
-    /// Parallelogram origin + s·edge_u + t·edge_v, s,t∈[0,1]; front-face normal = normalize(edge_u × edge_v).
+    /// Parallelogram origin + s·edge_u + t·edge_v, s,t ∈ \[0,1\]; front-face normal = normalize(edge_u × edge_v).
     Quad {
         origin: Vec3,
         edge_u: Vec3,

@@ -114,6 +114,9 @@ pub(crate) fn intersect_triangle<const KZ: usize>(
     if det == 0.0 {
         return None;
     }
+    // Largest |z| before scaling by 1/d_z, in spatial units (pbrt uses the scaled z in δx/δy,
+    // which mixes units and rejects valid hits for short, unnormalised directions).
+    let max_zs = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
     p0t.z *= r.sz;
     p1t.z *= r.sz;
     p2t.z *= r.sz;
@@ -129,13 +132,14 @@ pub(crate) fn intersect_triangle<const KZ: usize>(
     if t >= t_max || t.is_nan() {
         return None;
     }
-    // Conservative check that t is positive despite rounding (pbrt-v4 §6.8.7).
+    // Conservative check that t is positive despite rounding (pbrt-v4 §6.8.7; δx, δy in
+    // spatial units, δz and t in ray-parameter units).
     let max_zt = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
     let delta_z = gamma(3) * max_zt;
     let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
     let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_x = gamma(5) * (max_xt + max_zs);
+    let delta_y = gamma(5) * (max_yt + max_zs);
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = e0.abs().max(e1.abs()).max(e2.abs());
     let delta_t =
