@@ -64,7 +64,7 @@ pub fn radiance_to_xyz(l: &SampledSpectrum, wl: &SampledWavelengths) -> [f64; 3]
 }
 
 /// Running sums for one pixel.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PixelSums {
     pub sum_xyz: [f64; 3],
     /// Σ Y², for the sample variance of luminance.
@@ -148,11 +148,17 @@ pub fn standard_error(sum: f64, sum2: f64, n: u64) -> f64 {
 }
 
 /// The whole image's sums.
-#[derive(Clone, Debug)]
+///
+/// In adaptive mode (a target error), each pixel takes its samples in pairs: one for `pixels`
+/// (the image), one from an independent random stream for `decision`, whose statistics alone
+/// decide whether the pixel needs more samples. The number of image samples is then a stopping
+/// time independent of the image samples themselves, so the image stays unbiased.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Film {
     pub width: usize,
     pub height: usize,
     pub pixels: Vec<PixelSums>,
+    pub decision: Option<Vec<PixelSums>>,
 }
 
 impl Film {
@@ -161,6 +167,29 @@ impl Film {
             width,
             height,
             pixels: vec![PixelSums::default(); width * height],
+            decision: None,
+        }
+    }
+    pub fn new_adaptive(width: usize, height: usize) -> Self {
+        Self {
+            decision: Some(vec![PixelSums::default(); width * height]),
+            ..Self::new(width, height)
+        }
+    }
+    /// Samples taken so far for pixel `i` (image and decision buffers), i.e. the index of its
+    /// next sample.
+    pub fn samples_taken(&self, i: usize) -> u64 {
+        self.pixels[i].count + self.decision.as_ref().map_or(0, |d| d[i].count)
+    }
+    /// Combine another film of the same size (independent samples: a different seed).
+    pub fn merge(&mut self, o: &Film) {
+        for (a, b) in self.pixels.iter_mut().zip(&o.pixels) {
+            a.merge(b);
+        }
+        if let (Some(a), Some(b)) = (self.decision.as_mut(), o.decision.as_ref()) {
+            for (x, y) in a.iter_mut().zip(b) {
+                x.merge(y);
+            }
         }
     }
     /// Mean XYZ per pixel as f32 (row-major).

@@ -23,4 +23,5 @@ pub mod report;
 pub mod sampler;
 pub mod scene;
 pub mod spectrum;
+pub mod state;
 pub mod world;

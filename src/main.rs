@@ -3,13 +3,13 @@
 use anyhow::{bail, Context, Result};
 use candela::colour::tables::Observer;
 use candela::output::{self, Layers, PngSettings};
-use candela::render::{render, RenderResult};
 use candela::report::json::{grid_csv, grid_csv_path, report_json, write_text, ReportInput, Units};
 use candela::scene::{self, Overrides};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 #[derive(Parser)]
 #[command(
@@ -52,9 +52,45 @@ enum Command {
         /// Units of the report: si (lx, cd/m²) or imperial (fc, fL).
         #[arg(long, default_value = "si", value_parser = ["si", "imperial"])]
         units: String,
+        /// Render until every pixel's luminance (and illuminance, with --illuminance) is known to this relative error at 95 % confidence, e.g. `1%` or `0.01`; samples go where the error is still large.
+        #[arg(long, value_parser = parse_fraction)]
+        target_error: Option<f64>,
+        /// With --target-error: fraction of the eligible pixels that must meet it (default 1).
+        #[arg(long, default_value_t = 1.0)]
+        target_fraction: f64,
+        /// With --target-error: pixels darker than this luminance (cd/m²) need not meet it (default: 0.1 % of the image's mean luminance).
+        #[arg(long)]
+        target_floor: Option<f64>,
+        /// Upper bound of samples per pixel (default: the scene's spp, or 65536 with --target-error).
+        #[arg(long)]
+        max_spp: Option<u32>,
+        /// Stop after this long (e.g. `90s`, `10m`, `2h`), at the end of the pass in progress.
+        #[arg(long, value_parser = humantime::parse_duration)]
+        max_time: Option<std::time::Duration>,
+        /// Write a checkpoint (NAME.state and NAME.exr) this often (e.g. `60s`; `0s` disables).
+        #[arg(long, value_parser = humantime::parse_duration, default_value = "60s")]
+        checkpoint_interval: std::time::Duration,
+        /// Continue from NAME.state (refused if the scene or its settings changed).
+        #[arg(long)]
+        resume: bool,
+        /// Also write NAME.state at the end (for --resume to more samples, or `candela merge`).
+        #[arg(long)]
+        save_state: bool,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+    },
+    /// Combine independent renders of the same scene (different seeds) from their state files into one estimate.
+    Merge {
+        /// State files written with --save-state (or checkpoints).
+        #[arg(required = true, num_args = 2..)]
+        states: Vec<PathBuf>,
+        /// Output name: writes OUT.exr, OUT.png and OUT.state.
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Exposure of the PNG in EV (default: automatic).
+        #[arg(long, allow_hyphen_values = true)]
+        exposure: Option<f64>,
     },
     /// Colorimetry of a spectrum: XYZ, xy, u′v′, CCT, Duv, efficacy, S/P, sRGB, CRI.
     Spectrum {
@@ -101,25 +137,46 @@ fn main() -> ExitCode {
             exposure,
             illuminance,
             units,
+            target_error,
+            target_fraction,
+            target_floor,
+            max_spp,
+            max_time,
+            checkpoint_interval,
+            resume,
+            save_state,
             quiet,
-        } => cmd_render(
-            &scene,
-            Overrides {
+        } => cmd_render(RenderArgs {
+            scene_path: &scene,
+            overrides: Overrides {
                 spp,
                 seed,
                 max_depth,
                 illuminance,
             },
-            out.as_deref(),
+            out: out.as_deref(),
             threads,
             exposure,
-            if units == "imperial" {
+            units: if units == "imperial" {
                 Units::Imperial
             } else {
                 Units::Si
             },
+            target_error,
+            target_fraction,
+            target_floor,
+            max_spp,
+            max_time,
+            checkpoint_interval,
+            resume,
+            save_state,
             quiet,
-        ),
+        }),
+        Command::Merge {
+            states,
+            out,
+            exposure,
+        } => cmd_merge(&states, &out, exposure),
         Command::Spectrum {
             source,
             observer,
@@ -171,15 +228,61 @@ fn output_paths(scene: &Path, out: Option<&Path>) -> (PathBuf, PathBuf, PathBuf)
     (stem, exr.into(), png.into())
 }
 
-fn cmd_render(
-    scene_path: &Path,
+struct RenderArgs<'a> {
+    scene_path: &'a Path,
     overrides: Overrides,
-    out: Option<&Path>,
+    out: Option<&'a Path>,
     threads: Option<usize>,
     exposure: Option<f64>,
     units: Units,
+    target_error: Option<f64>,
+    target_fraction: f64,
+    target_floor: Option<f64>,
+    max_spp: Option<u32>,
+    max_time: Option<std::time::Duration>,
+    checkpoint_interval: std::time::Duration,
+    resume: bool,
+    save_state: bool,
     quiet: bool,
-) -> Result<()> {
+}
+
+/// `1%`, `0.5 %` or `0.01` → 0.01.
+fn parse_fraction(s: &str) -> Result<f64, String> {
+    let t = s.trim();
+    let (num, scale) = match t.strip_suffix('%') {
+        Some(n) => (n.trim(), 0.01),
+        None => (t, 1.0),
+    };
+    let v: f64 = num
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number or a percentage"))?;
+    let v = v * scale;
+    if v.is_finite() && v > 0.0 && v < 1.0 {
+        Ok(v)
+    } else {
+        Err(format!("{s:?} must lie strictly between 0 and 100 %"))
+    }
+}
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+fn with_suffix(stem: &Path, suffix: &str) -> PathBuf {
+    let mut p = stem.as_os_str().to_owned();
+    p.push(suffix);
+    PathBuf::from(p)
+}
+
+fn cmd_render(a: RenderArgs) -> Result<()> {
+    let RenderArgs {
+        scene_path,
+        overrides,
+        out,
+        threads,
+        exposure,
+        units,
+        quiet,
+        ..
+    } = a;
     if let Some(0) = threads {
         bail!("--threads must be at least 1");
     }
@@ -188,35 +291,156 @@ fn cmd_render(
             bail!("--exposure must be a finite number of EV, got {ev}");
         }
     }
+    if !(a.target_fraction > 0.0 && a.target_fraction <= 1.0) {
+        bail!(
+            "--target-fraction must lie in (0, 1], got {}",
+            a.target_fraction
+        );
+    }
+    if let Some(f) = a.target_floor {
+        if !(f.is_finite() && f >= 0.0) {
+            bail!("--target-floor must be a luminance ≥ 0 in cd/m², got {f}");
+        }
+    }
+    if a.max_spp == Some(0) {
+        bail!("--max-spp must be at least 1");
+    }
     let world = scene::load_world(scene_path, &overrides)?;
+    let scene_bytes = std::fs::read(scene_path)
+        .with_context(|| format!("cannot read scene file {}", scene_path.display()))?;
+    let hash = candela::state::scene_hash(&scene_bytes, &world);
     let (stem, exr_path, png_path) = output_paths(scene_path, out);
     if let Some(dir) = exr_path.parent() {
         if !dir.as_os_str().is_empty() && !dir.is_dir() {
             bail!("output directory {} does not exist", dir.display());
         }
     }
-    let (w, h, spp) = (world.camera.width, world.camera.height, world.settings.spp);
+    let state_path = with_suffix(&stem, ".state");
+    let (w, h) = (world.camera.width, world.camera.height);
+    let target = a.target_error.map(|relative| candela::render::TargetError {
+        relative,
+        fraction: a.target_fraction,
+        floor_cd_m2: a.target_floor,
+    });
+    let prog = candela::render::Progressive {
+        max_spp: a.max_spp.or(overrides.spp).unwrap_or(if target.is_some() {
+            65536
+        } else {
+            world.settings.spp
+        }),
+        target,
+        max_time: a.max_time,
+        checkpoint_interval: (!a.checkpoint_interval.is_zero()).then_some(a.checkpoint_interval),
+    };
+    let mut film = if a.resume {
+        let st = candela::state::RenderState::load(&state_path)?;
+        if st.scene_hash != hash || st.seed != world.settings.seed {
+            bail!(
+                "cannot resume from {}: the scene file {} or its settings (seed, max depth, resolution, illuminance) changed since the state was written",
+                state_path.display(),
+                scene_path.display()
+            );
+        }
+        if st.film.decision.is_some() != target.is_some() {
+            bail!(
+                "cannot resume from {}: it was {} a --target-error; resume it the same way",
+                state_path.display(),
+                if st.film.decision.is_some() {
+                    "rendered with"
+                } else {
+                    "rendered without"
+                }
+            );
+        }
+        st.film
+    } else if target.is_some() {
+        candela::film::Film::new_adaptive(w, h)
+    } else {
+        candela::film::Film::new(w, h)
+    };
+    ctrlc::set_handler(|| {
+        if STOP.swap(true, Ordering::SeqCst) {
+            eprintln!("\ninterrupted twice: exiting without a checkpoint");
+            std::process::exit(130);
+        }
+        eprintln!(
+            "\ninterrupted: finishing with a checkpoint (press Ctrl-C again to quit at once)"
+        );
+    })
+    .context("installing the Ctrl-C handler")?;
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
-        let b = ProgressBar::new(0);
+        let b = ProgressBar::new(prog.max_spp as u64 * (w * h) as u64);
         b.set_style(
             ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta}",
+                "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta} {msg}",
             )
             .expect("valid template"),
         );
         b
     };
-    let result = render(&world, threads, &|done, total| {
-        bar.set_length(total);
-        bar.set_position(done);
-    })?;
+    let mut last = candela::render::PassStatus::default();
+    let write_checkpoint = |film: &candela::film::Film| -> Result<()> {
+        candela::state::RenderState::new(scene_path, hash, &world, film.clone())
+            .save(&state_path)?;
+        write_exr(scene_path, &world, film, &exr_path)?;
+        Ok(())
+    };
+    let (result, reason) = candela::render::render_progressive(
+        &world,
+        &mut film,
+        threads,
+        &prog,
+        &STOP,
+        &mut |s| {
+            last = *s;
+            bar.set_position(s.samples);
+            if let Some(f) = s.converged_fraction {
+                bar.set_message(format!("{:.1} % of pixels at target", 100.0 * f));
+            }
+        },
+        &mut |f| write_checkpoint(f),
+    )?;
     bar.finish_and_clear();
+    if reason == candela::render::StopReason::Interrupted {
+        write_checkpoint(&result.film)?;
+        eprintln!(
+            "interrupted after {:.1} s: wrote {} and {}; continue with --resume",
+            result.elapsed.as_secs_f64(),
+            exr_path.display(),
+            state_path.display()
+        );
+        std::process::exit(130);
+    }
+    if a.save_state || a.resume || state_path.exists() {
+        candela::state::RenderState::new(scene_path, hash, &world, result.film.clone())
+            .save(&state_path)?;
+    }
+    match (reason, &target) {
+        (candela::render::StopReason::TargetReached, Some(t)) => println!(
+            "target reached: {:.1} % of eligible pixels have a 95 % interval within ±{} % ",
+            100.0 * last.converged_fraction.unwrap_or(1.0),
+            100.0 * t.relative
+        ),
+        (_, Some(t)) => println!(
+            "target not reached ({:?}): {:.1} % of eligible pixels within ±{} % (goal {:.1} %)",
+            reason,
+            100.0 * last.converged_fraction.unwrap_or(0.0),
+            100.0 * t.relative,
+            100.0 * t.fraction
+        ),
+        (candela::render::StopReason::MaxTime, None) => {
+            println!("stopped at --max-time before every pixel had its samples")
+        }
+        _ => {}
+    }
+    let spp = result.film.total_samples() as f64 / (w * h) as f64;
     let t_measure = std::time::Instant::now();
     let measurements = candela::meter::measure_all(&world);
     let measure_seconds = t_measure.elapsed().as_secs_f64();
-    write_outputs(scene_path, &world, &result, &exr_path, &png_path, exposure)?;
+    write_exr(scene_path, &world, &result.film, &exr_path)?;
+    write_png(&result.film, &png_path, exposure)?;
     let mut outputs = vec![
         exr_path.display().to_string(),
         png_path.display().to_string(),
@@ -280,7 +504,7 @@ fn cmd_render(
         .sum::<f64>()
         / (w * h) as f64;
     println!(
-        "rendered {w}×{h} at {spp} spp in {:.2} s on {} threads: {:.3} M samples/s, {:.3} M rays/s; mean luminance {:.4} cd/m²; wrote {} and {}",
+        "rendered {w}×{h} at {spp:.1} spp (image samples) in {:.2} s on {} threads: {:.3} M samples/s, {:.3} M rays/s; mean luminance {:.4} cd/m²; wrote {} and {}",
         result.elapsed.as_secs_f64(),
         result.threads,
         result.samples_per_second() / 1e6,
@@ -298,15 +522,12 @@ fn cmd_render(
     Ok(())
 }
 
-fn write_outputs(
+fn write_exr(
     scene_path: &Path,
     world: &candela::world::World,
-    result: &RenderResult,
+    film: &candela::film::Film,
     exr_path: &Path,
-    png_path: &Path,
-    exposure: Option<f64>,
 ) -> Result<()> {
-    let film = &result.film;
     let xyz = film.xyz_image();
     let mut layers = Layers::from_xyz(film.width, film.height, &xyz, &film.y_stderr_image());
     layers.attributes.extend([
@@ -321,7 +542,7 @@ fn write_outputs(
         ),
         (
             "spp".to_string(),
-            (film.total_samples() / (film.width * film.height) as u64).to_string(),
+            format!("{:.2}", film.total_samples() as f64 / (film.width * film.height) as f64),
         ),
     ]);
     if world.settings.illuminance {
@@ -341,15 +562,89 @@ fn write_outputs(
     }
     output::write_exr(exr_path, &layers)
         .with_context(|| format!("writing {}", exr_path.display()))?;
+    Ok(())
+}
+
+fn write_png(film: &candela::film::Film, png_path: &Path, exposure: Option<f64>) -> Result<()> {
     output::write_srgb_png(
         png_path,
         film.width,
         film.height,
-        &xyz,
+        &film.xyz_image(),
         &PngSettings {
             exposure_ev: exposure,
         },
     )
     .with_context(|| format!("writing {}", png_path.display()))?;
+    Ok(())
+}
+
+fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()> {
+    let mut loaded = Vec::new();
+    for p in states {
+        loaded.push((p, candela::state::RenderState::load(p)?));
+    }
+    let (p0, first) = &loaded[0];
+    let mut film = first.film.clone();
+    let mut seeds = vec![first.seed];
+    for (p, s) in &loaded[1..] {
+        if s.scene_hash != first.scene_hash
+            || s.film.width != film.width
+            || s.film.height != film.height
+            || s.film.decision.is_some() != film.decision.is_some()
+        {
+            bail!(
+                "{} and {} are renders of different scenes or settings and cannot be merged",
+                p0.display(),
+                p.display()
+            );
+        }
+        if seeds.contains(&s.seed) {
+            bail!(
+                "{} repeats seed {} of another input: renders with the same seed take the same samples, so merging them would not add information; render with different --seed values",
+                p.display(),
+                s.seed
+            );
+        }
+        seeds.push(s.seed);
+        film.merge(&s.film);
+    }
+    let stem = match out.extension().and_then(|e| e.to_str()) {
+        Some("exr") | Some("png") | Some("state") => out.with_extension(""),
+        _ => out.to_path_buf(),
+    };
+    let exr_path = with_suffix(&stem, ".exr");
+    let xyz = film.xyz_image();
+    let mut layers = Layers::from_xyz(film.width, film.height, &xyz, &film.y_stderr_image());
+    layers.attributes.extend([
+        (
+            "software".to_string(),
+            format!("candela {}", env!("CARGO_PKG_VERSION")),
+        ),
+        ("scene".to_string(), first.scene.clone()),
+        ("merged_seeds".to_string(), format!("{seeds:?}")),
+    ]);
+    if first.illuminance {
+        let (e, se, mask) = film.illuminance_images();
+        layers.channels.extend([
+            (output::CHANNEL_E.to_string(), e),
+            (output::CHANNEL_E_STDERR.to_string(), se),
+            (output::CHANNEL_E_MASK.to_string(), mask),
+        ]);
+    }
+    output::write_exr(&exr_path, &layers)?;
+    write_png(&film, &with_suffix(&stem, ".png"), exposure)?;
+    let merged = candela::state::RenderState {
+        seed: seeds[0],
+        film,
+        ..first.clone()
+    };
+    merged.save(&with_suffix(&stem, ".state"))?;
+    println!(
+        "merged {} renders (seeds {seeds:?}): {:.1} image samples per pixel; wrote {}",
+        loaded.len(),
+        merged.film.total_samples() as f64 / (merged.film.width * merged.film.height) as f64,
+        exr_path.display()
+    );
     Ok(())
 }

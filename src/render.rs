@@ -7,6 +7,7 @@ use crate::sampler::Sampler;
 use crate::spectrum::SampledWavelengths;
 use crate::world::World;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 const TILE: usize = 16;
@@ -28,9 +29,11 @@ impl RenderResult {
     }
 }
 
-/// Render one pixel's samples `first..first+count` into `sums`.
+/// Render one pixel's samples `first..first+count` of the random stream `seed` into `sums`.
+#[allow(clippy::too_many_arguments)]
 pub fn render_pixel(
     world: &World,
+    seed: u64,
     x: usize,
     y: usize,
     first: u64,
@@ -41,7 +44,7 @@ pub fn render_pixel(
     let cam = &world.camera;
     let pixel = (y * cam.width + x) as u64;
     for s in first..first + count {
-        let mut sampler = Sampler::new(world.settings.seed, pixel, s);
+        let mut sampler = Sampler::new(seed, pixel, s);
         let u_wl = sampler.get1d();
         let off = world.settings.filter.sample(sampler.get2d());
         let u_lens = sampler.get2d();
@@ -101,61 +104,310 @@ fn surface_illuminance(
     }
 }
 
-/// Render the whole image with `threads` worker threads (None = all cores), calling
-/// `progress(done_tiles, total_tiles)` as tiles finish.
+/// How long to render and when to stop.
+#[derive(Clone, Debug, Default)]
+pub struct Progressive {
+    /// Most samples per pixel (image and decision buffers together).
+    pub max_spp: u32,
+    /// Render until this error is reached (adaptive sampling).
+    pub target: Option<TargetError>,
+    /// Stop after this much time (at the end of the pass in progress).
+    pub max_time: Option<Duration>,
+    /// Call the checkpoint callback at the end of the first pass after each interval.
+    pub checkpoint_interval: Option<Duration>,
+}
+
+/// "Every pixel's luminance known to ±`relative` at 95 % confidence".
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TargetError {
+    /// Half-width of the 95 % confidence interval relative to the value (0.01 = 1 %).
+    pub relative: f64,
+    /// Fraction of the eligible pixels that must meet it (default 1).
+    pub fraction: f64,
+    /// Pixels darker than this luminance (cd/m²) are not required to meet it; None = 0.1 % of
+    /// the image's mean luminance.
+    pub floor_cd_m2: Option<f64>,
+}
+
+/// Stream of the decision buffer's samples (statistically independent of the image's).
+const DECISION_STREAM: u64 = 0xdec1_5104_0000_0000;
+
+/// Samples a pixel's decision buffer needs before its error estimate is trusted.
+pub const MIN_DECISION_SAMPLES: u64 = 8;
+/// Largest number of samples one pixel receives in one pass.
+const MAX_PASS_SPP: u64 = 64;
+
+/// Progress of a progressive render after a pass.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PassStatus {
+    pub passes: u32,
+    /// Samples taken so far, all pixels.
+    pub samples: u64,
+    /// Upper bound of samples (pixels × max_spp).
+    pub max_samples: u64,
+    /// With a target error: fraction of eligible pixels that meet it.
+    pub converged_fraction: Option<f64>,
+}
+
+/// Why a progressive render ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// Every pixel has max_spp samples (or the target was met where set).
+    Done,
+    TargetReached,
+    MaxTime,
+    Interrupted,
+}
+
+/// Whether pixel `i` still needs samples under `target`, judged on its decision buffer; and
+/// whether it counts toward the fraction (not below the floor).
+fn pixel_converged(
+    d: &PixelSums,
+    target: &TargetError,
+    floor: f64,
+    illuminance: bool,
+) -> (bool, bool) {
+    if d.count < MIN_DECISION_SAMPLES {
+        return (false, true);
+    }
+    let y = d.mean_xyz()[1];
+    if y < floor {
+        return (true, false);
+    }
+    let z = 1.959_963_984_540_054;
+    let mut ok = z * d.y_standard_error() <= target.relative * y;
+    if illuminance {
+        if let Some(e) = d.mean_e() {
+            if d.count_e >= MIN_DECISION_SAMPLES && e > 0.0 {
+                ok &= z * d.e_standard_error() <= target.relative * e;
+            }
+        }
+    }
+    (ok, true)
+}
+
+/// Per-pixel sample counts to add in the next pass (0 = pixel done), and the fraction of
+/// eligible pixels that meet the target.
+fn plan_pass(world: &World, film: &Film, prog: &Progressive) -> (Vec<u64>, Option<f64>) {
+    let max = prog.max_spp as u64;
+    let n = film.pixels.len();
+    let mut plan = vec![0u64; n];
+    let (mut eligible, mut converged) = (0u64, 0u64);
+    let floor = match (&prog.target, &film.decision) {
+        (Some(t), Some(d)) => t.floor_cd_m2.unwrap_or_else(|| {
+            1e-3 * d.iter().map(|p| p.mean_xyz()[1]).sum::<f64>() / n.max(1) as f64
+        }),
+        _ => 0.0,
+    };
+    for (i, slot) in plan.iter_mut().enumerate() {
+        let taken = film.samples_taken(i);
+        if taken >= max {
+            continue;
+        }
+        if let (Some(t), Some(d)) = (&prog.target, &film.decision) {
+            let (ok, counts) = pixel_converged(&d[i], t, floor, world.settings.illuminance);
+            if counts {
+                eligible += 1;
+                converged += ok as u64;
+            }
+            if ok {
+                continue;
+            }
+            // Even sample counts keep the two buffers balanced.
+            let add = taken.clamp(2, MAX_PASS_SPP).min(max - taken);
+            *slot = add + (add & 1);
+        } else {
+            *slot = taken.clamp(1, MAX_PASS_SPP).min(max - taken);
+        }
+    }
+    let frac = prog.target.map(|_| {
+        if eligible == 0 {
+            1.0
+        } else {
+            converged as f64 / eligible as f64
+        }
+    });
+    (plan, frac)
+}
+
+/// Render progressively into `film` (which may hold a resumed state): passes over all pixels
+/// that still need samples, each pixel's samples indexed from where it stopped, so an
+/// interrupted and resumed render equals an uninterrupted one. `stop` is polled between tiles;
+/// a pass that is interrupted is discarded. `on_pass` runs after every pass; `on_checkpoint`
+/// after the passes that close a checkpoint interval.
+pub fn render_progressive(
+    world: &World,
+    film: &mut Film,
+    threads: Option<usize>,
+    prog: &Progressive,
+    stop: &AtomicBool,
+    on_pass: &mut dyn FnMut(&PassStatus),
+    on_checkpoint: &mut dyn FnMut(&Film) -> anyhow::Result<()>,
+) -> anyhow::Result<(RenderResult, StopReason)> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()?;
+    let (w, h) = (world.camera.width, world.camera.height);
+    anyhow::ensure!(
+        film.width == w && film.height == h,
+        "the film is {}×{} but the camera is {w}×{h}",
+        film.width,
+        film.height
+    );
+    let tiles_x = w.div_ceil(TILE);
+    let n_tiles = tiles_x * h.div_ceil(TILE);
+    let start = Instant::now();
+    let mut last_checkpoint = start;
+    let mut stats = RayStats::default();
+    let mut status = PassStatus {
+        max_samples: (w * h) as u64 * prog.max_spp as u64,
+        ..Default::default()
+    };
+    let reason = loop {
+        let (plan, frac) = plan_pass(world, film, prog);
+        status.converged_fraction = frac;
+        status.samples = (0..w * h).map(|i| film.samples_taken(i)).sum();
+        if let (Some(t), Some(f)) = (&prog.target, frac) {
+            if f >= t.fraction {
+                break StopReason::TargetReached;
+            }
+        }
+        if plan.iter().all(|&n| n == 0) {
+            break StopReason::Done;
+        }
+        if stop.load(Ordering::Relaxed) {
+            break StopReason::Interrupted;
+        }
+        if prog.max_time.is_some_and(|t| start.elapsed() >= t) {
+            break StopReason::MaxTime;
+        }
+        let adaptive = film.decision.is_some();
+        let film_ref: &Film = film;
+        let results: Vec<Option<TileResult>> = pool.install(|| {
+            (0..n_tiles)
+                .into_par_iter()
+                .map(|t| {
+                    if stop.load(Ordering::Relaxed) {
+                        return None;
+                    }
+                    let (tx, ty) = (t % tiles_x, t / tiles_x);
+                    let mut r = TileResult::default();
+                    for y in ty * TILE..((ty + 1) * TILE).min(h) {
+                        for x in tx * TILE..((tx + 1) * TILE).min(w) {
+                            let i = y * w + x;
+                            let mut est = film_ref.pixels[i];
+                            let mut dec = film_ref.decision.as_ref().map(|d| d[i]);
+                            let seed = world.settings.seed;
+                            match dec.as_mut() {
+                                // Independent streams: the image's samples continue its own
+                                // sequence, the decision buffer draws from another scramble.
+                                Some(d) => {
+                                    let half = plan[i] / 2;
+                                    let first = est.count;
+                                    render_pixel(
+                                        world,
+                                        seed,
+                                        x,
+                                        y,
+                                        first,
+                                        half,
+                                        &mut est,
+                                        &mut r.stats,
+                                    );
+                                    let first = d.count;
+                                    render_pixel(
+                                        world,
+                                        seed ^ DECISION_STREAM,
+                                        x,
+                                        y,
+                                        first,
+                                        half,
+                                        d,
+                                        &mut r.stats,
+                                    );
+                                }
+                                None => {
+                                    let first = est.count;
+                                    render_pixel(
+                                        world,
+                                        seed,
+                                        x,
+                                        y,
+                                        first,
+                                        plan[i],
+                                        &mut est,
+                                        &mut r.stats,
+                                    );
+                                }
+                            }
+                            r.pixels.push((i, est, dec));
+                        }
+                    }
+                    Some(r)
+                })
+                .collect()
+        });
+        if results.iter().any(Option::is_none) {
+            break StopReason::Interrupted;
+        }
+        for r in results.into_iter().flatten() {
+            stats.merge(&r.stats);
+            for (i, est, dec) in r.pixels {
+                film.pixels[i] = est;
+                if let (Some(d), Some(v)) = (film.decision.as_mut(), dec) {
+                    d[i] = v;
+                }
+            }
+        }
+        debug_assert_eq!(adaptive, film.decision.is_some());
+        status.passes += 1;
+        status.samples = (0..w * h).map(|i| film.samples_taken(i)).sum();
+        on_pass(&status);
+        if let Some(iv) = prog.checkpoint_interval {
+            if last_checkpoint.elapsed() >= iv {
+                on_checkpoint(film)?;
+                last_checkpoint = Instant::now();
+            }
+        }
+    };
+    Ok((
+        RenderResult {
+            film: film.clone(),
+            stats,
+            elapsed: start.elapsed(),
+            threads: pool.current_num_threads(),
+        },
+        reason,
+    ))
+}
+
+#[derive(Default)]
+struct TileResult {
+    pixels: Vec<(usize, PixelSums, Option<PixelSums>)>,
+    stats: RayStats,
+}
+
+/// Render the whole image at the scene's samples per pixel with `threads` worker threads
+/// (None = all cores), calling `progress(samples_done, samples_total)` after each pass.
 pub fn render(
     world: &World,
     threads: Option<usize>,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> anyhow::Result<RenderResult> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()?;
-    let (w, h) = (world.camera.width, world.camera.height);
-    let tiles_x = w.div_ceil(TILE);
-    let tiles_y = h.div_ceil(TILE);
-    let n_tiles = tiles_x * tiles_y;
-    let spp = world.settings.spp as u64;
-    let done = std::sync::atomic::AtomicU64::new(0);
-    let start = Instant::now();
-    let results: Vec<(usize, Vec<PixelSums>, RayStats)> = pool.install(|| {
-        (0..n_tiles)
-            .into_par_iter()
-            .map(|t| {
-                let (tx, ty) = (t % tiles_x, t / tiles_x);
-                let mut stats = RayStats::default();
-                let mut sums = Vec::with_capacity(TILE * TILE);
-                for y in ty * TILE..((ty + 1) * TILE).min(h) {
-                    for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                        let mut p = PixelSums::default();
-                        render_pixel(world, x, y, 0, spp, &mut p, &mut stats);
-                        sums.push(p);
-                    }
-                }
-                let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress(d, n_tiles as u64);
-                (t, sums, stats)
-            })
-            .collect()
-    });
-    let elapsed = start.elapsed();
-    let mut film = Film::new(w, h);
-    let mut stats = RayStats::default();
-    for (t, sums, s) in results {
-        stats.merge(&s);
-        let (tx, ty) = (t % tiles_x, t / tiles_x);
-        let mut k = 0;
-        for y in ty * TILE..((ty + 1) * TILE).min(h) {
-            for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                film.pixels[y * w + x] = sums[k];
-                k += 1;
-            }
-        }
-    }
-    Ok(RenderResult {
-        film,
-        stats,
-        elapsed,
-        threads: pool.current_num_threads(),
-    })
+    let mut film = Film::new(world.camera.width, world.camera.height);
+    let prog = Progressive {
+        max_spp: world.settings.spp,
+        ..Default::default()
+    };
+    let never = AtomicBool::new(false);
+    let (r, _) = render_progressive(
+        world,
+        &mut film,
+        threads,
+        &prog,
+        &never,
+        &mut |s| progress(s.samples, s.max_samples),
+        &mut |_| Ok(()),
+    )?;
+    Ok(r)
 }

@@ -1,0 +1,138 @@
+//! Progressive rendering: adaptive sampling to a target error stays unbiased; an interrupted
+//! and resumed render equals an uninterrupted one; independent renders merge exactly.
+
+mod common;
+use candela::film::Film;
+use candela::render::{render_progressive, Progressive, StopReason, TargetError};
+use common::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+const FURNACE: &str = r#"(
+    camera: (position: (0.1, -0.2, 0.05), look_at: (0, 0, 1), vfov_deg: 120, resolution: (10, 10)),
+    render: (spp: 64, max_depth: 64),
+    materials: { "wall": Diffuse(reflectance: Constant(0.5)) },
+    objects: [(
+        shape: Sphere(center: (0, 0, 0), radius: 1),
+        material: "wall",
+        emission: (spectrum: Named("E"), amount: Luminance(1.0), two_sided: true),
+    )],
+)"#;
+
+fn run(
+    w: &candela::world::World,
+    film: &mut Film,
+    prog: &Progressive,
+    stop_after_passes: Option<u32>,
+) -> StopReason {
+    let stop = AtomicBool::new(false);
+    let (_, reason) = render_progressive(
+        w,
+        film,
+        Some(2),
+        prog,
+        &stop,
+        &mut |s| {
+            if stop_after_passes.is_some_and(|n| s.passes >= n) {
+                stop.store(true, Ordering::Relaxed);
+            }
+        },
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    reason
+}
+
+#[test]
+fn adaptive_render_to_target_error_is_unbiased() {
+    // Furnace ρ = 0.5: L = 2 exactly. Every pixel to ±3 % (95 %); then the image mean (mean of
+    // 100 independent pixel estimates) must equal 2 within 4 of its standard errors.
+    let w = world(FURNACE);
+    let mut film = Film::new_adaptive(10, 10);
+    let prog = Progressive {
+        max_spp: 1 << 16,
+        target: Some(TargetError {
+            relative: 0.03,
+            fraction: 1.0,
+            floor_cd_m2: None,
+        }),
+        ..Default::default()
+    };
+    assert_eq!(run(&w, &mut film, &prog, None), StopReason::TargetReached);
+    for p in &film.pixels {
+        assert!(p.count >= 8);
+    }
+    let (m, se) = image_mean(&film);
+    assert!((m[1] - 2.0).abs() <= 4.0 * se, "mean {} ± {se}", m[1]);
+    // The decision buffer, not the image, met the target.
+    let d = film.decision.as_ref().unwrap();
+    assert!(d
+        .iter()
+        .all(|p| 1.96 * p.y_standard_error() <= 0.03 * p.mean_xyz()[1]));
+}
+
+#[test]
+fn interrupted_and_resumed_equals_uninterrupted() {
+    let w = world(FURNACE);
+    let prog = Progressive {
+        max_spp: 40,
+        ..Default::default()
+    };
+    let mut whole = Film::new(10, 10);
+    assert_eq!(run(&w, &mut whole, &prog, None), StopReason::Done);
+    let mut part = Film::new(10, 10);
+    assert_eq!(run(&w, &mut part, &prog, Some(3)), StopReason::Interrupted);
+    assert!(part.total_samples() < whole.total_samples());
+    // Through a state file, as `--resume` does.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.state");
+    candela::state::RenderState::new(std::path::Path::new("x.ron"), 7, &w, part)
+        .save(&path)
+        .unwrap();
+    let mut resumed = candela::state::RenderState::load(&path).unwrap().film;
+    assert_eq!(run(&w, &mut resumed, &prog, None), StopReason::Done);
+    assert_eq!(resumed, whole);
+
+    // The same holds in adaptive mode.
+    let prog = Progressive {
+        max_spp: 200,
+        target: Some(TargetError {
+            relative: 0.01,
+            fraction: 1.0,
+            floor_cd_m2: None,
+        }),
+        ..Default::default()
+    };
+    let mut whole = Film::new_adaptive(10, 10);
+    run(&w, &mut whole, &prog, None);
+    let mut part = Film::new_adaptive(10, 10);
+    assert_eq!(run(&w, &mut part, &prog, Some(2)), StopReason::Interrupted);
+    run(&w, &mut part, &prog, None);
+    assert_eq!(part, whole);
+}
+
+#[test]
+fn merged_renders_are_the_exact_combined_estimate() {
+    let a = render(&world(&FURNACE.replace("spp: 64", "spp: 16, seed: 1")), 2);
+    let b = render(&world(&FURNACE.replace("spp: 64", "spp: 16, seed: 2")), 2);
+    let mut m = a.clone();
+    m.merge(&b);
+    for i in 0..m.pixels.len() {
+        let (pa, pb, pm) = (&a.pixels[i], &b.pixels[i], &m.pixels[i]);
+        assert_eq!(pm.count, 32);
+        let expected = (pa.sum_xyz[1] + pb.sum_xyz[1]) / 32.0;
+        assert!((pm.mean_xyz()[1] - expected).abs() < 1e-12);
+    }
+    let (mean, se) = image_mean(&m);
+    assert!((mean[1] - 2.0).abs() <= 4.0 * se);
+}
+
+#[test]
+fn corrupt_state_file_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.state");
+    std::fs::write(&path, b"not a state").unwrap();
+    let e = candela::state::RenderState::load(&path)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad.state"), "{e}");
+}
