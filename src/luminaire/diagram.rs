@@ -13,12 +13,12 @@ const TEXT: Rgb<u8> = Rgb([60, 60, 60]);
 const RED: Rgb<u8> = Rgb([210, 30, 30]);
 const BLUE: Rgb<u8> = Rgb([30, 70, 210]);
 
-/// A "nice" ring spacing: 1, 2 or 5 × 10^k such that about 4–5 rings fit `max`.
+/// A "nice" ring spacing: 1, 2 or 5 × 10^k such that about 5 rings fit `max`.
 pub fn ring_step(max: f64) -> f64 {
     if max <= 0.0 || !max.is_finite() {
         return 1.0;
     }
-    let raw = max / 4.0;
+    let raw = max / 5.0;
     let p = 10f64.powf(raw.log10().floor());
     for m in [1.0, 2.0, 5.0, 10.0] {
         if m * p >= raw {
