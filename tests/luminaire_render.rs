@@ -155,3 +155,27 @@ fn light_power_and_emission_sampling() {
     let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
     assert!((mean - table).abs() <= 5.0 * se, "{mean} ± {se} vs {table}");
 }
+
+#[test]
+fn scene_errors_name_the_light_and_the_file() {
+    let scene = |light: &str| {
+        let text = format!(
+            "(camera: (position: (0, 0, 0), look_at: (0, 0, 1), vfov_deg: 10, resolution: (1, 1)), lights: [{light}])"
+        );
+        let path = Path::new("test-scene.ron");
+        let s = candela::scene::parse(&text, path).unwrap();
+        candela::scene::build(&s, path, &Default::default())
+            .err()
+            .expect("an error")
+            .to_string()
+    };
+    let e = scene("Goniometric(file: \"data/luminaires/missing.ies\", position: (0, 2, 0), spectrum: Blackbody(3000))");
+    assert!(
+        e.contains("lights[0].file") && e.contains("missing.ies"),
+        "{e}"
+    );
+    let e = scene("Goniometric(file: \"data/luminaires/narrow-spot.ies\", position: (0, 2, 0), spectrum: Blackbody(3000), lumens: -5)");
+    assert!(e.contains("lights[0].lumens"), "{e}");
+    let e = scene("Goniometric(file: \"data/luminaires/narrow-spot.ies\", position: (0, 2, 0), spectrum: Constant(0))");
+    assert!(e.contains("lights[0].spectrum"), "{e}");
+}
