@@ -236,3 +236,24 @@ fn write_then_read_gives_the_same_candela() {
         }
     }
 }
+
+#[test]
+fn luminaire_command_reports_and_draws() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("spot.png");
+    let out =
+        luminaire::cli::run(Path::new("data/luminaires/narrow-spot.ies"), Some(&png)).unwrap();
+    assert!(
+        out.contains("767.02 lm integrated") && out.contains("stated 766.24 lm"),
+        "{out}"
+    );
+    assert!(out.contains("5000.00 cd at C 0°, γ 0°"), "{out}");
+    // cos⁴⁰ γ = 1/2 at γ = 10.7°: beam 21.4° (the bilinear table and 0.1° scan give 21.2°).
+    assert!(out.contains("beam angle (50 %): 21.2°"), "{out}");
+    let img = image::open(&png).unwrap().to_rgb8();
+    assert_eq!((img.width(), img.height()), (800, 800));
+    // Some red (C0–C180 curve) and blue (C90–C270) pixels.
+    let red = img.pixels().filter(|p| p[0] > 180 && p[1] < 80).count();
+    let blue = img.pixels().filter(|p| p[2] > 180 && p[0] < 80).count();
+    assert!(red > 100 && blue > 100, "red {red}, blue {blue}");
+}
