@@ -15,6 +15,7 @@ pub mod film;
 pub mod geometry;
 pub mod integrator;
 pub mod light;
+pub mod luminaire;
 pub mod meter;
 pub mod output;
 pub mod photometry;

@@ -110,6 +110,14 @@ enum Command {
         from: String,
         to: String,
     },
+    /// Summary of an IES/EULUMDAT photometric file (flux, peak, beam and field angles) and a polar candela diagram (PNG).
+    Luminaire {
+        /// Photometric file: IES LM-63 (.ies) or EULUMDAT (.ldt).
+        file: PathBuf,
+        /// Where to write the polar diagram (default: FILE-STEM-polar.png in the current directory).
+        #[arg(long)]
+        diagram: Option<PathBuf>,
+    },
     /// Benchmark: samples/s and rays/s on the Cornell box and on a generated 1 M-triangle scene.
     Bench {
         /// Worker threads (default: all cores).
@@ -191,6 +199,9 @@ fn main() -> ExitCode {
         }
         Command::Convert { value, from, to } => {
             candela::cli_colour::convert_command(value, &from, &to).map(|s| print!("{s}"))
+        }
+        Command::Luminaire { file, diagram } => {
+            candela::luminaire::cli::run(&file, diagram.as_deref()).map(|s| print!("{s}"))
         }
         Command::Bench {
             threads,

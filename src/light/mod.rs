@@ -7,6 +7,7 @@
 //! | distant | irradiance at normal incidence E_e(λ) | W·m⁻²·nm⁻¹ |
 //! | environment, area | radiance L_e(λ) | W·m⁻²·sr⁻¹·nm⁻¹ |
 
+pub mod goniometric;
 pub mod sampler;
 
 use crate::bxdf::Frame;
@@ -67,6 +68,8 @@ pub enum Light {
         radiance: DenseSpectrum,
         two_sided: bool,
     },
+    /// A luminaire measured by a photometric file (IES/EULUMDAT): see [`goniometric`].
+    Goniometric(Box<goniometric::Goniometric>),
 }
 
 /// A sampled direction toward a light.
@@ -91,7 +94,10 @@ impl Light {
     pub fn is_delta(&self) -> bool {
         matches!(
             self,
-            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+            Light::Point { .. }
+                | Light::Spot { .. }
+                | Light::Distant { .. }
+                | Light::Goniometric(_)
         )
     }
 
@@ -123,6 +129,7 @@ impl Light {
                 let sides = if *two_sided { 2.0 } else { 1.0 };
                 pi * luminous_integral(radiance) * area * sides
             }
+            Light::Goniometric(g) => g.power_lm(),
         }
     }
 
@@ -234,6 +241,7 @@ impl Light {
                     delta: false,
                 })
             }
+            Light::Goniometric(g) => g.sample_li(p, wl),
         }
     }
 

@@ -802,5 +802,28 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
                 radiance: scaled(spectrum, lum)?,
             }
         }
+        LightDesc::Goniometric {
+            file,
+            position,
+            rotate_deg,
+            spectrum,
+            lumens,
+            multiplier,
+        } => crate::light::goniometric::build(
+            &ctx.resolve(file),
+            ctx.vec3(&format!("{field}.position"), *position)?,
+            match rotate_deg {
+                Some(r) => ctx.vec3(&format!("{field}.rotate_deg"), *r)?,
+                None => Vec3::ZERO,
+            },
+            resolve_spectrum(ctx, &sfield, spectrum, Role::Emission)?,
+            lumens
+                .map(|v| nonneg(ctx, &format!("{field}.lumens"), v))
+                .transpose()?,
+            multiplier
+                .map(|v| nonneg(ctx, &format!("{field}.multiplier"), v))
+                .transpose()?,
+        )
+        .map_err(|(sub, m)| ctx.err(format!("{field}{sub}"), m))?,
     })
 }

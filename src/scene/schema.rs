@@ -331,4 +331,22 @@ pub enum LightDesc {
         spectrum: SpectrumDesc,
         amount: Amount,
     },
+    /// A luminaire from a photometric file (docs/luminaires.md): candela from the file,
+    /// colour from `spectrum`.
+    Goniometric {
+        /// IES LM-63 (.ies) or EULUMDAT (.ldt) file, relative to the scene file.
+        file: String,
+        position: V3,
+        /// Aiming: Euler angles, degrees, about X, then Y, then Z (as in transforms). Without
+        /// it, nadir is −Y and C0 is +X.
+        #[serde(default)]
+        rotate_deg: Option<V3>,
+        spectrum: SpectrumDesc,
+        /// Scale the table to this total luminous flux, lm.
+        #[serde(default)]
+        lumens: Option<f64>,
+        /// Multiply the candela (after `lumens`), default 1.
+        #[serde(default)]
+        multiplier: Option<f64>,
+    },
 }
