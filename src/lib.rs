@@ -18,6 +18,7 @@ pub mod light;
 pub mod output;
 pub mod photometry;
 pub mod render;
+pub mod report;
 pub mod sampler;
 pub mod scene;
 pub mod spectrum;
