@@ -96,3 +96,84 @@ fn inconsistent_grid_is_an_error_naming_the_file() {
     assert!(err.to_string().contains("bad.png"), "{err}");
     assert!(!png.exists());
 }
+
+/// Writes example images for eyeballing:
+/// `CANDELA_REPORT_SAMPLES=/tmp/x cargo test --test report_heatmap -- --ignored`.
+#[test]
+#[ignore]
+fn sample_images() {
+    use candela::output::{Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR};
+    use candela::report::falsecolour::{write_falsecolour, Scale};
+    use candela::report::units::Quantity;
+    let dir = std::path::PathBuf::from(std::env::var("CANDELA_REPORT_SAMPLES").unwrap());
+    // A point source of 1000 cd, 2 m above a 6 × 4 m work plane: E = I cos θ / d².
+    let (nx, ny, sx, sy) = (12, 8, 6.0, 4.0);
+    let e = |x: f64, y: f64| {
+        let (dx, dy, h) = (x - 2.0, y - 2.5, 2.0);
+        let d2: f64 = dx * dx + dy * dy + h * h;
+        1000.0 * h / d2.powf(1.5)
+    };
+    let values: Vec<f64> = (0..nx * ny)
+        .map(|k| {
+            let (i, j) = (k % nx, k / nx);
+            e(
+                (i as f64 + 0.5) * sx / nx as f64,
+                (j as f64 + 0.5) * sy / ny as f64,
+            )
+        })
+        .collect();
+    let grid = GridValues {
+        name: "work plane 0.8 m".into(),
+        nx,
+        ny,
+        stderr: values.iter().map(|v| v * 0.008).collect(),
+        values,
+        size_m: (sx, sy),
+    };
+    write_grid_heatmap(
+        &dir.join("grid.png"),
+        &grid,
+        &FalsecolourSettings::default(),
+    )
+    .unwrap();
+    let imperial = FalsecolourSettings {
+        units: UnitSystem::Imperial,
+        steps: Some(8),
+        ..Default::default()
+    };
+    write_grid_heatmap(&dir.join("grid-fc.png"), &grid, &imperial).unwrap();
+
+    // An illuminance image: the plane seen from above, sky (undefined) in the top rows.
+    let (w, h) = (240, 160);
+    let mut layers = Layers::from_xyz(w, h, &vec![[1.0; 3]; w * h], &vec![0.0; w * h]);
+    let (mut ev, mut mask) = (Vec::new(), Vec::new());
+    for py in 0..h {
+        for px in 0..w {
+            if py < 30 {
+                ev.push(-1.0);
+                mask.push(0.0);
+            } else {
+                ev.push(e(px as f64 / 40.0, py as f64 / 40.0) as f32);
+                mask.push(1.0);
+            }
+        }
+    }
+    layers.channels.push((CHANNEL_E.into(), ev));
+    layers
+        .channels
+        .push((CHANNEL_E_STDERR.into(), vec![0.0; w * h]));
+    layers.channels.push((CHANNEL_E_MASK.into(), mask));
+    let s = FalsecolourSettings {
+        quantity: Quantity::Illuminance,
+        steps: Some(10),
+        contours: true,
+        ..Default::default()
+    };
+    write_falsecolour(&dir.join("illuminance.png"), &layers, &s).unwrap();
+    let s = FalsecolourSettings {
+        quantity: Quantity::Illuminance,
+        scale: Scale::Log,
+        ..Default::default()
+    };
+    write_falsecolour(&dir.join("illuminance-log.png"), &layers, &s).unwrap();
+}

@@ -154,7 +154,9 @@ impl ColourScale {
     ///
     /// Automatic range (documented in docs/reports.md):
     /// * linear: min = 0 (or the 1st percentile rounded down, if that is negative), max = the
-    ///   99th percentile rounded up to a "nice" number (1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10ᵏ);
+    ///   99th percentile rounded up so that the interval per step ((max − min)/N, N = the
+    ///   steps, or 10 for a continuous scale) is a "nice" number (1, 1.2, 1.5, 2, 2.5, 3, 4,
+    ///   5, 6, 8 × 10ᵏ);
     /// * log: whole decades around the 1st and 99th percentiles of the positive values, at most
     ///   six decades below the top.
     ///
@@ -189,11 +191,10 @@ impl ColourScale {
                 let max = settings.max.unwrap_or_else(|| {
                     let p99 = percentile(&finite, 0.99).unwrap_or(1.0);
                     if p99 > min {
-                        if min == 0.0 {
-                            nice_ceil(p99)
-                        } else {
-                            min + nice_ceil(p99 - min)
-                        }
+                        // A nice interval per step (or per tenth), so that the legend's
+                        // values are round numbers.
+                        let n = steps.unwrap_or(10) as f64;
+                        min + n * nice_ceil((p99 - min) / n)
                     } else {
                         min + 1.0
                     }
@@ -690,7 +691,7 @@ impl<'a> Legend<'a> {
         let labels_w = cs
             .ticks
             .iter()
-            .map(|&t| draw::text_width(LABEL_PX, &format_sig(t, 4)))
+            .map(|&t| draw::text_width(LABEL_PX, &format_sig(t, 3)))
             .max()
             .unwrap_or(0);
         let unit_w = draw::text_width(LABEL_PX, unit);
@@ -752,7 +753,7 @@ impl<'a> Legend<'a> {
             let room = (last_label_y - ty) >= lh;
             let room_for_top = i + 1 == n || (ty - tick_y(cs.ticks[n - 1])) >= lh;
             if i == 0 || i + 1 == n || (room && room_for_top) {
-                let label = format_sig(v, 4);
+                let label = format_sig(v, 3);
                 let f = draw::line_height(LABEL_PX) as i32;
                 draw::draw_text(
                     img,
