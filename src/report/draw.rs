@@ -9,7 +9,11 @@ use std::sync::OnceLock;
 
 use ab_glyph::{Font, FontRef, PxScale, ScaleFont};
 use image::{Rgb, RgbImage};
-use imageproc::drawing::{draw_filled_rect_mut, draw_line_segment_mut, draw_text_mut};
+use imageproc::drawing::{
+    draw_antialiased_line_segment_mut, draw_filled_rect_mut, draw_hollow_circle_mut,
+    draw_line_segment_mut, draw_text_mut,
+};
+use imageproc::pixelops::interpolate;
 use imageproc::rect::Rect;
 
 /// An sRGB colour.
@@ -77,6 +81,17 @@ pub fn draw_text_centred(
 /// Draws a one-pixel line from (`x0`, `y0`) to (`x1`, `y1`) (Bresenham, not anti-aliased).
 pub fn draw_line(img: &mut RgbImage, x0: f32, y0: f32, x1: f32, y1: f32, colour: Colour) {
     draw_line_segment_mut(img, (x0, y0), (x1, y1), colour);
+}
+
+/// Draws an anti-aliased one-pixel line between integer pixel positions (Xiaolin Wu), e.g. for
+/// diagrams with slanted lines.
+pub fn draw_line_aa(img: &mut RgbImage, x0: i32, y0: i32, x1: i32, y1: i32, colour: Colour) {
+    draw_antialiased_line_segment_mut(img, (x0, y0), (x1, y1), colour, interpolate);
+}
+
+/// Draws the outline of a circle of `radius` pixels centred on (`cx`, `cy`).
+pub fn draw_circle(img: &mut RgbImage, cx: i32, cy: i32, radius: i32, colour: Colour) {
+    draw_hollow_circle_mut(img, (cx, cy), radius, colour);
 }
 
 /// Fills the rectangle with top-left (`x`, `y`), `w` × `h` pixels. Empty sizes draw nothing.

@@ -781,6 +781,34 @@ mod tests {
     use super::*;
 
     #[test]
+    fn ranges_parse() {
+        assert_eq!(parse_range("0:500"), Ok((Some(0.0), Some(500.0))));
+        assert_eq!(parse_range(":500"), Ok((None, Some(500.0))));
+        assert_eq!(parse_range("1e-2:"), Ok((Some(0.01), None)));
+        assert!(parse_range("500").is_err());
+        assert!(parse_range("a:b").is_err());
+        assert!(parse_range("0:inf").is_err());
+    }
+
+    #[test]
+    fn banded_steps_and_nice_automatic_maximum() {
+        let values: Vec<f64> = (0..=100).map(|i| i as f64 * 0.22).collect();
+        let s = FalsecolourSettings {
+            steps: Some(8),
+            ..Default::default()
+        };
+        let cs = ColourScale::resolve(&s, &values).unwrap();
+        // 99th percentile 21.8 → 8 steps of 3.
+        assert_eq!(cs.max, 24.0);
+        assert_eq!(cs.ticks[1], 3.0);
+        assert_eq!(cs.step_of(2.99), Some(0));
+        assert_eq!(cs.step_of(3.0), Some(1));
+        assert_eq!(cs.step_of(-5.0), Some(0));
+        assert_eq!(cs.step_of(1e9), Some(7));
+        assert_eq!(cs.colour(1e9), cs.step_colour(7));
+    }
+
+    #[test]
     fn nice_numbers() {
         assert_eq!(nice_ceil(437.0), 500.0);
         assert_eq!(nice_ceil(500.0), 500.0);

@@ -359,11 +359,12 @@ impl ProbeResult {
         let mut s = match self.radius {
             None => format!("{file}: pixel ({}, {})\n", self.x, self.y),
             Some(r) => format!(
-                "{file}: disc of radius {} px around pixel ({}, {}): {} pixels\n",
+                "{file}: disc of radius {} px around pixel ({}, {}): {} pixel{}\n",
                 format_sig(r, 4),
                 self.x,
                 self.y,
-                self.pixels
+                self.pixels,
+                if self.pixels == 1 { "" } else { "s" }
             ),
         };
         let row = |s: &mut String, k: &str, v: String| s.push_str(&format!("  {k:<13} {v}\n"));
