@@ -90,6 +90,7 @@ fn linear_steps_match_the_exr() {
     assert_eq!((lo, hi), (5.0, 995.0));
     assert!((mean - 500.0).abs() < 1e-9);
     assert_eq!(info.undefined_pixels, 0);
+    assert_eq!((info.below_range, info.above_range), (0, 0));
 }
 
 #[test]
@@ -183,6 +184,7 @@ fn illuminance_honours_the_mask_and_imperial_units() {
     assert_eq!(info.unit, "fc");
     assert_eq!(info.undefined_pixels, 5 * 40);
     assert_eq!(info.scale.ticks, vec![0.0, 10.0, 20.0, 30.0, 40.0]);
+    assert_eq!((info.below_range, info.above_range), (0, 0));
     // Column x has x fc: columns 0..9 step 0, 10..19 step 1 (skip the boundaries).
     let img = image::open(&png).unwrap().to_rgb8();
     for (x, k) in [(3, 0), (15, 1), (25, 2), (35, 3), (39, 3)] {
@@ -322,4 +324,24 @@ fn command_line_errors() {
         assert!(!err.contains("panicked"), "{err}");
         assert!(pngs(d).is_empty(), "{args:?} left {:?}", pngs(d));
     }
+}
+
+#[test]
+fn values_outside_the_range_take_the_end_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("ramp.exr");
+    let layers = ramp(&exr, 100, 3, |x| x as f32 * 10.0 + 5.0);
+    let png = dir.path().join("clip.png");
+    let settings = FalsecolourSettings {
+        min: Some(100.0),
+        max: Some(900.0),
+        steps: Some(8),
+        ..Default::default()
+    };
+    let info = write_falsecolour(&png, &layers, &settings).unwrap();
+    // Columns 0..9 (5…95) lie below, 90..99 (905…995) above.
+    assert_eq!((info.below_range, info.above_range), (30, 30));
+    let img = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(map_pixel(&img, &info, 0, 1), info.step_colours[0]);
+    assert_eq!(map_pixel(&img, &info, 99, 1), info.step_colours[7]);
 }

@@ -393,6 +393,12 @@ pub struct LegendInfo {
     pub step_colours: Vec<[u8; 3]>,
     /// Pixels where the quantity is undefined (drawn hatched grey).
     pub undefined_pixels: usize,
+    /// Defined pixels below the range's minimum (painted with the lowest colour; the legend's
+    /// bottom label then reads "< min").
+    pub below_range: usize,
+    /// Defined pixels above the range's maximum (painted with the highest colour; the legend's
+    /// top label then reads "> max").
+    pub above_range: usize,
     /// Smallest, mean and largest defined value (display units); `None` if nothing is defined.
     pub stats: Option<(f64, f64, f64)>,
     /// Top-left corner of the map inside the PNG.
@@ -521,7 +527,15 @@ pub fn render_falsecolour(
         )
     });
 
-    let legend = Legend::new(&cs, unit, undefined_label.as_deref(), mh.max(260));
+    let below_range = data.iter().filter(|&&v| v < cs.min).count();
+    let above_range = data.iter().filter(|&&v| v > cs.max).count();
+    let legend = Legend::new(
+        &cs,
+        unit,
+        undefined_label.as_deref(),
+        (below_range > 0, above_range > 0),
+        mh.max(260),
+    );
     let header_h = PAD + draw::line_height(TITLE_PX) + 4 + draw::line_height(LABEL_PX) + 10;
     let footer_h = 8 + draw::line_height(LABEL_PX) + PAD;
     let body_h = mh.max(legend.height);
@@ -619,12 +633,27 @@ pub fn render_falsecolour(
             .collect(),
         scale: cs,
         undefined_pixels: undefined,
+        below_range,
+        above_range,
         stats,
         map_origin: (ox, oy),
         zoom,
         image_size: (width, height),
     };
     Ok((img, info))
+}
+
+/// The legend's label of tick `i`: its value, with "< " / "> " on the end ticks when some
+/// values lie outside the range (and take the end colours).
+fn tick_label(cs: &ColourScale, i: usize, (below, above): (bool, bool)) -> String {
+    let v = format_sig(cs.ticks[i], 3);
+    if i == 0 && below {
+        format!("< {v}")
+    } else if i + 1 == cs.ticks.len() && above {
+        format!("> {v}")
+    } else {
+        v
+    }
 }
 
 /// "linear scale, 10 steps, 0 – 500 cd/m²".
@@ -671,6 +700,8 @@ pub(crate) struct Legend<'a> {
     cs: &'a ColourScale,
     unit: &'a str,
     undefined: Option<&'a str>,
+    /// Some values lie below `min` / above `max` (labelled "< min" / "> max").
+    clipped: (bool, bool),
     bar_h: u32,
     /// Total size, pixels.
     pub width: u32,
@@ -685,13 +716,13 @@ impl<'a> Legend<'a> {
         cs: &'a ColourScale,
         unit: &'a str,
         undefined: Option<&'a str>,
+        clipped: (bool, bool),
         height: u32,
     ) -> Self {
         let lh = draw::line_height(LABEL_PX);
-        let labels_w = cs
-            .ticks
-            .iter()
-            .map(|&t| draw::text_width(LABEL_PX, &format_sig(t, 3)))
+        let n = cs.ticks.len();
+        let labels_w = (0..n)
+            .map(|i| draw::text_width(LABEL_PX, &tick_label(cs, i, clipped)))
             .max()
             .unwrap_or(0);
         let unit_w = draw::text_width(LABEL_PX, unit);
@@ -705,6 +736,7 @@ impl<'a> Legend<'a> {
             cs,
             unit,
             undefined,
+            clipped,
             bar_h,
             width: (BAR_W + 6 + labels_w).max(unit_w).max(undef_w),
             height: top + bar_h + lh / 2 + undef_h,
@@ -753,7 +785,7 @@ impl<'a> Legend<'a> {
             let room = (last_label_y - ty) >= lh;
             let room_for_top = i + 1 == n || (ty - tick_y(cs.ticks[n - 1])) >= lh;
             if i == 0 || i + 1 == n || (room && room_for_top) {
-                let label = format_sig(v, 3);
+                let label = tick_label(cs, i, self.clipped);
                 let f = draw::line_height(LABEL_PX) as i32;
                 draw::draw_text(
                     img,

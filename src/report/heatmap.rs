@@ -34,7 +34,7 @@ pub struct GridValues {
 }
 
 /// Statistics of a grid, in the units of the values they were computed from.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct GridStats {
     /// Smallest value (Emin).
     pub min: f64,
@@ -225,7 +225,11 @@ pub fn render_grid_heatmap(
     let (gw, gh) = (nx as u32 * cell, ny as u32 * cell);
     let gx = PAD + axis_label_w + 10;
     let gy = header_h;
-    let legend = Legend::new(&cs, unit, None, gh.max(260));
+    let clipped = (
+        shown.iter().any(|&v| v < cs.min),
+        shown.iter().any(|&v| v > cs.max),
+    );
+    let legend = Legend::new(&cs, unit, None, clipped, gh.max(260));
     let footer_h = 8 + lh * 2 + PAD;
     let body_h = gh.max(legend.height);
     let mut width = gx + gw + 24 + legend.width + PAD;
