@@ -130,6 +130,10 @@ enum Command {
         #[arg(long, default_value_t = 1_000_000)]
         triangles: usize,
     },
+    /// Luminance, illuminance (95 % CI), XYZ, xy, u′v′, CCT, Duv and sRGB of a pixel or disc of an EXR; see docs/reports.md.
+    Probe(candela::report::probe::ProbeArgs),
+    /// False-colour PNG of luminance or illuminance with a legend; see docs/reports.md.
+    Falsecolour(candela::report::falsecolour::FalsecolourArgs),
 }
 
 fn main() -> ExitCode {
@@ -208,6 +212,10 @@ fn main() -> ExitCode {
             spp,
             triangles,
         } => candela::bench::run(threads, spp, triangles),
+        Command::Probe(args) => candela::report::probe::run(&args).map(|s| print!("{s}")),
+        Command::Falsecolour(args) => {
+            candela::report::falsecolour::run(&args).map(|s| print!("{s}"))
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,372 @@
+//! Heat maps of calculation grids: one coloured cell per grid point with its value printed
+//! in it (as DIALux and Relux draw them), a legend bar, axes in m (ft) and a title with the
+//! grid statistics Emin, Eavg, Emax, U₀ = Emin/Eavg and Emin/Emax.
+//!
+//! Drawing convention: the grid is seen from the side its normal points to, with row 0 at the
+//! **bottom** and column 0 at the **left** (the origin of the grid rectangle bottom-left, like
+//! a plan); the x axis runs along the first edge (`size_m.0`, columns), the y axis along the
+//! second (`size_m.1`, rows).
+
+use std::path::Path;
+
+use image::{Rgb, RgbImage};
+
+use super::draw::{self, BLACK, DARK_GREY, WHITE};
+use super::falsecolour::{describe_scale, write_png, ColourScale, FalsecolourSettings, Legend};
+use super::units::{format_sig, Quantity, UnitSystem};
+use crate::output::OutputError;
+
+/// The values of one calculation grid, as the report JSON holds them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridValues {
+    /// The grid's name (scene file), used in the title.
+    pub name: String,
+    /// Points along the first edge (columns).
+    pub nx: usize,
+    /// Points along the second edge (rows).
+    pub ny: usize,
+    /// Illuminance at each point, lx; row-major, row 0 first (`values[j * nx + i]`).
+    pub values: Vec<f64>,
+    /// Standard error of each value, lx (same layout), or empty if unknown.
+    pub stderr: Vec<f64>,
+    /// Extent of the grid along its two edges, metres (for the axis labels).
+    pub size_m: (f64, f64),
+}
+
+/// Statistics of a grid, in the units of the values they were computed from.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct GridStats {
+    /// Smallest value (Emin).
+    pub min: f64,
+    /// Arithmetic mean over the points (Eavg).
+    pub avg: f64,
+    /// Largest value (Emax).
+    pub max: f64,
+    /// Uniformity U₀ = Emin / Eavg (`None` if Eavg = 0).
+    pub u0: Option<f64>,
+    /// Emin / Emax (`None` if Emax = 0).
+    pub min_over_max: Option<f64>,
+    /// Largest standard error of a point (`None` if no errors are given).
+    pub max_stderr: Option<f64>,
+}
+
+impl GridStats {
+    /// Statistics of `values` (with optional per-point standard errors); `None` if empty.
+    pub fn of(values: &[f64], stderr: &[f64]) -> Option<GridStats> {
+        if values.is_empty() {
+            return None;
+        }
+        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let avg = values.iter().sum::<f64>() / values.len() as f64;
+        let ratio = |a: f64, b: f64| (b != 0.0).then(|| a / b);
+        Some(GridStats {
+            min,
+            avg,
+            max,
+            u0: ratio(min, avg),
+            min_over_max: ratio(min, max),
+            max_stderr: (!stderr.is_empty()).then(|| stderr.iter().copied().fold(0.0f64, f64::max)),
+        })
+    }
+
+    /// The same statistics converted from SI (lx) to `units` (ratios unchanged).
+    pub fn in_units(&self, units: UnitSystem) -> GridStats {
+        let c = |v: f64| units.from_si(Quantity::Illuminance, v);
+        GridStats {
+            min: c(self.min),
+            avg: c(self.avg),
+            max: c(self.max),
+            max_stderr: self.max_stderr.map(c),
+            ..*self
+        }
+    }
+}
+
+/// What a heat map shows, returned by [`write_grid_heatmap`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeatmapInfo {
+    /// Statistics in lx.
+    pub stats_si: GridStats,
+    /// Statistics in the display units (what the title prints).
+    pub stats: GridStats,
+    /// Unit symbol (`lx` or `fc`).
+    pub unit: String,
+    /// The title lines as printed.
+    pub title_lines: Vec<String>,
+    /// The colour scale (legend ticks in display units).
+    pub scale: ColourScale,
+    /// Side of one cell, pixels.
+    pub cell_px: u32,
+    /// Top-left corner of the grid (the cell of column 0, row ny − 1) in the PNG.
+    pub grid_origin: (u32, u32),
+    /// Size of the PNG, pixels.
+    pub image_size: (u32, u32),
+}
+
+impl HeatmapInfo {
+    /// Centre of the cell of point (`i`, `j`) (column, row) in PNG pixels.
+    pub fn cell_centre(&self, i: usize, j: usize, ny: usize) -> (u32, u32) {
+        let c = self.cell_px;
+        (
+            self.grid_origin.0 + i as u32 * c + c / 2,
+            self.grid_origin.1 + (ny - 1 - j) as u32 * c + c / 2,
+        )
+    }
+}
+
+const PAD: u32 = 16;
+const TITLE_PX: f32 = 20.0;
+const LABEL_PX: f32 = 14.0;
+
+fn validate(grid: &GridValues) -> Result<(), String> {
+    let n = grid.nx.checked_mul(grid.ny).unwrap_or(0);
+    if grid.nx == 0 || grid.ny == 0 || n > 1_000_000 {
+        return Err(format!(
+            "grid '{}' has {}×{} points (need at least 1×1, at most 10⁶)",
+            grid.name, grid.nx, grid.ny
+        ));
+    }
+    if grid.values.len() != n {
+        return Err(format!(
+            "grid '{}' has {} values, expected {}×{} = {n}",
+            grid.name,
+            grid.values.len(),
+            grid.nx,
+            grid.ny
+        ));
+    }
+    if !grid.stderr.is_empty() && grid.stderr.len() != n {
+        return Err(format!(
+            "grid '{}' has {} standard errors, expected {n} (or none)",
+            grid.name,
+            grid.stderr.len()
+        ));
+    }
+    if let Some(i) = grid
+        .values
+        .iter()
+        .chain(&grid.stderr)
+        .position(|v| !v.is_finite())
+    {
+        return Err(format!(
+            "grid '{}' has a non-finite value at index {}",
+            grid.name,
+            i % n
+        ));
+    }
+    let (a, b) = grid.size_m;
+    if !(a.is_finite() && b.is_finite() && a >= 0.0 && b >= 0.0) {
+        return Err(format!(
+            "grid '{}' has an invalid size {a} × {b} m",
+            grid.name
+        ));
+    }
+    Ok(())
+}
+
+/// Renders the heat map in memory (see [`write_grid_heatmap`]).
+pub fn render_grid_heatmap(
+    grid: &GridValues,
+    settings: &FalsecolourSettings,
+) -> Result<(RgbImage, HeatmapInfo), String> {
+    validate(grid)?;
+    let units = settings.units;
+    let q = Quantity::Illuminance;
+    let unit = units.symbol(q);
+    let shown: Vec<f64> = grid.values.iter().map(|&v| units.from_si(q, v)).collect();
+    let settings = FalsecolourSettings {
+        quantity: q,
+        ..settings.clone()
+    };
+    let cs = ColourScale::resolve(&settings, &shown)?;
+    let stats_si = GridStats::of(&grid.values, &grid.stderr).expect("grid is not empty");
+    let stats = stats_si.in_units(units);
+
+    let (nx, ny) = (grid.nx, grid.ny);
+    let cell = (840 / nx as u32).min(640 / ny as u32).clamp(28, 96);
+    let value_px = (cell as f32 * 0.30).min(16.0);
+
+    let ratio = |r: Option<f64>| r.map_or("–".to_string(), |r| format!("{r:.2}"));
+    let title_lines = vec![
+        format!("{} — illuminance ({unit})", grid.name),
+        format!(
+            "Emin {}   Eavg {}   Emax {} {unit}   U₀ = Emin/Eavg = {}   Emin/Emax = {}",
+            format_sig(stats.min, 4),
+            format_sig(stats.avg, 4),
+            format_sig(stats.max, 4),
+            ratio(stats.u0),
+            ratio(stats.min_over_max),
+        ),
+        {
+            let len = units.length_symbol();
+            let mut s = format!(
+                "{nx} × {ny} points, {} × {} {len}",
+                format_sig(units.length_from_m(grid.size_m.0), 4),
+                format_sig(units.length_from_m(grid.size_m.1), 4)
+            );
+            if let Some(e) = stats.max_stderr {
+                s += &format!("; largest standard error {} {unit}", format_sig(e, 3));
+            }
+            s
+        },
+    ];
+    let subtitle = describe_scale(&cs, unit);
+
+    let lh_title = draw::line_height(TITLE_PX);
+    let lh = draw::line_height(LABEL_PX);
+    let header_h = PAD + lh_title + 4 + (lh + 2) * 3 + 12 + lh + 6;
+    let axis_label_w = [0.0, grid.size_m.1 / 2.0, grid.size_m.1]
+        .iter()
+        .map(|&m| draw::text_width(LABEL_PX, &format_sig(units.length_from_m(m), 3)))
+        .max()
+        .unwrap_or(0)
+        .max(draw::text_width(LABEL_PX, "y (m)"));
+    let (gw, gh) = (nx as u32 * cell, ny as u32 * cell);
+    let gx = PAD + axis_label_w + 10;
+    let gy = header_h;
+    let clipped = (
+        shown.iter().any(|&v| v < cs.min),
+        shown.iter().any(|&v| v > cs.max),
+    );
+    let legend = Legend::new(&cs, unit, None, clipped, gh.max(260));
+    let footer_h = 8 + lh * 2 + PAD;
+    let body_h = gh.max(legend.height);
+    let mut width = gx + gw + 24 + legend.width + PAD;
+    for (t, px) in title_lines
+        .iter()
+        .map(|t| (t, LABEL_PX))
+        .chain([(&subtitle, LABEL_PX)])
+    {
+        width = width.max(2 * PAD + draw::text_width(px, t));
+    }
+    width = width.max(2 * PAD + draw::text_width(TITLE_PX, &title_lines[0]));
+    let height = header_h + body_h + footer_h;
+    let mut img = RgbImage::from_pixel(width, height, WHITE);
+
+    // Title block.
+    draw::draw_text(
+        &mut img,
+        PAD as i32,
+        PAD as i32,
+        TITLE_PX,
+        &title_lines[0],
+        BLACK,
+    );
+    let mut y = PAD + lh_title + 4;
+    for line in &title_lines[1..] {
+        draw::draw_text(&mut img, PAD as i32, y as i32, LABEL_PX, line, BLACK);
+        y += lh + 2;
+    }
+    draw::draw_text(
+        &mut img, PAD as i32, y as i32, LABEL_PX, &subtitle, DARK_GREY,
+    );
+
+    // Cells, row 0 at the bottom.
+    let separator = Rgb([255, 255, 255]);
+    for j in 0..ny {
+        for i in 0..nx {
+            let v = shown[j * nx + i];
+            let c = Rgb(cs.colour(v));
+            let x0 = (gx + i as u32 * cell) as i32;
+            let y0 = (gy + (ny - 1 - j) as u32 * cell) as i32;
+            draw::fill_rect(&mut img, x0, y0, cell, cell, c);
+            draw::stroke_rect(&mut img, x0, y0, cell, cell, separator);
+            let text = format_sig(v, 3);
+            let mut px = value_px;
+            while px > 7.0 && draw::text_width(px, &text) + 4 > cell {
+                px -= 1.0;
+            }
+            if px > 7.0 {
+                draw::draw_text_centred(
+                    &mut img,
+                    x0 + cell as i32 / 2,
+                    y0 + cell as i32 / 2,
+                    px,
+                    &text,
+                    draw::contrasting_text(c),
+                );
+            }
+        }
+    }
+    draw::stroke_rect(
+        &mut img,
+        gx as i32 - 1,
+        gy as i32 - 1,
+        gw + 2,
+        gh + 2,
+        DARK_GREY,
+    );
+
+    // Axes: ticks at 0, half and full extent.
+    let len = units.length_symbol();
+    for f in [0.0, 0.5, 1.0] {
+        let tx = gx as f32 + f * gw as f32;
+        let by = (gy + gh + 1) as f32;
+        draw::draw_line(&mut img, tx, by, tx, by + 4.0, BLACK);
+        let label = format_sig(units.length_from_m(f as f64 * grid.size_m.0), 3);
+        let w = draw::text_width(LABEL_PX, &label) as f32;
+        let lx = (tx - w / 2.0).max(gx as f32 - 4.0);
+        draw::draw_text(&mut img, lx as i32, by as i32 + 5, LABEL_PX, &label, BLACK);
+
+        let ty = (gy + gh) as f32 - f * gh as f32;
+        let ax = gx as f32 - 2.0;
+        draw::draw_line(&mut img, ax - 4.0, ty, ax, ty, BLACK);
+        let label = format_sig(units.length_from_m(f as f64 * grid.size_m.1), 3);
+        let w = draw::text_width(LABEL_PX, &label) as i32;
+        draw::draw_text(
+            &mut img,
+            ax as i32 - 6 - w,
+            ty as i32 - lh as i32 / 2,
+            LABEL_PX,
+            &label,
+            BLACK,
+        );
+    }
+    let xlabel = format!("x ({len}), row 0 at the bottom");
+    draw::draw_text(
+        &mut img,
+        gx as i32,
+        (gy + gh + 6 + lh) as i32,
+        LABEL_PX,
+        &xlabel,
+        DARK_GREY,
+    );
+    let ylabel = format!("y ({len})");
+    draw::draw_text(
+        &mut img,
+        PAD as i32,
+        gy as i32 - lh as i32 - 4,
+        LABEL_PX,
+        &ylabel,
+        DARK_GREY,
+    );
+
+    legend.draw(&mut img, (gx + gw + 24) as i32, gy as i32);
+
+    let info = HeatmapInfo {
+        stats_si,
+        stats,
+        unit: unit.to_string(),
+        title_lines,
+        scale: cs,
+        cell_px: cell,
+        grid_origin: (gx, gy),
+        image_size: (width, height),
+    };
+    Ok((img, info))
+}
+
+/// Writes the heat map of `grid` to `path` (PNG, atomically). `settings.quantity` and
+/// `settings.contours` are ignored (a grid holds illuminance; cells carry their values).
+/// Errors (inconsistent grid, bad range, I/O) name `path`.
+pub fn write_grid_heatmap(
+    path: &Path,
+    grid: &GridValues,
+    settings: &FalsecolourSettings,
+) -> Result<HeatmapInfo, OutputError> {
+    let (img, info) =
+        render_grid_heatmap(grid, settings).map_err(|e| OutputError::invalid(path, e))?;
+    write_png(path, &img)?;
+    Ok(info)
+}

@@ -1,0 +1,453 @@
+//! `candela probe`: the measured values of one pixel, or of a small disc of pixels, of a
+//! rendered EXR — luminance and illuminance with 95 % confidence intervals, XYZ, xy, u′v′,
+//! CCT, Duv and sRGB. See `docs/reports.md` for the text and JSON formats.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::anyhow;
+use serde_json::{json, Value};
+
+use super::units::{format_sig, Quantity, UnitSystem};
+use crate::colour::models::{xyz_to_upvp, xyz_to_xy};
+use crate::colour::rgb::{srgb_encode, xyz_to_linear_srgb};
+use crate::colour::temperature::xyz_to_cct_ohno2013;
+use crate::output::{
+    read_exr, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR, CHANNEL_X, CHANNEL_Y,
+    CHANNEL_Y_STDERR, CHANNEL_Z, ILLUMINANCE_SENTINEL,
+};
+
+/// z value of the two-sided 95 % normal confidence interval.
+pub const Z95: f64 = 1.96;
+
+/// Arguments of `candela probe`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ProbeArgs {
+    /// EXR image written by `candela render` (channels X, Y, Z, stderr.Y; E, stderr.E, mask.E
+    /// with --illuminance).
+    pub exr: PathBuf,
+    /// Column of the pixel, 0 = left.
+    #[arg(allow_hyphen_values = true)]
+    pub x: i64,
+    /// Row of the pixel, 0 = top.
+    #[arg(allow_hyphen_values = true)]
+    pub y: i64,
+    /// Average over every pixel whose centre is within R pixels of (X, Y).
+    #[arg(long, allow_hyphen_values = true)]
+    pub radius: Option<f64>,
+    /// Print JSON (keys documented in docs/reports.md) instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// si (cd/m², lx) or imperial (fL, fc).
+    #[arg(long, default_value = "si", value_parser = parse_units)]
+    pub units: UnitSystem,
+}
+
+/// clap value parser for `--units`.
+pub fn parse_units(s: &str) -> Result<UnitSystem, String> {
+    UnitSystem::parse(s).ok_or_else(|| format!("unknown unit system '{s}' (use si or imperial)"))
+}
+
+/// A mean with its standard error (display units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// Mean value.
+    pub mean: f64,
+    /// Standard error of the mean; `None` if the image has no error channel.
+    pub stderr: Option<f64>,
+}
+
+impl Estimate {
+    /// The 95 % confidence interval mean ± 1.96·SE.
+    pub fn ci95(&self) -> Option<(f64, f64)> {
+        self.stderr
+            .map(|se| (self.mean - Z95 * se, self.mean + Z95 * se))
+    }
+
+    fn to_json(self) -> Value {
+        json!({
+            "mean": self.mean,
+            "stderr": self.stderr,
+            "ci95": self.ci95().map(|(a, b)| [a, b]),
+        })
+    }
+}
+
+/// The illuminance part of a probe.
+#[derive(Clone, Debug, PartialEq)]
+pub enum IlluminanceProbe {
+    /// The image has no `E` channel (rendered without `--illuminance`).
+    NoChannel,
+    /// No probed pixel sees a surface (sky, emitter, nothing): illuminance is undefined.
+    Undefined,
+    /// Mean over the probed pixels where `E` is defined.
+    Defined {
+        /// Mean and standard error, display units.
+        estimate: Estimate,
+        /// How many of the probed pixels have `E` defined.
+        pixels: usize,
+        /// Mean of `mask.E` over all probed pixels (`None` without a mask channel).
+        mask_mean: Option<f64>,
+    },
+}
+
+/// Everything `candela probe` reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProbeResult {
+    /// Column and row of the centre pixel.
+    pub x: usize,
+    /// Row of the centre pixel.
+    pub y: usize,
+    /// Disc radius in pixels (`None` = the single pixel).
+    pub radius: Option<f64>,
+    /// Number of pixels averaged.
+    pub pixels: usize,
+    /// SI or imperial; luminance, XYZ and illuminance are in its units.
+    pub units: UnitSystem,
+    /// Luminance (mean of the pixels' means; SE = √(Σ SEᵢ²)/n).
+    pub luminance: Estimate,
+    /// Illuminance, likewise over the pixels where it is defined.
+    pub illuminance: IlluminanceProbe,
+    /// Mean absolute XYZ (display luminance units), if the image has X and Z.
+    pub xyz: Option<[f64; 3]>,
+    /// CIE 1931 chromaticity.
+    pub xy: Option<[f64; 2]>,
+    /// CIE 1976 UCS chromaticity.
+    pub upvp: Option<[f64; 2]>,
+    /// Correlated colour temperature (K) and Duv, Ohno (2013); `None` for black.
+    pub cct_duv: Option<[f64; 2]>,
+    /// Linear sRGB of XYZ / Y (white at Y = 1), not clipped.
+    pub srgb_linear: Option<[f64; 3]>,
+    /// IEC 61966-2-1 encoded sRGB of `srgb_linear`, not clipped.
+    pub srgb_encoded: Option<[f64; 3]>,
+}
+
+/// Probes pixel (`x`, `y`) (0, 0 = top-left) of `layers`, or the disc of pixels whose centres
+/// lie within `radius` pixels of it. Errors (no `Y` channel, pixel outside the image, bad
+/// radius) are messages without the file name.
+pub fn probe(
+    layers: &Layers,
+    x: i64,
+    y: i64,
+    radius: Option<f64>,
+    units: UnitSystem,
+) -> Result<ProbeResult, String> {
+    let (w, h) = (layers.width, layers.height);
+    let channels = || {
+        layers
+            .channels
+            .iter()
+            .map(|(n, _)| n.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let lum = layers.channel(CHANNEL_Y).ok_or_else(|| {
+        format!(
+            "no '{CHANNEL_Y}' (luminance) channel; the image has: {}",
+            channels()
+        )
+    })?;
+    if x < 0 || y < 0 || x as u64 >= w as u64 || y as u64 >= h as u64 {
+        return Err(format!(
+            "pixel ({x}, {y}) is outside the {w}×{h} image (x from 0 to {}, y from 0 to {}; 0, 0 = top-left)",
+            w as i64 - 1,
+            h as i64 - 1
+        ));
+    }
+    let (x, y) = (x as usize, y as usize);
+    if let Some(r) = radius {
+        if !r.is_finite() || r < 0.0 {
+            return Err(format!(
+                "--radius must be a finite number of pixels ≥ 0, got {r}"
+            ));
+        }
+    }
+
+    // The probed pixels.
+    let mut idx = Vec::new();
+    match radius {
+        None => idx.push(y * w + x),
+        Some(r) => {
+            let k = r.floor() as usize;
+            for j in y.saturating_sub(k)..=(y + k).min(h - 1) {
+                for i in x.saturating_sub(k)..=(x + k).min(w - 1) {
+                    let (dx, dy) = (i as f64 - x as f64, j as f64 - y as f64);
+                    if dx * dx + dy * dy <= r * r {
+                        idx.push(j * w + i);
+                    }
+                }
+            }
+        }
+    }
+    let mean_of =
+        |c: &[f32], ids: &[usize]| ids.iter().map(|&i| c[i] as f64).sum::<f64>() / ids.len() as f64;
+    // SE of a mean of independent pixel means: √(Σ SEᵢ²) / n.
+    let se_of = |c: &[f32], ids: &[usize]| {
+        ids.iter()
+            .map(|&i| (c[i] as f64).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / ids.len() as f64
+    };
+    let lq = Quantity::Luminance;
+    let luminance = Estimate {
+        mean: units.from_si(lq, mean_of(lum, &idx)),
+        stderr: layers
+            .channel(CHANNEL_Y_STDERR)
+            .map(|c| units.from_si(lq, se_of(c, &idx))),
+    };
+
+    let eq = Quantity::Illuminance;
+    let illuminance = match layers.channel(CHANNEL_E) {
+        None => IlluminanceProbe::NoChannel,
+        Some(e) => {
+            let mask = layers.channel(CHANNEL_E_MASK);
+            let defined: Vec<usize> = idx
+                .iter()
+                .copied()
+                .filter(|&i| {
+                    let v = e[i];
+                    v.is_finite()
+                        && v != ILLUMINANCE_SENTINEL
+                        && v >= 0.0
+                        && mask.is_none_or(|m| m[i] > 0.0)
+                })
+                .collect();
+            if defined.is_empty() {
+                IlluminanceProbe::Undefined
+            } else {
+                IlluminanceProbe::Defined {
+                    estimate: Estimate {
+                        mean: units.from_si(eq, mean_of(e, &defined)),
+                        stderr: layers
+                            .channel(CHANNEL_E_STDERR)
+                            .map(|c| units.from_si(eq, se_of(c, &defined))),
+                    },
+                    pixels: defined.len(),
+                    mask_mean: mask.map(|m| mean_of(m, &idx)),
+                }
+            }
+        }
+    };
+
+    let xyz_si = match (layers.channel(CHANNEL_X), layers.channel(CHANNEL_Z)) {
+        (Some(cx), Some(cz)) => Some([mean_of(cx, &idx), mean_of(lum, &idx), mean_of(cz, &idx)]),
+        _ => None,
+    };
+    let positive = xyz_si.filter(|v| v[1] > 0.0 && v.iter().all(|c| c.is_finite()));
+    let srgb_linear = positive.map(|v| xyz_to_linear_srgb(v.map(|c| c / v[1])));
+    let cct_duv = positive
+        .map(xyz_to_cct_ohno2013)
+        .filter(|c| c.iter().all(|v| v.is_finite()));
+    Ok(ProbeResult {
+        x,
+        y,
+        radius,
+        pixels: idx.len(),
+        units,
+        luminance,
+        illuminance,
+        xyz: xyz_si.map(|v| v.map(|c| units.from_si(lq, c))),
+        xy: xyz_si.map(xyz_to_xy),
+        upvp: xyz_si.map(xyz_to_upvp),
+        cct_duv,
+        srgb_linear,
+        srgb_encoded: srgb_linear.map(|v| v.map(srgb_encode)),
+    })
+}
+
+/// Reads `path` and probes it; every error names the file.
+pub fn probe_file(
+    path: &Path,
+    x: i64,
+    y: i64,
+    radius: Option<f64>,
+    units: UnitSystem,
+) -> anyhow::Result<ProbeResult> {
+    let layers = read_exr(path)?;
+    probe(&layers, x, y, radius, units).map_err(|e| anyhow!("{}: {e}", path.display()))
+}
+
+/// `candela probe`: returns the text (or JSON) to print.
+pub fn run(args: &ProbeArgs) -> anyhow::Result<String> {
+    // Flatten to one line: the messages already name the file and their cause.
+    let r = probe_file(&args.exr, args.x, args.y, args.radius, args.units)
+        .map_err(|e| anyhow!("{e}"))?;
+    if args.json {
+        let mut v = r.to_json();
+        v["file"] = json!(args.exr.display().to_string());
+        Ok(serde_json::to_string_pretty(&v)? + "\n")
+    } else {
+        Ok(r.to_text(&args.exr.display().to_string()))
+    }
+}
+
+fn fmt3(v: [f64; 3], digits: usize) -> String {
+    format!(
+        "{:.*} {:.*} {:.*}",
+        digits, v[0], digits, v[1], digits, v[2]
+    )
+}
+
+fn estimate_text(e: &Estimate, unit: &str) -> String {
+    match (e.stderr, e.ci95()) {
+        (Some(se), Some((lo, hi))) => format!(
+            "{} ± {} {unit}   (95 % CI {} … {}; standard error {})",
+            format_sig(e.mean, 5),
+            format_sig(Z95 * se, 3),
+            format_sig(lo, 5),
+            format_sig(hi, 5),
+            format_sig(se, 3)
+        ),
+        _ => format!(
+            "{} {unit}   (no standard error channel: confidence interval unknown)",
+            format_sig(e.mean, 5)
+        ),
+    }
+}
+
+impl ProbeResult {
+    /// JSON with the keys documented in docs/reports.md (`file` is added by the command).
+    pub fn to_json(&self) -> Value {
+        let u = self.units;
+        let illuminance = match &self.illuminance {
+            IlluminanceProbe::NoChannel => Value::Null,
+            IlluminanceProbe::Undefined => json!({
+                "defined": false,
+                "reason": "pixel sees no surface",
+                "pixels": 0,
+                "mean": null, "stderr": null, "ci95": null,
+            }),
+            IlluminanceProbe::Defined {
+                estimate,
+                pixels,
+                mask_mean,
+            } => {
+                let mut v = estimate.to_json();
+                v["defined"] = json!(true);
+                v["pixels"] = json!(pixels);
+                v["mask_mean"] = json!(mask_mean);
+                v
+            }
+        };
+        json!({
+            "x": self.x,
+            "y": self.y,
+            "radius_px": self.radius,
+            "pixels": self.pixels,
+            "units": {
+                "system": u.name(),
+                "luminance": u.symbol(Quantity::Luminance),
+                "illuminance": u.symbol(Quantity::Illuminance),
+            },
+            "luminance": self.luminance.to_json(),
+            "illuminance": illuminance,
+            "xyz": self.xyz,
+            "xy": self.xy,
+            "upvp": self.upvp,
+            "cct_k": self.cct_duv.map(|c| c[0]),
+            "duv": self.cct_duv.map(|c| c[1]),
+            "srgb_linear": self.srgb_linear,
+            "srgb_encoded": self.srgb_encoded,
+        })
+    }
+
+    /// The human-readable report; `file` names the image in the first line.
+    pub fn to_text(&self, file: &str) -> String {
+        let u = self.units;
+        let lu = u.symbol(Quantity::Luminance);
+        let eu = u.symbol(Quantity::Illuminance);
+        let mut s = match self.radius {
+            None => format!("{file}: pixel ({}, {})\n", self.x, self.y),
+            Some(r) => format!(
+                "{file}: disc of radius {} px around pixel ({}, {}): {} pixel{}\n",
+                format_sig(r, 4),
+                self.x,
+                self.y,
+                self.pixels,
+                if self.pixels == 1 { "" } else { "s" }
+            ),
+        };
+        let row = |s: &mut String, k: &str, v: String| s.push_str(&format!("  {k:<13} {v}\n"));
+        row(&mut s, "luminance", estimate_text(&self.luminance, lu));
+        let e = match &self.illuminance {
+            IlluminanceProbe::NoChannel => {
+                "no E channel in this image (render with --illuminance)".to_string()
+            }
+            IlluminanceProbe::Undefined => "undefined: pixel sees no surface".to_string(),
+            IlluminanceProbe::Defined {
+                estimate,
+                pixels,
+                mask_mean,
+            } => {
+                let mut t = estimate_text(estimate, eu);
+                if *pixels < self.pixels {
+                    t += &format!(
+                        "; over the {pixels} of {} pixels that see a surface",
+                        self.pixels
+                    );
+                }
+                if let Some(m) = mask_mean {
+                    if *m < 1.0 {
+                        t += &format!("; coverage {}", format_sig(*m, 3));
+                    }
+                }
+                t
+            }
+        };
+        row(&mut s, "illuminance", e);
+        match self.xyz {
+            None => row(&mut s, "XYZ", "no X/Z channels".to_string()),
+            Some(v) => {
+                row(
+                    &mut s,
+                    "XYZ",
+                    format!(
+                        "{} {} {} {lu}",
+                        format_sig(v[0], 5),
+                        format_sig(v[1], 5),
+                        format_sig(v[2], 5)
+                    ),
+                );
+            }
+        }
+        if let Some(v) = self.xy {
+            row(&mut s, "xy", format!("{:.4} {:.4}", v[0], v[1]));
+        }
+        if let Some(v) = self.upvp {
+            row(&mut s, "u′v′", format!("{:.4} {:.4}", v[0], v[1]));
+        }
+        match self.cct_duv {
+            Some([t, duv]) => {
+                let mut line = format!("{t:.0} K   Duv {duv:+.4}");
+                if duv.abs() > 0.05 {
+                    line += "  (|Duv| > 0.05: CCT is not meaningful)";
+                }
+                row(&mut s, "CCT", line);
+            }
+            None if self.xyz.is_some() => row(&mut s, "CCT", "undefined (black)".into()),
+            None => {}
+        }
+        if let (Some(l), Some(e)) = (self.srgb_linear, self.srgb_encoded) {
+            let gamut = if l.iter().any(|&c| !(-1e-9..=1.0 + 1e-9).contains(&c)) {
+                "  (outside 0…1: out of gamut or brighter than white)"
+            } else {
+                ""
+            };
+            row(
+                &mut s,
+                "sRGB linear",
+                format!("{}   (Y = 1){gamut}", fmt3(l, 4)),
+            );
+            let hex: Vec<String> = e
+                .iter()
+                .map(|c| format!("{:02X}", (c.clamp(0.0, 1.0) * 255.0).round() as u8))
+                .collect();
+            row(
+                &mut s,
+                "sRGB encoded",
+                format!("{}   #{}", fmt3(e, 4), hex.concat()),
+            );
+        }
+        s
+    }
+}
