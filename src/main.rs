@@ -4,6 +4,7 @@ use anyhow::{bail, Context, Result};
 use candela::colour::tables::Observer;
 use candela::output::{self, Layers, PngSettings};
 use candela::report::json::{grid_csv, grid_csv_path, report_json, write_text, ReportInput, Units};
+use candela::report::units::Quantity;
 use candela::scene::{self, Overrides};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -76,6 +77,9 @@ enum Command {
         /// Also write NAME.state at the end (for --resume to more samples, or `candela merge`).
         #[arg(long)]
         save_state: bool,
+        /// Also write false-colour maps NAME.luminance.png (and NAME.illuminance.png with --illuminance), automatic range; `candela falsecolour` offers every option.
+        #[arg(long)]
+        falsecolour: bool,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
@@ -157,6 +161,7 @@ fn main() -> ExitCode {
             checkpoint_interval,
             resume,
             save_state,
+            falsecolour,
             quiet,
         } => cmd_render(RenderArgs {
             scene_path: &scene,
@@ -182,6 +187,7 @@ fn main() -> ExitCode {
             checkpoint_interval,
             resume,
             save_state,
+            falsecolour,
             quiet,
         }),
         Command::Merge {
@@ -262,6 +268,7 @@ struct RenderArgs<'a> {
     checkpoint_interval: std::time::Duration,
     resume: bool,
     save_state: bool,
+    falsecolour: bool,
     quiet: bool,
 }
 
@@ -468,6 +475,39 @@ fn cmd_render(a: RenderArgs) -> Result<()> {
         let path = grid_csv_path(&stem, &g.name);
         write_text(&path, &grid_csv(&world, k, est, units))?;
         outputs.push(path.display().to_string());
+        let png = path.with_extension("png");
+        let values = candela::report::heatmap::GridValues {
+            name: g.name.clone(),
+            nx: g.nx as usize,
+            ny: g.ny as usize,
+            values: est.iter().map(|e| e.mean).collect(),
+            stderr: est.iter().map(|e| e.stderr).collect(),
+            size_m: (g.edge_u.length() as f64, g.edge_v.length() as f64),
+        };
+        let settings = candela::report::falsecolour::FalsecolourSettings {
+            quantity: Quantity::Illuminance,
+            units,
+            ..Default::default()
+        };
+        candela::report::heatmap::write_grid_heatmap(&png, &values, &settings)?;
+        outputs.push(png.display().to_string());
+    }
+    if a.falsecolour {
+        let layers = output::read_exr(&exr_path)?;
+        let mut quantities = vec![(Quantity::Luminance, ".luminance.png")];
+        if world.settings.illuminance {
+            quantities.push((Quantity::Illuminance, ".illuminance.png"));
+        }
+        for (q, suffix) in quantities {
+            let path = with_suffix(&stem, suffix);
+            let settings = candela::report::falsecolour::FalsecolourSettings {
+                quantity: q,
+                units,
+                ..Default::default()
+            };
+            candela::report::falsecolour::write_falsecolour(&path, &layers, &settings)?;
+            outputs.push(path.display().to_string());
+        }
     }
     let report_path = {
         let mut p = stem.clone().into_os_string();
@@ -486,12 +526,14 @@ fn cmd_render(a: RenderArgs) -> Result<()> {
     write_text(&report_path, &serde_json::to_string_pretty(&report)?)?;
     for (m, e) in world.meters.iter().zip(&measurements.meters) {
         let (k, unit) = match m.kind {
-            candela::meter::MeterKind::Illuminance { .. } => {
-                (units.illuminance_factor(), units.illuminance_symbol())
-            }
-            candela::meter::MeterKind::Luminance { .. } => {
-                (units.luminance_factor(), units.luminance_symbol())
-            }
+            candela::meter::MeterKind::Illuminance { .. } => (
+                units.from_si(Quantity::Illuminance, 1.0),
+                units.symbol(Quantity::Illuminance),
+            ),
+            candela::meter::MeterKind::Luminance { .. } => (
+                units.from_si(Quantity::Luminance, 1.0),
+                units.symbol(Quantity::Luminance),
+            ),
         };
         println!(
             "meter {:?}: {:.4} ± {:.4} {unit} (95 %, {} samples)",
@@ -503,7 +545,10 @@ fn cmd_render(a: RenderArgs) -> Result<()> {
     }
     for (g, est) in world.grids.iter().zip(&measurements.grids) {
         let s = candela::meter::grid_stats(est);
-        let (k, u) = (units.illuminance_factor(), units.illuminance_symbol());
+        let (k, u) = (
+            units.from_si(Quantity::Illuminance, 1.0),
+            units.symbol(Quantity::Illuminance),
+        );
         println!(
             "grid {:?} ({}×{}): E_min {:.2} {u}, E_avg {:.2} {u}, E_max {:.2} {u}, U0 {:.3}",
             g.name,

@@ -8,50 +8,8 @@ use crate::world::World;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
-/// The unit system of reports.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Units {
-    /// lx and cd/m².
-    #[default]
-    Si,
-    /// footcandles and footlamberts.
-    Imperial,
-}
-
-impl Units {
-    pub fn illuminance_symbol(self) -> &'static str {
-        match self {
-            Units::Si => "lx",
-            Units::Imperial => "fc",
-        }
-    }
-    pub fn luminance_symbol(self) -> &'static str {
-        match self {
-            Units::Si => "cd/m^2",
-            Units::Imperial => "fL",
-        }
-    }
-    /// Factor from lx to this system's illuminance unit.
-    pub fn illuminance_factor(self) -> f64 {
-        match self {
-            Units::Si => 1.0,
-            Units::Imperial => crate::photometry::convert(1.0, "lx", "fc").expect("lx→fc"),
-        }
-    }
-    /// Factor from cd/m² to this system's luminance unit.
-    pub fn luminance_factor(self) -> f64 {
-        match self {
-            Units::Si => 1.0,
-            Units::Imperial => crate::photometry::convert(1.0, "cd/m2", "fL").expect("nit→fL"),
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            Units::Si => "si",
-            Units::Imperial => "imperial",
-        }
-    }
-}
+use super::units::Quantity;
+pub use super::units::UnitSystem as Units;
 
 fn v3(v: glam::Vec3) -> Value {
     json!([v.x, v.y, v.z])
@@ -123,8 +81,8 @@ fn stats(values: impl Iterator<Item = f64>) -> Value {
 
 /// Build the JSON report.
 pub fn report_json(r: &ReportInput) -> Value {
-    let ke = r.units.illuminance_factor();
-    let kl = r.units.luminance_factor();
+    let ke = r.units.from_si(Quantity::Illuminance, 1.0);
+    let kl = r.units.from_si(Quantity::Luminance, 1.0);
     let w = r.world;
     let film = &r.render.film;
     let luminance = stats(film.pixels.iter().map(|p| p.mean_xyz()[1] * kl));
@@ -147,7 +105,7 @@ pub fn report_json(r: &ReportInput) -> Value {
                 let mut v = estimate(e, ke);
                 v["name"] = json!(m.name);
                 v["kind"] = json!("illuminance");
-                v["unit"] = json!(r.units.illuminance_symbol());
+                v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
                 v["position"] = v3(*position);
                 v["normal"] = v3(*normal);
                 v
@@ -160,7 +118,7 @@ pub fn report_json(r: &ReportInput) -> Value {
                 let mut v = estimate(e, kl);
                 v["name"] = json!(m.name);
                 v["kind"] = json!("luminance");
-                v["unit"] = json!(r.units.luminance_symbol());
+                v["unit"] = json!(r.units.symbol(Quantity::Luminance));
                 v["position"] = v3(*position);
                 v["direction"] = v3(*direction);
                 v["half_angle_deg"] = json!(half_angle_rad.to_degrees());
@@ -186,7 +144,7 @@ pub fn report_json(r: &ReportInput) -> Value {
             };
             json!({
                 "name": g.name,
-                "unit": r.units.illuminance_symbol(),
+                "unit": r.units.symbol(Quantity::Illuminance),
                 "nx": g.nx, "ny": g.ny,
                 "origin": v3(g.origin), "edge_u": v3(g.edge_u), "edge_v": v3(g.edge_v), "normal": v3(g.normal),
                 "values": rows(&|e| json!(e.mean * ke)),
@@ -206,8 +164,8 @@ pub fn report_json(r: &ReportInput) -> Value {
         "scene": r.scene_path.display().to_string(),
         "units": {
             "system": r.units.name(),
-            "luminance": r.units.luminance_symbol(),
-            "illuminance": r.units.illuminance_symbol(),
+            "luminance": r.units.symbol(Quantity::Luminance),
+            "illuminance": r.units.symbol(Quantity::Illuminance),
             "length": "m",
         },
         "settings": {
@@ -234,8 +192,8 @@ pub fn report_json(r: &ReportInput) -> Value {
 /// The CSV of one grid: one row per point.
 pub fn grid_csv(world: &World, grid: usize, est: &[Estimate], units: Units) -> String {
     let g = &world.grids[grid];
-    let k = units.illuminance_factor();
-    let u = units.illuminance_symbol();
+    let k = units.from_si(Quantity::Illuminance, 1.0);
+    let u = units.symbol(Quantity::Illuminance);
     let mut s = format!(
         "# candela {} grid {:?}: illuminance on the plane facing ({}, {}, {}); positions in m\ni,j,x,y,z,E_{u},stderr_{u},ci95_low_{u},ci95_high_{u},samples\n",
         env!("CARGO_PKG_VERSION"),
