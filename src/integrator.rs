@@ -109,6 +109,7 @@ pub fn radiance(
             break;
         }
 
+        material.prepare(wl);
         let frame = Frame::from_normal(hit.ns);
         let wo_world = -ray_d;
         let wo = frame.to_local(wo_world);
@@ -120,7 +121,12 @@ pub fn radiance(
         let u_light = sampler.get1d();
         let u_prim = sampler.get1d();
         let u_pt = sampler.get2d();
-        if let Some((k, p_select)) = world.light_sampler.sample(u_light) {
+        let light_sample = if material.is_specular() {
+            None
+        } else {
+            world.light_sampler.sample(u_light)
+        };
+        if let Some((k, p_select)) = light_sample {
             let light = &world.lights[k];
             if let Some(ls) = light.sample_li(&world.geometry, hit.p, u_prim, u_pt, wl) {
                 if ls.pdf > 0.0 && !ls.li.is_black() {
@@ -133,7 +139,7 @@ pub fn radiance(
                             let w = if ls.delta {
                                 1.0
                             } else {
-                                power_heuristic(pdf, material.pdf(wo, wi))
+                                power_heuristic(pdf, material.pdf(wo, wi, wl))
                             };
                             l += beta * f * ls.li * (w / pdf);
                         }
