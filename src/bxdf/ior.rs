@@ -50,12 +50,16 @@ impl Ior {
     pub fn is_constant(&self) -> bool {
         matches!(self, Ior::Constant(_))
     }
-    /// Smallest and largest index over 360–830 nm (for validation).
+    /// Smallest and largest index over 360–830 nm (for validation; NaN if any value is not
+    /// finite).
     pub fn range(&self) -> (f32, f32) {
         let mut lo = f32::MAX;
         let mut hi = f32::MIN;
         for nm in 360..=830 {
             let n = self.at(nm as f32);
+            if !n.is_finite() {
+                return (f32::NAN, f32::NAN);
+            }
             lo = lo.min(n);
             hi = hi.max(n);
         }
