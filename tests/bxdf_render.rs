@@ -107,3 +107,70 @@ fn prism_deviates_shorter_wavelengths_more() {
         "δ(550) = {d550}, expected {expected}"
     );
 }
+
+/// Luminance of a point on a rough plane lit by a quad light, rendered (light sampling and
+/// BSDF sampling combined by MIS) and by direct quadrature of f cos θ over the light.
+#[test]
+fn rough_materials_under_an_area_light_match_quadrature() {
+    let le = 1000.0f64;
+    let cam_dir = Vec3::new(40f32.to_radians().sin(), 40f32.to_radians().cos(), 0.0);
+    let cam = cam_dir * 2.0;
+    for m in [
+        r#"Conductor(n: Constant(0.3), k: Constant(3.0), roughness: 0.3)"#,
+        r#"Conductor(n: Constant(1.2), k: Constant(2.0), roughness: 0.15, roughness_v: 0.5, distribution: Beckmann)"#,
+        r#"Conductor(n: Constant(0.3), k: Constant(3.0), roughness: 0.3, masking: VCavity)"#,
+        r#"Dielectric(ior: Constant(1.5), roughness: 0.2)"#,
+        r#"Phong(diffuse: Constant(0.3), specular: Constant(0.6), exponent: 40)"#,
+        r#"OrenNayar(reflectance: Constant(0.8), sigma_deg: 30)"#,
+    ] {
+        let text = format!(
+            r#"(
+            camera: (position: ({}, {}, {}), look_at: (0, 0, 0), vfov_deg: 0.01, resolution: (1, 1)),
+            render: (spp: 40000, max_depth: 1),
+            materials: {{ "m": {m} }},
+            objects: [
+                (shape: Disk(center: (0, 0, 0), normal: (0, 1, 0), radius: 1), material: "m"),
+                (shape: Quad(origin: (-1.51, 1.5, -0.25), edge_u: (0.5, 0, 0), edge_v: (0, 0, 0.5)),
+                 material: "black", emission: (spectrum: Named("E"), amount: Luminance({le}))),
+            ],
+        )"#,
+            cam.x, cam.y, cam.z
+        );
+        let w = world(&text);
+        let film = render(&w, 2);
+        let (y, se) = image_mean(&film);
+        // Quadrature over the light (f is the same at every wavelength here).
+        let mat = &w.materials[1];
+        let frame = Frame::from_normal(Vec3::Y);
+        let wo = frame.to_local(cam_dir);
+        let wl = SampledWavelengths::sample_uniform(0.5);
+        let n = 400;
+        let mut sum = 0.0f64;
+        for i in 0..n {
+            for j in 0..n {
+                let q = Vec3::new(
+                    -1.51 + 0.5 * (i as f32 + 0.5) / n as f32,
+                    1.5,
+                    -0.25 + 0.5 * (j as f32 + 0.5) / n as f32,
+                );
+                let r2 = q.length_squared();
+                let wi_w = q / r2.sqrt();
+                let cos_l = wi_w.y; // light faces −y
+                let da = 0.25 / (n * n) as f32;
+                let wi = frame.to_local(wi_w);
+                sum += (mat.eval(wo, wi, &wl)[0] * wi.z * cos_l / r2 * da) as f64;
+            }
+        }
+        let expected = le * sum;
+        println!(
+            "{m:100} rendered {:.4} ± {:.4}, quadrature {expected:.4}",
+            y[1], se
+        );
+        assert!(
+            (y[1] - expected).abs() <= 5.0 * se + 1e-3 * expected,
+            "{m}: rendered {} ± {se}, quadrature {expected}",
+            y[1]
+        );
+        assert!(se < 0.02 * expected);
+    }
+}
