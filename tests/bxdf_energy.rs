@@ -271,6 +271,26 @@ fn furnace_lossless_smooth_materials() {
         }
         assert_eq!(tr.wi, -wo);
     }
+    // Thin slab: the reflected fraction of samples is R(θ) (binomial standard error).
+    for t in [20.0f32, 75.0] {
+        let wo = dir_deg(t, 0.0);
+        let m = thin(1.5);
+        let n = 200_000;
+        let mut refl = 0usize;
+        for _ in 0..n {
+            let mut wl = wl0;
+            if m.sample(wo, rng.f32(), rng.vec2(), &mut wl).unwrap().wi.z > 0.0 {
+                refl += 1;
+            }
+        }
+        let r = candela::bxdf::thin_dielectric::thin_slab_reflectance(wo.z, 1.5) as f64;
+        let se = (r * (1.0 - r) / n as f64).sqrt();
+        let frac = refl as f64 / n as f64;
+        assert!(
+            (frac - r).abs() <= z_two_sided(0.01 / 2.0) * se,
+            "thin θ={t}: {frac} vs {r}"
+        );
+    }
     // Smooth metal: exactly F(θ) per wavelength, nothing else.
     let au = ior::named_metal("Au").unwrap();
     let m = conductor("Au", Ggx, 0.0, 0.0, Smith);

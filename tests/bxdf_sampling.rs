@@ -101,8 +101,32 @@ fn sampling_matches_pdf_chi_square() {
     let alpha = 0.01 / cases.len() as f64;
     let mut failures = Vec::new();
     let mut worst = (1.0f64, String::new());
-    for (k, (name, m, wo)) in cases.iter().enumerate() {
-        let r = chi2_test(m, *wo, 100_000, 18, 1000 + k as u64);
+    // The cases are independent: run them on two threads (the tests' machine has 2 cores).
+    let results: Vec<Chi2Result> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..2)
+            .map(|t| {
+                let cases = &cases;
+                s.spawn(move || {
+                    (0..cases.len())
+                        .filter(|k| k % 2 == t)
+                        .map(|k| {
+                            (
+                                k,
+                                chi2_test(&cases[k].1, cases[k].2, 100_000, 18, 1000 + k as u64),
+                            )
+                        })
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        let mut all: Vec<(usize, Chi2Result)> = handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect();
+        all.sort_by_key(|r| r.0);
+        all.into_iter().map(|r| r.1).collect()
+    });
+    for ((name, _, _), r) in cases.iter().zip(results) {
         println!(
             "{name:55} χ² = {:8.2}  dof = {:4}  p = {:.4}  ∫pdf = {:.5}",
             r.stat, r.dof, r.p_value, r.pdf_integral
