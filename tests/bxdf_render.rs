@@ -32,6 +32,7 @@ fn white_furnace_lossless_objects_are_invisible() {
         "Dielectric(ior: Glass(\"SF11\"))",
         "ThinDielectric(ior: Constant(1.5))",
         "Coated(base: Constant(1.0), ior: 1.5)",
+        "Coated(base: Constant(1.0), ior: 1.5, roughness: 0.3)",
     ] {
         let film = render(&world(&furnace_scene(m)), 2);
         let (mean, se) = image_mean(&film);

@@ -76,6 +76,16 @@ fn cases() -> Vec<(String, Material, Vec3)> {
             dir_deg(t, p),
         ));
         v.push((
+            format!("coated GGX α=0.2 θo={t}"),
+            rough_coated(0.5, 1.5, Ggx, 0.2),
+            dir_deg(t, p),
+        ));
+        v.push((
+            format!("coated Beckmann α=0.5 θo={t}"),
+            rough_coated(0.9, 1.8, Beckmann, 0.5),
+            dir_deg(t, p),
+        ));
+        v.push((
             format!("Oren–Nayar σ=30° θo={t}"),
             oren_nayar(0.7, 30.0),
             dir_deg(t, p),

@@ -40,6 +40,7 @@ fn documented_forms_build() {
         r#""m": ThinDielectric(ior: Constant(1.52))"#,
         r#""m": Coated(base: Rgb(0.6, 0.05, 0.05), ior: 1.5)"#,
         r#""m": Coated(base: Constant(0.5))"#,
+        r#""m": Coated(base: Constant(0.5), roughness: 0.2, distribution: Beckmann)"#,
         r#""m": OrenNayar(reflectance: Rgb(0.5, 0.3, 0.2), sigma_deg: 20)"#,
         r#""m": Phong(diffuse: Constant(0.4), specular: Constant(0.5), exponent: 50)"#,
         r#""m": Phong(specular: Constant(0.9), exponent: 500)"#,

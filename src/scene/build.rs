@@ -748,14 +748,23 @@ fn build_material(ctx: &Ctx, field: &str, m: &MaterialDesc) -> Result<Material, 
         MaterialDesc::ThinDielectric { ior } => Material::ThinDielectric(bxdf::ThinDielectric {
             ior: dielectric_ior(ior)?,
         }),
-        MaterialDesc::Coated { base, ior } => {
+        MaterialDesc::Coated {
+            base,
+            ior,
+            roughness,
+            distribution,
+        } => {
             if !ior.is_finite() || *ior <= 0.0 {
                 return Err(ctx.err(
                     format!("{field}.ior"),
                     format!("the refractive index must be finite and greater than 0, got {ior}"),
                 ));
             }
-            Material::Coated(bxdf::Coated::new(refl("base", base)?, *ior))
+            Material::Coated(bxdf::Coated::new(
+                refl("base", base)?,
+                *ior,
+                microfacet(*distribution, MaskingDesc::Smith, *roughness, None)?,
+            ))
         }
         MaterialDesc::Diffuse { .. } | MaterialDesc::Black => unreachable!("handled by build"),
     })

@@ -169,11 +169,16 @@ pub enum MaterialDesc {
     },
     /// Thin slab (window pane): mirror reflection and undeviated transmission.
     ThinDielectric { ior: IorDesc },
-    /// Diffuse base under a smooth clear coating of constant index (plastic, varnish).
+    /// Diffuse base under a clear coating of constant index (plastic, varnish); the coat is
+    /// smooth when roughness = 0 (default).
     Coated {
         base: SpectrumDesc,
         #[serde(default = "default_coat_ior")]
         ior: f32,
+        #[serde(default)]
+        roughness: f32,
+        #[serde(default)]
+        distribution: DistributionDesc,
     },
     /// Absorbs all light.
     Black,

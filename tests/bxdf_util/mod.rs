@@ -84,7 +84,15 @@ pub fn thin(n: f32) -> Material {
 }
 
 pub fn coated(rho: f32, eta: f32) -> Material {
-    Material::Coated(Coated::new(DenseSpectrum::constant(rho), eta))
+    rough_coated(rho, eta, Distribution::Ggx, 0.0)
+}
+
+pub fn rough_coated(rho: f32, eta: f32, dist: Distribution, alpha: f32) -> Material {
+    Material::Coated(Coated::new(
+        DenseSpectrum::constant(rho),
+        eta,
+        Microfacet::isotropic(dist, alpha),
+    ))
 }
 
 pub fn diffuse(rho: f32) -> Material {
