@@ -5,6 +5,13 @@
 //! `wi` toward the light; both are unit vectors leaving the surface. `eval` returns f(wo, wi)
 //! in sr⁻¹ without the cosine; `sample` returns f, the sampled `wi` and its pdf w.r.t. solid
 //! angle. Each material family lives in its own file.
+//!
+//! Wavelengths: `eval` and `sample` return one value per lane of [`SampledWavelengths`]. A
+//! material whose scattering *directions* depend on wavelength (a dispersive dielectric) keeps
+//! only the hero wavelength — in [`Material::prepare`] for rough lobes (before light sampling),
+//! in `sample` when a smooth interface refracts — through
+//! [`SampledWavelengths::terminate_secondary`]; it then returns values in lane 0 only, and `pdf`
+//! is always the hero wavelength's.
 
 pub mod coated;
 pub mod conductor;
