@@ -155,6 +155,7 @@ pub fn trace(
             break;
         }
 
+        material.prepare(wl);
         let frame = Frame::from_normal(hit.ns);
         let wo_world = -ray_d;
         let wo = frame.to_local(wo_world);
@@ -166,7 +167,12 @@ pub fn trace(
         let u_light = sampler.get1d();
         let u_prim = sampler.get1d();
         let u_pt = sampler.get2d();
-        if let Some((k, p_select)) = world.light_sampler.sample(u_light) {
+        let light_sample = if material.is_specular() {
+            None
+        } else {
+            world.light_sampler.sample(u_light)
+        };
+        if let Some((k, p_select)) = light_sample {
             let light = &world.lights[k];
             if let Some(ls) = light.sample_li(&world.geometry, hit.p, u_prim, u_pt, wl) {
                 if ls.pdf > 0.0 && !ls.li.is_black() {
@@ -179,7 +185,7 @@ pub fn trace(
                             let w = if ls.delta {
                                 1.0
                             } else {
-                                power_heuristic(pdf, material.pdf(wo, wi))
+                                power_heuristic(pdf, material.pdf(wo, wi, wl))
                             };
                             l += beta * f * ls.li * (w / pdf);
                         }

@@ -5,13 +5,37 @@
 //! `wi` toward the light; both are unit vectors leaving the surface. `eval` returns f(wo, wi)
 //! in sr⁻¹ without the cosine; `sample` returns f, the sampled `wi` and its pdf w.r.t. solid
 //! angle. Each material family lives in its own file.
+//!
+//! Wavelengths: `eval` and `sample` return one value per lane of [`SampledWavelengths`]. A
+//! material whose scattering *directions* depend on wavelength (a dispersive dielectric) keeps
+//! only the hero wavelength — in [`Material::prepare`] for rough lobes (before light sampling),
+//! in `sample` when a smooth interface refracts — through
+//! [`SampledWavelengths::terminate_secondary`]; it then returns values in lane 0 only, and `pdf`
+//! is always the hero wavelength's.
 
+pub mod coated;
+pub mod conductor;
+pub mod dielectric;
 pub mod diffuse;
+pub mod fresnel;
+pub mod ior;
+pub mod microfacet;
+pub mod oren_nayar;
+pub mod phong;
+pub mod thin_dielectric;
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
+pub use coated::Coated;
+pub use conductor::Conductor;
+pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use ior::{ConductorIor, Ior};
+pub use microfacet::{Distribution, Masking, Microfacet};
+pub use oren_nayar::OrenNayar;
+pub use phong::Phong;
+pub use thin_dielectric::ThinDielectric;
 
 /// Every material the renderer knows. The integrator only calls the methods below, so a new
 /// family is one new variant and one new file.
@@ -19,6 +43,18 @@ pub use diffuse::Diffuse;
 pub enum Material {
     /// Lambertian reflection.
     Diffuse(Diffuse),
+    /// Oren–Nayar rough diffuse reflection.
+    OrenNayar(OrenNayar),
+    /// Energy-normalised modified Phong.
+    Phong(Phong),
+    /// Metal: smooth mirror or microfacet reflection with complex-index Fresnel.
+    Conductor(Conductor),
+    /// Glass interface: smooth or rough reflection and refraction, possibly dispersive.
+    Dielectric(Dielectric),
+    /// Thin dielectric slab: mirror reflection and straight transmission.
+    ThinDielectric(ThinDielectric),
+    /// Diffuse base under a smooth dielectric coating ("plastic").
+    Coated(Coated),
     /// Absorbs everything (an emitter that reflects nothing, or a light-trap).
     Black,
 }
@@ -37,9 +73,27 @@ pub struct BsdfSample {
 }
 
 impl Material {
+    /// Called once per surface hit, before `eval`, `pdf` or `sample`: a material whose
+    /// scattering directions depend on wavelength (a rough dispersive dielectric) keeps only
+    /// the hero wavelength here, so that light sampling and BSDF sampling at this vertex
+    /// agree on the wavelengths they carry.
+    #[inline]
+    pub fn prepare(&self, wl: &mut SampledWavelengths) {
+        if let Material::Dielectric(d) = self {
+            d.prepare(wl);
+        }
+    }
+
+    /// f(wo, wi) per wavelength, sr⁻¹, without the cosine; zero for delta lobes.
     pub fn eval(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
         match self {
             Material::Diffuse(d) => d.eval(wo, wi, wl),
+            Material::OrenNayar(m) => m.eval(wo, wi, wl),
+            Material::Phong(m) => m.eval(wo, wi, wl),
+            Material::Conductor(m) => m.eval(wo, wi, wl),
+            Material::Dielectric(m) => m.eval(wo, wi, wl),
+            Material::ThinDielectric(_) => SampledSpectrum::ZERO,
+            Material::Coated(m) => m.eval(wo, wi, wl),
             Material::Black => SampledSpectrum::ZERO,
         }
     }
@@ -51,16 +105,38 @@ impl Material {
         u: Vec2,
         wl: &mut SampledWavelengths,
     ) -> Option<BsdfSample> {
-        let _ = uc;
         match self {
             Material::Diffuse(d) => d.sample(wo, u, wl),
+            Material::OrenNayar(m) => m.sample(wo, u, wl),
+            Material::Phong(m) => m.sample(wo, uc, u, wl),
+            Material::Conductor(m) => m.sample(wo, u, wl),
+            Material::Dielectric(m) => m.sample(wo, uc, u, wl),
+            Material::ThinDielectric(m) => m.sample(wo, uc, wl),
+            Material::Coated(m) => m.sample(wo, uc, u, wl),
             Material::Black => None,
         }
     }
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    /// Density of `sample` producing `wi` (solid angle; the non-delta part only). For a
+    /// dispersive material it is the hero wavelength's (`wl.lambda[0]`).
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> f32 {
         match self {
             Material::Diffuse(d) => d.pdf(wo, wi),
+            Material::OrenNayar(m) => m.pdf(wo, wi),
+            Material::Phong(m) => m.pdf(wo, wi),
+            Material::Conductor(m) => m.pdf(wo, wi),
+            Material::Dielectric(m) => m.pdf(wo, wi, wl),
+            Material::ThinDielectric(_) => 0.0,
+            Material::Coated(m) => m.pdf(wo, wi),
             Material::Black => 0.0,
+        }
+    }
+    /// True if every lobe is a delta (light sampling cannot contribute).
+    pub fn is_specular(&self) -> bool {
+        match self {
+            Material::Conductor(m) => m.mf.effectively_smooth(),
+            Material::Dielectric(m) => m.mf.effectively_smooth(),
+            Material::ThinDielectric(_) => true,
+            _ => false,
         }
     }
     /// True if the material scatters nothing, so paths can stop at it.

@@ -211,8 +211,107 @@ pub enum SpectrumDesc {
 pub enum MaterialDesc {
     /// Lambertian reflection with reflectance in [0, 1].
     Diffuse { reflectance: SpectrumDesc },
+    /// Oren–Nayar rough diffuse; `sigma_deg` is the facet slope deviation, degrees.
+    OrenNayar {
+        reflectance: SpectrumDesc,
+        sigma_deg: f32,
+    },
+    /// Energy-normalised Phong: diffuse + specular ≤ 1 at every wavelength.
+    Phong {
+        #[serde(default = "zero_spectrum")]
+        diffuse: SpectrumDesc,
+        specular: SpectrumDesc,
+        exponent: f32,
+    },
+    /// Metal. Either `metal: "Au"` (a table in data/ior) or `n` and `k` spectra.
+    /// `roughness` is the microfacet α (0 = mirror); `roughness_v`, if given, makes it
+    /// anisotropic (α along the tangent, α along the bitangent).
+    Conductor {
+        #[serde(default)]
+        metal: Option<String>,
+        #[serde(default)]
+        n: Option<SpectrumDesc>,
+        #[serde(default)]
+        k: Option<SpectrumDesc>,
+        #[serde(default)]
+        roughness: f32,
+        #[serde(default)]
+        roughness_v: Option<f32>,
+        #[serde(default)]
+        distribution: DistributionDesc,
+        #[serde(default)]
+        masking: MaskingDesc,
+    },
+    /// Glass interface (outside = the side the normal points to); smooth when roughness = 0.
+    Dielectric {
+        ior: IorDesc,
+        #[serde(default)]
+        roughness: f32,
+        #[serde(default)]
+        roughness_v: Option<f32>,
+        #[serde(default)]
+        distribution: DistributionDesc,
+    },
+    /// Thin slab (window pane): mirror reflection and undeviated transmission.
+    ThinDielectric { ior: IorDesc },
+    /// Diffuse base under a clear coating of constant index (plastic, varnish); the coat is
+    /// smooth when roughness = 0 (default).
+    Coated {
+        base: SpectrumDesc,
+        #[serde(default = "default_coat_ior")]
+        ior: f32,
+        #[serde(default)]
+        roughness: f32,
+        #[serde(default)]
+        distribution: DistributionDesc,
+    },
     /// Absorbs all light.
     Black,
+}
+
+fn zero_spectrum() -> SpectrumDesc {
+    SpectrumDesc::Constant(0.0)
+}
+fn default_coat_ior() -> f32 {
+    1.5
+}
+
+/// Microfacet normal distribution.
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+pub enum DistributionDesc {
+    /// GGX / Trowbridge–Reitz.
+    #[default]
+    Ggx,
+    Beckmann,
+}
+
+/// Microfacet masking-shadowing.
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+pub enum MaskingDesc {
+    /// Smith, height-correlated.
+    #[default]
+    Smith,
+    /// V-cavity (Cook–Torrance).
+    VCavity,
+}
+
+/// A dielectric's refractive index.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum IorDesc {
+    /// The same index at every wavelength (no dispersion).
+    Constant(f32),
+    /// A glass from data/ior/glasses.csv: "BK7", "fused-silica", "SF11", "F2", "BaK4".
+    Glass(String),
+    /// n = a + b/λ² + c/λ⁴, λ in nm.
+    Cauchy {
+        a: f64,
+        b: f64,
+        #[serde(default)]
+        c: f64,
+    },
+    /// n² = 1 + Σ bᵢλ²/(λ² − cᵢ), λ in µm, cᵢ in µm² (three terms).
+    Sellmeier { b: [f64; 3], c: [f64; 3] },
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -1,0 +1,99 @@
+//! Conductors: a smooth mirror (delta lobe) or Torrance–Sparrow microfacet reflection
+//! f = D(ωm) F(ωo·ωm) G(ωo, ωi) / (4 cos θo cos θi) with the exact complex-index Fresnel
+//! factor per wavelength (pbrt-v4 §9.6, `ConductorBxDF`; Walter et al. 2007).
+//! Two-sided: it reflects on whichever side `wo` is.
+
+use super::fresnel::{fr_conductor, reflect};
+use super::ior::ConductorIor;
+use super::microfacet::Microfacet;
+use super::{same_hemisphere, BsdfSample};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, N_LAMBDA};
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Debug)]
+pub struct Conductor {
+    pub ior: ConductorIor,
+    pub mf: Microfacet,
+}
+
+impl Conductor {
+    #[inline]
+    fn fresnel(&self, cos: f32, wl: &SampledWavelengths) -> SampledSpectrum {
+        let (n, k) = self.ior.sample(wl);
+        let mut f = SampledSpectrum::ZERO;
+        for i in 0..N_LAMBDA {
+            f[i] = fr_conductor(cos.abs(), n[i], k[i]);
+        }
+        f
+    }
+
+    pub fn eval(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
+        if !same_hemisphere(wo, wi) || self.mf.effectively_smooth() {
+            return SampledSpectrum::ZERO;
+        }
+        let (co, ci) = (wo.z.abs(), wi.z.abs());
+        let wm = (wo + wi).normalize_or_zero();
+        if wm == Vec3::ZERO || co == 0.0 || ci == 0.0 {
+            return SampledSpectrum::ZERO;
+        }
+        let wm = if wm.z < 0.0 { -wm } else { wm };
+        let (wo_u, wi_u) = (flip_up(wo), flip_up(wi));
+        let v = self.mf.d(wm) * self.mf.g(wo_u, wi_u, wm) / (4.0 * co * ci);
+        self.fresnel(wo.dot(wm), wl) * v
+    }
+
+    pub fn sample(&self, wo: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        if self.mf.effectively_smooth() {
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            let c = wi.z.abs();
+            return Some(BsdfSample {
+                wi,
+                f: self.fresnel(c, wl) / c,
+                pdf: 1.0,
+                specular: true,
+            });
+        }
+        // Work on the +z side and mirror back.
+        let wo_u = flip_up(wo);
+        let wm = self.mf.sample_wm(wo_u, u);
+        let wi_u = reflect(wo_u, wm);
+        if wi_u.z <= 0.0 {
+            return None;
+        }
+        let wi = Vec3::new(wi_u.x, wi_u.y, wi_u.z.copysign(wo.z));
+        let pdf = self.pdf(wo, wi);
+        if pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f: self.eval(wo, wi, wl),
+            pdf,
+            specular: false,
+        })
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if !same_hemisphere(wo, wi) || self.mf.effectively_smooth() {
+            return 0.0;
+        }
+        let (wo_u, wi_u) = (flip_up(wo), flip_up(wi));
+        let wm = (wo_u + wi_u).normalize_or_zero();
+        if wm == Vec3::ZERO {
+            return 0.0;
+        }
+        let c = wo_u.dot(wm);
+        if c <= 0.0 {
+            return 0.0;
+        }
+        self.mf.pdf_wm(wo_u, wm) / (4.0 * c)
+    }
+}
+
+#[inline]
+pub(crate) fn flip_up(w: Vec3) -> Vec3 {
+    Vec3::new(w.x, w.y, w.z.abs())
+}

@@ -1,0 +1,78 @@
+//! Oren–Nayar rough diffuse reflection, the qualitative model (Oren & Nayar 1994,
+//! "Generalization of Lambert's Reflectance Model", eq. 30; pbrt-v3 §8.4.2):
+//! f = ρ/π (A + B max(0, cos(φi − φo)) sin α tan β), α = max(θi, θo), β = min(θi, θo),
+//! A = 1 − σ²/(2(σ² + 0.33)), B = 0.45 σ²/(σ² + 0.09), σ the facet slope deviation (radians).
+//! Sampled with the cosine-weighted hemisphere. Two-sided like [`super::Diffuse`].
+
+use super::{same_hemisphere, sample_cosine_hemisphere, BsdfSample};
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
+use std::f32::consts::FRAC_1_PI;
+
+#[derive(Clone, Debug)]
+pub struct OrenNayar {
+    pub reflectance: DenseSpectrum,
+    a: f32,
+    b: f32,
+}
+
+impl OrenNayar {
+    /// `sigma` in radians.
+    pub fn new(reflectance: DenseSpectrum, sigma: f32) -> Self {
+        let s2 = sigma * sigma;
+        Self {
+            reflectance,
+            a: 1.0 - s2 / (2.0 * (s2 + 0.33)),
+            b: 0.45 * s2 / (s2 + 0.09),
+        }
+    }
+
+    fn factor(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let sin_i = (1.0 - wi.z * wi.z).max(0.0).sqrt();
+        let sin_o = (1.0 - wo.z * wo.z).max(0.0).sqrt();
+        let mut max_cos = 0.0;
+        if sin_i > 1e-4 && sin_o > 1e-4 {
+            let (ci, co) = (wi.x / sin_i, wo.x / sin_o);
+            let (si, so) = (wi.y / sin_i, wo.y / sin_o);
+            max_cos = (ci * co + si * so).max(0.0);
+        }
+        let (ai, ao) = (wi.z.abs(), wo.z.abs());
+        let (sin_a, tan_b) = if ai > ao {
+            (sin_o, sin_i / ai)
+        } else {
+            (sin_i, sin_o / ao)
+        };
+        self.a + self.b * max_cos * sin_a * tan_b
+    }
+
+    pub fn eval(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
+        if !same_hemisphere(wo, wi) {
+            return SampledSpectrum::ZERO;
+        }
+        self.reflectance.sample(wl) * (FRAC_1_PI * self.factor(wo, wi))
+    }
+
+    pub fn sample(&self, wo: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<BsdfSample> {
+        let mut wi = sample_cosine_hemisphere(u);
+        if wo.z < 0.0 {
+            wi.z = -wi.z;
+        }
+        let pdf = wi.z.abs() * FRAC_1_PI;
+        if pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f: self.eval(wo, wi, wl),
+            pdf,
+            specular: false,
+        })
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if !same_hemisphere(wo, wi) {
+            return 0.0;
+        }
+        wi.z.abs() * FRAC_1_PI
+    }
+}
