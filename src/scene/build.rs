@@ -486,7 +486,16 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
             pending_area.push((i as u32, field.clone(), s, e.amount, e.two_sided));
         }
     }
-    let geometry = SceneGeometry::build(&shapes).map_err(|e| ctx.err("objects", e.to_string()))?;
+    let geometry = SceneGeometry::build(&shapes).map_err(|e| {
+        let field = match &e {
+            geometry::GeometryError::InvalidShape { object, .. } => scene
+                .objects
+                .get(*object as usize)
+                .map(|o| format!("{}.shape", object_field(*object as usize, o))),
+            _ => None,
+        };
+        ctx.err(field.unwrap_or_else(|| "objects".into()), e.to_string())
+    })?;
     let (lo, hi) = geometry.bounds();
     let scene_radius = if lo.is_finite() && hi.is_finite() && hi.cmpge(lo).all() {
         (0.5 * (hi - lo).length()).max(1e-6)
@@ -527,6 +536,7 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         };
         let k = photometric_scale(&s, luminance)
             .map_err(|m| ctx.err(format!("{field}.emission.spectrum"), m))?;
+        representable(&ctx, &afield, &s, k)?;
         let mut cdf = Vec::with_capacity(areas.len());
         let mut acc = 0.0;
         for a in &areas {
@@ -690,6 +700,26 @@ fn build_meters(
     ))
 }
 
+/// Largest spectral value of a light (W·m⁻²·sr⁻¹·nm⁻¹ for radiance, W·sr⁻¹·nm⁻¹ for
+/// intensity, W·m⁻²·nm⁻¹ for irradiance) — some 10¹⁸ times the sun's radiance — so that the
+/// single-precision light spectra and the f32 image channels cannot overflow to infinity.
+pub const MAX_SPECTRAL_VALUE: f64 = 1e25;
+
+/// Check that spectrum `s` scaled by `k` stays finite with headroom (see [`MAX_SPECTRAL_VALUE`]).
+fn representable(ctx: &Ctx, afield: &str, s: &DenseSpectrum, k: f32) -> Result<(), SceneError> {
+    let peak = s.max_value() as f64 * k as f64;
+    if peak <= MAX_SPECTRAL_VALUE {
+        Ok(())
+    } else {
+        Err(ctx.err(
+            afield,
+            format!(
+                "the amount is too large: the light's spectral value would reach {peak:e} (more than {MAX_SPECTRAL_VALUE:e} in W, m, sr, nm), beyond any physical source"
+            ),
+        ))
+    }
+}
+
 fn nonneg(ctx: &Ctx, field: &str, v: f64) -> Result<f64, SceneError> {
     ctx.finite(field, v)?;
     if v < 0.0 {
@@ -707,6 +737,7 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
     let scaled = |spec: &SpectrumDesc, amount: f64| -> Result<DenseSpectrum, SceneError> {
         let s = resolve_spectrum(ctx, &sfield, spec, Role::Emission)?;
         let k = photometric_scale(&s, amount).map_err(|m| ctx.err(&sfield, m))?;
+        representable(ctx, &afield, &s, k)?;
         Ok(s.scaled(k))
     };
     let wrong = |a: &Amount, allowed: &str| {
