@@ -203,12 +203,15 @@ fn environment_only_gives_its_luminance() {
     let path = corpus_dir().join("environment-only.ron");
     let world = scene::load_world(&path, &Overrides::default()).unwrap();
     let r = candela::render::render(&world, Some(2), &|_, _| {}).unwrap();
-    // Exact in expectation; the only noise is the spectral (hero-wavelength) sampling.
+    // Exact in expectation; the only noise is the spectral (hero-wavelength) sampling, whose
+    // per-pixel standard error is unreliable at 4 spp: check the image mean, and each pixel
+    // loosely.
     for p in &r.film.pixels {
-        let (y, se) = (p.mean_xyz()[1], p.y_standard_error());
-        assert!((y - 50.0).abs() <= 5.0 * se, "{y} ± {se}");
+        let y = p.mean_xyz()[1];
+        assert!((y - 50.0).abs() < 5.0, "{y}");
     }
-    common::assert_every_pixel(&r.film, 50.0, 5.0);
+    let (m, se) = common::image_mean(&r.film);
+    assert!((m[1] - 50.0).abs() <= 4.0 * se + 0.01, "{} ± {se}", m[1]);
 }
 
 /// A template with a number in every field category; side files written next to it.
@@ -327,8 +330,11 @@ fn nan_inf_and_extremes_in_every_numeric_field() {
                         !matches!(v, "NaN" | "inf" | "-inf"),
                         "{what}: a non-finite number was accepted"
                     );
+                    // Sample budgets are the user's (see huge_sample_counts_…): keep them small.
                     world.settings.spp = 1;
                     world.settings.max_depth = world.settings.max_depth.min(4);
+                    world.measure.samples = world.measure.samples.min(8);
+                    world.measure.max_samples = world.measure.max_samples.min(16);
                     if world.camera.width * world.camera.height <= 64 {
                         render_checked(&world, &what);
                     }
