@@ -437,4 +437,17 @@ fn huge_resolution_is_refused_before_allocating() {
         let (code, stderr) = cli(&p, &[]);
         assert_eq!(code, 1, "{stderr}");
     }
+    // 16384 × 16384 is within the pixel limit but needs ~40 GiB: refused where that much
+    // memory is not available (checked against /proc/meminfo), instead of an OOM kill.
+    let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();
+    let avail_kb: u64 = meminfo
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .unwrap_or(u64::MAX);
+    if avail_kb < 30 << 20 {
+        let (_d, p) = write_temp(base.replace("RES", "(16384, 16384)").as_bytes());
+        let e = scene::load_world(&p, &Overrides::default()).err().expect("refused").to_string();
+        assert!(e.contains("camera.resolution") && e.contains("GiB"), "{e}");
+    }
 }

@@ -30,6 +30,32 @@ pub struct Overrides {
 /// Largest image the renderer accepts (pixels), so a typo cannot exhaust memory.
 pub const MAX_PIXELS: u64 = 1 << 28;
 
+/// Peak memory of a render per pixel: the tiles' pixel sums and the film (64 B each, both alive
+/// while the film is assembled) plus the EXR and PNG buffers.
+const BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<crate::film::PixelSums>() as u64 + 32;
+
+/// Memory this process may still allocate (Linux: MemAvailable and the cgroup limit), if known.
+fn available_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb: u64 = meminfo
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    let mut avail = kb * 1024;
+    let cg = |f: &str| -> Option<u64> { std::fs::read_to_string(f).ok()?.trim().parse().ok() };
+    if let (Some(max), Some(cur)) = (
+        cg("/sys/fs/cgroup/memory.max"),
+        cg("/sys/fs/cgroup/memory.current"),
+    ) {
+        avail = avail.min(max.saturating_sub(cur));
+    }
+    Some(avail)
+}
+
 /// Load and build a scene file.
 pub fn load_world(path: &Path, overrides: &Overrides) -> Result<World, SceneError> {
     let scene = super::load(path)?;
@@ -359,9 +385,22 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
             "camera.resolution",
             format!(
                 "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {} GiB)",
-                (w as u64 * h as u64 * 40) >> 30
+                (w as u64 * h as u64 * BYTES_PER_PIXEL) >> 30
             ),
         ));
+    }
+    let need = w as u64 * h as u64 * BYTES_PER_PIXEL;
+    if let Some(avail) = available_memory() {
+        if need > avail {
+            return Err(ctx.err(
+                "camera.resolution",
+                format!(
+                    "{w}×{h} pixels need about {:.1} GiB of memory but only {:.1} GiB is available",
+                    need as f64 / (1u64 << 30) as f64,
+                    avail as f64 / (1u64 << 30) as f64
+                ),
+            ));
+        }
     }
     let lens = match &c.lens {
         None => None,
