@@ -172,7 +172,7 @@ fn seeds_are_valid_scenes() {
 }
 
 proptest! {
-    #![proptest_config(config(600))]
+    #![proptest_config(config(2000))]
 
     /// Mutated valid scenes.
     #[test]
