@@ -162,6 +162,10 @@ fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32
     hit_mask
 }
 
+/// Largest distance from the origin (m, per axis) of any primitive's bounds: beyond it the
+/// BVH builder's f32 surface-area costs overflow (7 astronomical units: room for a sun).
+pub const MAX_COORDINATE: f32 = 1e12;
+
 /// Maximum supported BVH depth (our traversal stack size).
 const MAX_DEPTH: usize = 64;
 
@@ -422,18 +426,28 @@ impl SceneGeometry {
 
         let mut lo = Vec3::INFINITY;
         let mut hi = Vec3::NEG_INFINITY;
-        let aabbs: Vec<Aabb> = prims
-            .iter()
-            .map(|p| {
-                let (a, b) = p.bounds();
-                lo = lo.min(a);
-                hi = hi.max(b);
-                // Pad by a few ulps so rounding in bounds/quantization can never exclude the
-                // primitive's surface.
-                let pad = (a.abs().max(b.abs()) * gamma(4)) + Vec3::splat(f32::MIN_POSITIVE);
-                Aabb::new((a - pad).into(), (b + pad).into())
-            })
-            .collect();
+        let mut aabbs: Vec<Aabb> = Vec::with_capacity(prims.len());
+        for (p, &object) in prims.iter().zip(&objects) {
+            let (a, b) = p.bounds();
+            // The BVH builder's surface-area costs (f32) overflow to inf and NaN for boxes
+            // near f32::MAX, which corrupts the build (an out-of-bounds panic in obvhs).
+            let reach = a.abs().max(b.abs()).max_element();
+            if !(reach <= MAX_COORDINATE) {
+                return Err(GeometryError::InvalidShape {
+                    shape: "primitive",
+                    object,
+                    message: format!(
+                        "it extends to {reach:e} m from the origin; geometry must lie within ±{MAX_COORDINATE:e} m"
+                    ),
+                });
+            }
+            lo = lo.min(a);
+            hi = hi.max(b);
+            // Pad by a few ulps so rounding in bounds/quantization can never exclude the
+            // primitive's surface.
+            let pad = (a.abs().max(b.abs()) * gamma(4)) + Vec3::splat(f32::MIN_POSITIVE);
+            aabbs.push(Aabb::new((a - pad).into(), (b + pad).into()));
+        }
         let bounds = if prims.is_empty() {
             (Vec3::ZERO, Vec3::ZERO)
         } else {

@@ -30,6 +30,32 @@ pub struct Overrides {
 /// Largest image the renderer accepts (pixels), so a typo cannot exhaust memory.
 pub const MAX_PIXELS: u64 = 1 << 28;
 
+/// Peak memory of a render per pixel: the tiles' pixel sums and the film (64 B each, both alive
+/// while the film is assembled) plus the EXR and PNG buffers.
+const BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<crate::film::PixelSums>() as u64 + 32;
+
+/// Memory this process may still allocate (Linux: MemAvailable and the cgroup limit), if known.
+fn available_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb: u64 = meminfo
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    let mut avail = kb * 1024;
+    let cg = |f: &str| -> Option<u64> { std::fs::read_to_string(f).ok()?.trim().parse().ok() };
+    if let (Some(max), Some(cur)) = (
+        cg("/sys/fs/cgroup/memory.max"),
+        cg("/sys/fs/cgroup/memory.current"),
+    ) {
+        avail = avail.min(max.saturating_sub(cur));
+    }
+    Some(avail)
+}
+
 /// Load and build a scene file.
 pub fn load_world(path: &Path, overrides: &Overrides) -> Result<World, SceneError> {
     let scene = super::load(path)?;
@@ -359,9 +385,22 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
             "camera.resolution",
             format!(
                 "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {} GiB)",
-                (w as u64 * h as u64 * 40) >> 30
+                (w as u64 * h as u64 * BYTES_PER_PIXEL) >> 30
             ),
         ));
+    }
+    let need = w as u64 * h as u64 * BYTES_PER_PIXEL;
+    if let Some(avail) = available_memory() {
+        if need > avail {
+            return Err(ctx.err(
+                "camera.resolution",
+                format!(
+                    "{w}×{h} pixels need about {:.1} GiB of memory but only {:.1} GiB is available",
+                    need as f64 / (1u64 << 30) as f64,
+                    avail as f64 / (1u64 << 30) as f64
+                ),
+            ));
+        }
     }
     let lens = match &c.lens {
         None => None,
@@ -487,7 +526,16 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
             pending_area.push((i as u32, field.clone(), s, e.amount, e.two_sided));
         }
     }
-    let geometry = SceneGeometry::build(&shapes).map_err(|e| ctx.err("objects", e.to_string()))?;
+    let geometry = SceneGeometry::build(&shapes).map_err(|e| {
+        let field = match &e {
+            geometry::GeometryError::InvalidShape { object, .. } => scene
+                .objects
+                .get(*object as usize)
+                .map(|o| format!("{}.shape", object_field(*object as usize, o))),
+            _ => None,
+        };
+        ctx.err(field.unwrap_or_else(|| "objects".into()), e.to_string())
+    })?;
     let (lo, hi) = geometry.bounds();
     let scene_radius = if lo.is_finite() && hi.is_finite() && hi.cmpge(lo).all() {
         (0.5 * (hi - lo).length()).max(1e-6)
@@ -528,6 +576,7 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         };
         let k = photometric_scale(&s, luminance)
             .map_err(|m| ctx.err(format!("{field}.emission.spectrum"), m))?;
+        representable(&ctx, &afield, &s, k)?;
         let mut cdf = Vec::with_capacity(areas.len());
         let mut acc = 0.0;
         for a in &areas {
@@ -691,6 +740,26 @@ fn build_meters(
     ))
 }
 
+/// Largest spectral value of a light (W·m⁻²·sr⁻¹·nm⁻¹ for radiance, W·sr⁻¹·nm⁻¹ for
+/// intensity, W·m⁻²·nm⁻¹ for irradiance) — some 10¹⁸ times the sun's radiance — so that the
+/// single-precision light spectra and the f32 image channels cannot overflow to infinity.
+pub const MAX_SPECTRAL_VALUE: f64 = 1e25;
+
+/// Check that spectrum `s` scaled by `k` stays finite with headroom (see [`MAX_SPECTRAL_VALUE`]).
+fn representable(ctx: &Ctx, afield: &str, s: &DenseSpectrum, k: f32) -> Result<(), SceneError> {
+    let peak = s.max_value() as f64 * k as f64;
+    if peak <= MAX_SPECTRAL_VALUE {
+        Ok(())
+    } else {
+        Err(ctx.err(
+            afield,
+            format!(
+                "the amount is too large: the light's spectral value would reach {peak:e} (more than {MAX_SPECTRAL_VALUE:e} in W, m, sr, nm), beyond any physical source"
+            ),
+        ))
+    }
+}
+
 fn nonneg(ctx: &Ctx, field: &str, v: f64) -> Result<f64, SceneError> {
     ctx.finite(field, v)?;
     if v < 0.0 {
@@ -708,6 +777,7 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
     let scaled = |spec: &SpectrumDesc, amount: f64| -> Result<DenseSpectrum, SceneError> {
         let s = resolve_spectrum(ctx, &sfield, spec, Role::Emission)?;
         let k = photometric_scale(&s, amount).map_err(|m| ctx.err(&sfield, m))?;
+        representable(ctx, &afield, &s, k)?;
         Ok(s.scaled(k))
     };
     let wrong = |a: &Amount, allowed: &str| {
