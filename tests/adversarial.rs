@@ -430,7 +430,7 @@ fn empty_and_non_utf8_files_are_refused() {
         b"(camera: \xc3(position: (0,0,0)))",
     ] {
         let (_d, p) = write_temp(bytes);
-        let e = scene::load(&p).err().expect("refused").to_string();
+        let e = scene::load(&p).expect_err("refused").to_string();
         assert!(e.contains("scene.ron"), "{e}");
         let (code, stderr) = cli(&p, &[]);
         assert_eq!(code, 1);
@@ -447,7 +447,7 @@ fn deeply_nested_input_is_refused_without_overflowing_the_stack() {
             // Through the binary first: a stack overflow would kill the process (a signal).
             let (code, stderr) = cli(&p, &[]);
             assert_eq!(code, 1, "{stderr}");
-            let e = scene::load(&p).err().expect("refused").to_string();
+            let e = scene::load(&p).expect_err("refused").to_string();
             assert!(e.contains("scene.ron"), "{e}");
         }
     }
