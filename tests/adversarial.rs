@@ -54,7 +54,10 @@ fn render_checked(world: &candela::world::World, what: &str) -> f64 {
             "{what}: pixel {i} not finite: {xyz:?}"
         );
     }
-    assert_eq!(r.stats.non_finite, 0, "{what}: non-finite samples were dropped");
+    assert_eq!(
+        r.stats.non_finite, 0,
+        "{what}: non-finite samples were dropped"
+    );
     let m = candela::meter::measure_all(world);
     for e in m.meters.iter().chain(m.grids.iter().flatten()) {
         assert!(
@@ -76,7 +79,10 @@ fn corpus_in_process() {
             ("error", Ok(_)) => panic!("{name}: accepted, but expected an error ({needles})"),
             ("error" | "any", Err(e)) => {
                 let m = e.to_string();
-                assert!(m.contains(&name), "{name}: message does not name the file: {m}");
+                assert!(
+                    m.contains(&name),
+                    "{name}: message does not name the file: {m}"
+                );
                 for n in needles.split('|').map(str::trim).filter(|n| !n.is_empty()) {
                     assert!(m.contains(n), "{name}: message lacks {n:?}: {m}");
                 }
@@ -105,7 +111,10 @@ fn cli(scene: &Path, extra: &[&str]) -> (i32, String) {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     // A signal (no exit code) or a panic (101) is a failure.
-    let code = out.status.code().unwrap_or_else(|| panic!("killed by a signal: {stderr}"));
+    let code = out
+        .status
+        .code()
+        .unwrap_or_else(|| panic!("killed by a signal: {stderr}"));
     assert!(code == 0 || code == 1, "exit code {code}: {stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(!stderr.contains("non-finite"), "{stderr}");
@@ -259,7 +268,8 @@ fn number_spans(s: &str) -> Vec<(usize, usize)> {
     let mut v = Vec::new();
     let mut i = 0;
     while i < b.len() {
-        let start = b[i].is_ascii_digit() || (b[i] == b'-' && b.get(i + 1).is_some_and(u8::is_ascii_digit));
+        let start =
+            b[i].is_ascii_digit() || (b[i] == b'-' && b.get(i + 1).is_some_and(u8::is_ascii_digit));
         if start && !(i > 0 && (b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'"')) {
             let a = i;
             i += 1;
@@ -307,14 +317,27 @@ fn nan_inf_and_extremes_in_every_numeric_field() {
     let mut refused = 0;
     for &(a, b) in &spans {
         for v in [
-            "NaN", "inf", "-inf", "1e38", "-1e38", "3e38", "1e-30", "1e-45", "0", "-0.0", "-1", "1e300",
+            "NaN",
+            "inf",
+            "-inf",
+            "1e38",
+            "-1e38",
+            "3e38",
+            "1e-30",
+            "1e-45",
+            "0",
+            "-0.0",
+            "-1",
+            "1e300",
             "4294967295",
         ] {
             let text = format!("{}{v}{}", &TEMPLATE[..a], &TEMPLATE[b..]);
             let what = format!("{v} at byte {a} ({:?})", &TEMPLATE[a.saturating_sub(30)..b]);
-            let result = scene::parse(&text, &path).map_err(|e| (e, true)).and_then(|s| {
-                scene::build(&s, &path, &Overrides::default()).map_err(|e| (e, false))
-            });
+            let result = scene::parse(&text, &path)
+                .map_err(|e| (e, true))
+                .and_then(|s| {
+                    scene::build(&s, &path, &Overrides::default()).map_err(|e| (e, false))
+                });
             match result {
                 Err((e, syntax)) => {
                     refused += 1;
@@ -322,7 +345,10 @@ fn nan_inf_and_extremes_in_every_numeric_field() {
                     assert!(m.contains("scene.ron"), "{what}: {m}");
                     if !syntax {
                         let sec = section(TEMPLATE, a);
-                        assert!(m.contains(&format!("`{sec}")), "{what}: message does not name the field ({sec}…): {m}");
+                        assert!(
+                            m.contains(&format!("`{sec}")),
+                            "{what}: message does not name the field ({sec}…): {m}"
+                        );
                     }
                 }
                 Ok(mut world) => {
@@ -355,7 +381,11 @@ fn huge_sample_counts_are_accepted_as_asked_and_depth_is_bounded() {
         let p = Path::new("scene.ron");
         scene::build(&scene::parse(&text, p).unwrap(), p, &Overrides::default())
     };
-    let w = build("spp: 4294967295, rr_depth: 4294967295, seed: 18446744073709551615", "samples: 18446744073709551615").unwrap();
+    let w = build(
+        "spp: 4294967295, rr_depth: 4294967295, seed: 18446744073709551615",
+        "samples: 18446744073709551615",
+    )
+    .unwrap();
     assert_eq!(w.settings.spp, u32::MAX);
     let e = build("max_depth: 10001", "").err().unwrap().to_string();
     assert!(e.contains("render.max_depth"), "{e}");
@@ -364,10 +394,24 @@ fn huge_sample_counts_are_accepted_as_asked_and_depth_is_bounded() {
     let text = base.replace("RENDER", "").replace("MEASURE", "");
     let p = Path::new("scene.ron");
     let s = scene::parse(&text, p).unwrap();
-    let o = Overrides { spp: Some(0), ..Default::default() };
-    assert!(scene::build(&s, p, &o).err().unwrap().to_string().contains("render.spp"));
-    let o = Overrides { max_depth: Some(u32::MAX), ..Default::default() };
-    assert!(scene::build(&s, p, &o).err().unwrap().to_string().contains("render.max_depth"));
+    let o = Overrides {
+        spp: Some(0),
+        ..Default::default()
+    };
+    assert!(scene::build(&s, p, &o)
+        .err()
+        .unwrap()
+        .to_string()
+        .contains("render.spp"));
+    let o = Overrides {
+        max_depth: Some(u32::MAX),
+        ..Default::default()
+    };
+    assert!(scene::build(&s, p, &o)
+        .err()
+        .unwrap()
+        .to_string()
+        .contains("render.max_depth"));
 }
 
 fn write_temp(bytes: &[u8]) -> (tempfile::TempDir, PathBuf) {
@@ -379,9 +423,14 @@ fn write_temp(bytes: &[u8]) -> (tempfile::TempDir, PathBuf) {
 
 #[test]
 fn empty_and_non_utf8_files_are_refused() {
-    for bytes in [&b""[..], b"   \n// only a comment\n", b"\xff\xfe(\x00c\x00", b"(camera: \xc3(position: (0,0,0)))"] {
+    for bytes in [
+        &b""[..],
+        b"   \n// only a comment\n",
+        b"\xff\xfe(\x00c\x00",
+        b"(camera: \xc3(position: (0,0,0)))",
+    ] {
         let (_d, p) = write_temp(bytes);
-        let e = scene::load(&p).err().expect("refused").to_string();
+        let e = scene::load(&p).expect_err("refused").to_string();
         assert!(e.contains("scene.ron"), "{e}");
         let (code, stderr) = cli(&p, &[]);
         assert_eq!(code, 1);
@@ -398,7 +447,7 @@ fn deeply_nested_input_is_refused_without_overflowing_the_stack() {
             // Through the binary first: a stack overflow would kill the process (a signal).
             let (code, stderr) = cli(&p, &[]);
             assert_eq!(code, 1, "{stderr}");
-            let e = scene::load(&p).err().expect("refused").to_string();
+            let e = scene::load(&p).expect_err("refused").to_string();
             assert!(e.contains("scene.ron"), "{e}");
         }
     }
@@ -412,7 +461,11 @@ fn very_long_input() {
     for i in 0..100_000u32 {
         let x = (i % 1000) as f32 * 0.002 - 1.0;
         let z = (i / 1000) as f32 * 0.02;
-        pos.push_str(&format!("({x}, 0, {z}), ({}, 0, {z}), ({x}, 0, {}),", x + 0.002, z + 0.02));
+        pos.push_str(&format!(
+            "({x}, 0, {z}), ({}, 0, {z}), ({x}, 0, {}),",
+            x + 0.002,
+            z + 0.02
+        ));
         idx.push_str(&format!("({}, {}, {}),", 3 * i, 3 * i + 2, 3 * i + 1));
     }
     let text = format!(
@@ -429,10 +482,20 @@ fn very_long_input() {
 
 #[test]
 fn huge_resolution_is_refused_before_allocating() {
-    let base = r#"(camera: (position: (0, 0, 0), look_at: (0, 0, 1), vfov_deg: 30, resolution: RES))"#;
-    for res in ["(4294967295, 4294967295)", "(4294967295, 1)", "(1, 4294967295)", "(65536, 65536)", "(16385, 16384)"] {
+    let base =
+        r#"(camera: (position: (0, 0, 0), look_at: (0, 0, 1), vfov_deg: 30, resolution: RES))"#;
+    for res in [
+        "(4294967295, 4294967295)",
+        "(4294967295, 1)",
+        "(1, 4294967295)",
+        "(65536, 65536)",
+        "(16385, 16384)",
+    ] {
         let (_d, p) = write_temp(base.replace("RES", res).as_bytes());
-        let e = scene::load_world(&p, &Overrides::default()).err().expect("refused").to_string();
+        let e = scene::load_world(&p, &Overrides::default())
+            .err()
+            .expect("refused")
+            .to_string();
         assert!(e.contains("camera.resolution"), "{e}");
         let (code, stderr) = cli(&p, &[]);
         assert_eq!(code, 1, "{stderr}");
@@ -447,7 +510,10 @@ fn huge_resolution_is_refused_before_allocating() {
         .unwrap_or(u64::MAX);
     if avail_kb < 30 << 20 {
         let (_d, p) = write_temp(base.replace("RES", "(16384, 16384)").as_bytes());
-        let e = scene::load_world(&p, &Overrides::default()).err().expect("refused").to_string();
+        let e = scene::load_world(&p, &Overrides::default())
+            .err()
+            .expect("refused")
+            .to_string();
         assert!(e.contains("camera.resolution") && e.contains("GiB"), "{e}");
     }
 }

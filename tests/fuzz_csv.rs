@@ -38,7 +38,16 @@ fn check(bytes: &[u8]) {
             assert!(w.len() >= 2 && w.len() == sd.values.len());
             assert!(w.windows(2).all(|p| p[0] < p[1]), "not increasing: {w:?}");
             assert!(w.iter().chain(&sd.values).all(|v| v.is_finite()));
-            for nm in [f64::NAN, -1.0, 360.0, 555.5, 830.0, 1e300, w[0], w[w.len() - 1]] {
+            for nm in [
+                f64::NAN,
+                -1.0,
+                360.0,
+                555.5,
+                830.0,
+                1e300,
+                w[0],
+                w[w.len() - 1],
+            ] {
                 let _ = sd.value(nm);
             }
             let _ = sd.to_table();

@@ -11,8 +11,8 @@ use candela::geometry::{load_obj, load_ply};
 use candela::scene::{self, Overrides};
 use fuzz_common::{apply, config, plan};
 use proptest::prelude::*;
-use std::path::Path;
 use std::cell::Cell;
+use std::path::Path;
 
 const OBJ_SEEDS: &[&str] = &[
     "# cube corner\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\nf 1/1/1 2/2/2 3/3/3\nf 2/2/2 4/4/4 3/3/3\n",
@@ -25,10 +25,26 @@ fn ply_ascii() -> Vec<u8> {
 }
 
 fn ply_binary(big_endian: bool) -> Vec<u8> {
-    let fmt = if big_endian { "binary_big_endian" } else { "binary_little_endian" };
+    let fmt = if big_endian {
+        "binary_big_endian"
+    } else {
+        "binary_little_endian"
+    };
     let mut v = format!("ply\nformat {fmt} 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n").into_bytes();
-    let f = |x: f32| if big_endian { x.to_be_bytes() } else { x.to_le_bytes() };
-    let u = |x: u32| if big_endian { x.to_be_bytes() } else { x.to_le_bytes() };
+    let f = |x: f32| {
+        if big_endian {
+            x.to_be_bytes()
+        } else {
+            x.to_le_bytes()
+        }
+    };
+    let u = |x: u32| {
+        if big_endian {
+            x.to_be_bytes()
+        } else {
+            x.to_le_bytes()
+        }
+    };
     for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
         for c in p {
             v.extend(f(c));
@@ -80,7 +96,11 @@ fn check(bytes: &[u8], ply: bool) {
     let name = if ply { "m.ply" } else { "m.obj" };
     let file = dir.path().join(name);
     std::fs::write(&file, bytes).unwrap();
-    let r = if ply { load_ply(&file) } else { load_obj(&file) };
+    let r = if ply {
+        load_ply(&file)
+    } else {
+        load_obj(&file)
+    };
     let shown = String::from_utf8_lossy(bytes);
     assert_eq!(
         PANICS.with(Cell::get),
@@ -103,7 +123,10 @@ fn check(bytes: &[u8], ply: bool) {
             return;
         }
     }
-    let text = SCENE.replace("MESH", &format!("{}({name:?})", if ply { "Ply" } else { "Obj" }));
+    let text = SCENE.replace(
+        "MESH",
+        &format!("{}({name:?})", if ply { "Ply" } else { "Obj" }),
+    );
     let path = dir.path().join("scene.ron");
     let parsed = scene::parse(&text, &path).unwrap();
     match scene::build(&parsed, &path, &Overrides::default()) {

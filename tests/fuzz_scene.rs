@@ -100,7 +100,10 @@ fn check(bytes: &[u8], path: &Path) {
         Ok(s) => s,
         Err(e) => {
             let m = e.to_string();
-            assert!(m.contains("scene.ron"), "parse error does not name the file: {m}");
+            assert!(
+                m.contains("scene.ron"),
+                "parse error does not name the file: {m}"
+            );
             return;
         }
     };
@@ -108,7 +111,10 @@ fn check(bytes: &[u8], path: &Path) {
         Ok(w) => w,
         Err(e) => {
             let m = e.to_string();
-            assert!(m.contains("scene.ron"), "build error does not name the file: {m}");
+            assert!(
+                m.contains("scene.ron"),
+                "build error does not name the file: {m}"
+            );
             return;
         }
     };

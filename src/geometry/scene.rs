@@ -432,7 +432,7 @@ impl SceneGeometry {
             // The BVH builder's surface-area costs (f32) overflow to inf and NaN for boxes
             // near f32::MAX, which corrupts the build (an out-of-bounds panic in obvhs).
             let reach = a.abs().max(b.abs()).max_element();
-            if !(reach <= MAX_COORDINATE) {
+            if reach.is_nan() || reach > MAX_COORDINATE {
                 return Err(GeometryError::InvalidShape {
                     shape: "primitive",
                     object,

@@ -82,7 +82,12 @@ pub enum Mutation {
     /// Cut the input at `pos`.
     Truncate { pos: usize },
     /// Splice in a range of another seed.
-    Splice { seed: usize, from: usize, len: usize, to: usize },
+    Splice {
+        seed: usize,
+        from: usize,
+        len: usize,
+        to: usize,
+    },
 }
 
 /// Bytes worth inserting into a text format: structure characters and tokens.
@@ -140,9 +145,7 @@ pub fn number_spans(s: &[u8]) -> Vec<(usize, usize)> {
     let mut i = 0;
     while i < s.len() {
         let starts = s[i].is_ascii_digit()
-            || ((s[i] == b'-' || s[i] == b'.')
-                && i + 1 < s.len()
-                && s[i + 1].is_ascii_digit());
+            || ((s[i] == b'-' || s[i] == b'.') && i + 1 < s.len() && s[i + 1].is_ascii_digit());
         let prev_ident = i > 0 && (s[i - 1].is_ascii_alphanumeric() || s[i - 1] == b'_');
         if starts && !prev_ident {
             let a = i;
