@@ -384,8 +384,8 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         return Err(ctx.err(
             "camera.resolution",
             format!(
-                "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {} GiB)",
-                (w as u64 * h as u64 * BYTES_PER_PIXEL) >> 30
+                "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {:.0} GiB)",
+                w as f64 * h as f64 * BYTES_PER_PIXEL as f64 / (1u64 << 30) as f64
             ),
         ));
     }
