@@ -522,6 +522,17 @@ fn cmd_render(a: RenderArgs) -> Result<()> {
         measure_seconds,
         units,
         outputs,
+        progressive: serde_json::json!({
+            "stop_reason": format!("{reason:?}"),
+            "passes": last.passes,
+            "max_spp": prog.max_spp,
+            "image_samples_per_pixel": spp,
+            "target_relative_error_95": target.map(|t| t.relative),
+            "target_fraction": target.map(|t| t.fraction),
+            "target_floor_cd_m2": target.and_then(|t| t.floor_cd_m2),
+            "fraction_of_eligible_pixels_at_target": last.converged_fraction,
+            "max_time_s": a.max_time.map(|d| d.as_secs_f64()),
+        }),
     });
     write_text(&report_path, &serde_json::to_string_pretty(&report)?)?;
     for (m, e) in world.meters.iter().zip(&measurements.meters) {

@@ -263,23 +263,23 @@ pub fn render_progressive(
         max_samples: (w * h) as u64 * prog.max_spp as u64,
         ..Default::default()
     };
-    let reason = loop {
+    let reason = 'passes: loop {
         let (plan, frac) = plan_pass(world, film, prog);
         status.converged_fraction = frac;
         status.samples = (0..w * h).map(|i| film.samples_taken(i)).sum();
         if let (Some(t), Some(f)) = (&prog.target, frac) {
             if f >= t.fraction {
-                break StopReason::TargetReached;
+                break 'passes StopReason::TargetReached;
             }
         }
         if plan.iter().all(|&n| n == 0) {
-            break StopReason::Done;
+            break 'passes StopReason::Done;
         }
         if stop.load(Ordering::Relaxed) {
-            break StopReason::Interrupted;
+            break 'passes StopReason::Interrupted;
         }
         if prog.max_time.is_some_and(|t| start.elapsed() >= t) {
-            break StopReason::MaxTime;
+            break 'passes StopReason::MaxTime;
         }
         let adaptive = film.decision.is_some();
         let film_ref: &Film = film;
@@ -348,7 +348,7 @@ pub fn render_progressive(
                 .collect()
         });
         if results.iter().any(Option::is_none) {
-            break StopReason::Interrupted;
+            break 'passes StopReason::Interrupted;
         }
         for r in results.into_iter().flatten() {
             stats.merge(&r.stats);
@@ -370,6 +370,8 @@ pub fn render_progressive(
             }
         }
     };
+    // The status the stop decision saw (the last pass's report predates it).
+    on_pass(&status);
     Ok((
         RenderResult {
             film: film.clone(),

@@ -149,3 +149,47 @@ fn merge_combines_two_seeds() {
     let o = candela(dir.path(), &["merge", "r1.state", "r1.state", "-o", "m2"]);
     assert_eq!(o.status.code(), Some(1));
 }
+
+#[test]
+fn target_error_run_reports_what_was_reached() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("s.ron"),
+        SCENE.replace("(32, 32)", "(8, 8)"),
+    )
+    .unwrap();
+    let o = candela(
+        dir.path(),
+        &[
+            "render",
+            "--quiet",
+            "--target-error",
+            "4%",
+            "--out",
+            "t",
+            "s.ron",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("target reached"), "{stdout}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("t.report.json")).unwrap())
+            .unwrap();
+    let p = &report["progressive"];
+    assert_eq!(p["stop_reason"], "TargetReached");
+    assert_eq!(p["target_relative_error_95"], 0.04);
+    assert!(p["fraction_of_eligible_pixels_at_target"].as_f64().unwrap() >= 1.0);
+    // The image mean equals the furnace value L = 1/(1 − 0.7) within 4 of its standard errors
+    // (from the EXR's stderr.Y; pixels are independent).
+    let layers = candela::output::read_exr(&dir.path().join("t.exr")).unwrap();
+    let y = layers.channel("Y").unwrap();
+    let se = layers.channel("stderr.Y").unwrap();
+    let n = y.len() as f64;
+    let mean = y.iter().map(|&v| v as f64).sum::<f64>() / n;
+    let se_mean = se.iter().map(|&s| (s as f64).powi(2)).sum::<f64>().sqrt() / n;
+    assert!(
+        (mean - 1.0 / 0.3).abs() <= 4.0 * se_mean,
+        "{mean} ± {se_mean}"
+    );
+}

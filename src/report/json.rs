@@ -62,6 +62,8 @@ pub struct ReportInput<'a> {
     pub units: Units,
     /// Output files already written, for reference.
     pub outputs: Vec<String>,
+    /// How the progressive render ended: stop reason, target and what was reached.
+    pub progressive: Value,
 }
 
 /// Min, mean and max of defined values.
@@ -186,6 +188,7 @@ pub fn report_json(r: &ReportInput) -> Value {
         "meters": meters,
         "grids": grids,
         "outputs": r.outputs,
+        "progressive": r.progressive,
     })
 }
 
