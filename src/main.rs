@@ -26,64 +26,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to NAME.exr (absolute XYZ, Y = luminance in cd/m², plus its standard error) and NAME.png (sRGB).
-    Render {
-        /// Scene file (RON).
-        scene: PathBuf,
-        /// Samples per pixel (overrides the scene's render.spp).
-        #[arg(long)]
-        spp: Option<u32>,
-        /// Output directory, or output file name (NAME, NAME.exr or NAME.png: both files are written). Default: the current directory, named after the scene.
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Worker threads (default: all cores). The image does not depend on it.
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Random seed (overrides render.seed).
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Maximum path depth (overrides render.max_depth).
-        #[arg(long)]
-        max_depth: Option<u32>,
-        /// Exposure of the PNG in EV (ISO 100); default: automatic. Does not affect the EXR.
-        #[arg(long, allow_hyphen_values = true)]
-        exposure: Option<f64>,
-        /// Also estimate the illuminance (lx) on the surface seen through each pixel (EXR channels E, stderr.E, mask.E).
-        #[arg(long)]
-        illuminance: bool,
-        /// Units of the report: si (lx, cd/m²) or imperial (fc, fL).
-        #[arg(long, default_value = "si", value_parser = ["si", "imperial"])]
-        units: String,
-        /// Render until every pixel's luminance (and illuminance, with --illuminance) is known to this relative error at 95 % confidence, e.g. `1%` or `0.01`; samples go where the error is still large.
-        #[arg(long, value_parser = parse_fraction)]
-        target_error: Option<f64>,
-        /// With --target-error: fraction of the eligible pixels that must meet it (default 1).
-        #[arg(long, default_value_t = 1.0)]
-        target_fraction: f64,
-        /// With --target-error: pixels darker than this luminance (cd/m²) need not meet it (default: 0.1 % of the image's mean luminance).
-        #[arg(long)]
-        target_floor: Option<f64>,
-        /// Upper bound of samples per pixel (default: the scene's spp, or 65536 with --target-error).
-        #[arg(long)]
-        max_spp: Option<u32>,
-        /// Stop after this long (e.g. `90s`, `10m`, `2h`), at the end of the pass in progress.
-        #[arg(long, value_parser = humantime::parse_duration)]
-        max_time: Option<std::time::Duration>,
-        /// Write a checkpoint (NAME.state and NAME.exr) this often (e.g. `60s`; `0s` disables).
-        #[arg(long, value_parser = humantime::parse_duration, default_value = "60s")]
-        checkpoint_interval: std::time::Duration,
-        /// Continue from NAME.state (refused if the scene or its settings changed).
-        #[arg(long)]
-        resume: bool,
-        /// Also write NAME.state at the end (for --resume to more samples, or `candela merge`).
-        #[arg(long)]
-        save_state: bool,
-        /// Also write false-colour maps NAME.luminance.png (and NAME.illuminance.png with --illuminance), automatic range; `candela falsecolour` offers every option.
-        #[arg(long)]
-        falsecolour: bool,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
+    Render(Box<RenderOpts>),
     /// Combine independent renders of the same scene (different seeds) from their state files into one estimate.
     Merge {
         /// State files written with --save-state (or checkpoints).
@@ -140,56 +83,71 @@ enum Command {
     Falsecolour(candela::report::falsecolour::FalsecolourArgs),
 }
 
+/// Options of `candela render`.
+#[derive(clap::Args)]
+struct RenderOpts {
+    /// Scene file (RON).
+    scene: PathBuf,
+    /// Samples per pixel (overrides the scene's render.spp).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Output directory, or output file name (NAME, NAME.exr or NAME.png: both files are written). Default: the current directory, named after the scene.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Random seed (overrides render.seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Maximum path depth (overrides render.max_depth).
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Exposure of the PNG in EV (ISO 100); default: automatic. Does not affect the EXR.
+    #[arg(long, allow_hyphen_values = true)]
+    exposure: Option<f64>,
+    /// Also estimate the illuminance (lx) on the surface seen through each pixel (EXR channels E, stderr.E, mask.E).
+    #[arg(long)]
+    illuminance: bool,
+    /// Units of the report: si (lx, cd/m²) or imperial (fc, fL).
+    #[arg(long, default_value = "si", value_parser = ["si", "imperial"])]
+    units: String,
+    /// Render until every pixel's luminance (and illuminance, with --illuminance) is known to this relative error at 95 % confidence, e.g. `1%` or `0.01`; samples go where the error is still large.
+    #[arg(long, value_parser = parse_fraction)]
+    target_error: Option<f64>,
+    /// With --target-error: fraction of the eligible pixels that must meet it (default 1).
+    #[arg(long, default_value_t = 1.0)]
+    target_fraction: f64,
+    /// With --target-error: pixels darker than this luminance (cd/m²) need not meet it (default: 0.1 % of the image's mean luminance).
+    #[arg(long)]
+    target_floor: Option<f64>,
+    /// Upper bound of samples per pixel (default: the scene's spp, or 65536 with --target-error).
+    #[arg(long)]
+    max_spp: Option<u32>,
+    /// Stop after this long (e.g. `90s`, `10m`, `2h`), at the end of the pass in progress.
+    #[arg(long, value_parser = humantime::parse_duration)]
+    max_time: Option<std::time::Duration>,
+    /// Write a checkpoint (NAME.state and NAME.exr) this often (e.g. `60s`; `0s` disables).
+    #[arg(long, value_parser = humantime::parse_duration, default_value = "60s")]
+    checkpoint_interval: std::time::Duration,
+    /// Continue from NAME.state (refused if the scene or its settings changed).
+    #[arg(long)]
+    resume: bool,
+    /// Also write NAME.state at the end (for --resume to more samples, or `candela merge`).
+    #[arg(long)]
+    save_state: bool,
+    /// Also write false-colour maps NAME.luminance.png (and NAME.illuminance.png with --illuminance), automatic range; `candela falsecolour` offers every option.
+    #[arg(long)]
+    falsecolour: bool,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render {
-            scene,
-            spp,
-            out,
-            threads,
-            seed,
-            max_depth,
-            exposure,
-            illuminance,
-            units,
-            target_error,
-            target_fraction,
-            target_floor,
-            max_spp,
-            max_time,
-            checkpoint_interval,
-            resume,
-            save_state,
-            falsecolour,
-            quiet,
-        } => cmd_render(RenderArgs {
-            scene_path: &scene,
-            overrides: Overrides {
-                spp,
-                seed,
-                max_depth,
-                illuminance,
-            },
-            out: out.as_deref(),
-            threads,
-            exposure,
-            units: if units == "imperial" {
-                Units::Imperial
-            } else {
-                Units::Si
-            },
-            target_error,
-            target_fraction,
-            target_floor,
-            max_spp,
-            max_time,
-            checkpoint_interval,
-            resume,
-            save_state,
-            falsecolour,
-            quiet,
-        }),
+        Command::Render(opts) => cmd_render(&opts),
         Command::Merge {
             states,
             out,
@@ -253,25 +211,6 @@ fn output_paths(scene: &Path, out: Option<&Path>) -> (PathBuf, PathBuf, PathBuf)
     (stem, exr.into(), png.into())
 }
 
-struct RenderArgs<'a> {
-    scene_path: &'a Path,
-    overrides: Overrides,
-    out: Option<&'a Path>,
-    threads: Option<usize>,
-    exposure: Option<f64>,
-    units: Units,
-    target_error: Option<f64>,
-    target_fraction: f64,
-    target_floor: Option<f64>,
-    max_spp: Option<u32>,
-    max_time: Option<std::time::Duration>,
-    checkpoint_interval: std::time::Duration,
-    resume: bool,
-    save_state: bool,
-    falsecolour: bool,
-    quiet: bool,
-}
-
 /// `1%`, `0.5 %` or `0.01` → 0.01.
 fn parse_fraction(s: &str) -> Result<f64, String> {
     let t = s.trim();
@@ -298,17 +237,20 @@ fn with_suffix(stem: &Path, suffix: &str) -> PathBuf {
     PathBuf::from(p)
 }
 
-fn cmd_render(a: RenderArgs) -> Result<()> {
-    let RenderArgs {
-        scene_path,
-        overrides,
-        out,
-        threads,
-        exposure,
-        units,
-        quiet,
-        ..
-    } = a;
+fn cmd_render(a: &RenderOpts) -> Result<()> {
+    let scene_path = a.scene.as_path();
+    let overrides = Overrides {
+        spp: a.spp,
+        seed: a.seed,
+        max_depth: a.max_depth,
+        illuminance: a.illuminance,
+    };
+    let (out, threads, exposure, quiet) = (a.out.as_deref(), a.threads, a.exposure, a.quiet);
+    let units = if a.units == "imperial" {
+        Units::Imperial
+    } else {
+        Units::Si
+    };
     if let Some(0) = threads {
         bail!("--threads must be at least 1");
     }

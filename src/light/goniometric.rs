@@ -48,13 +48,7 @@ impl Goniometric {
 
     /// The (single) direction from `p` toward the light with li = I_e(ω)/d².
     pub fn sample_li(&self, p: Vec3, wl: &SampledWavelengths) -> Option<LightSample> {
-        let d = self.position - p;
-        let dist2 = d.length_squared();
-        if dist2 == 0.0 {
-            return None;
-        }
-        let dist = dist2.sqrt();
-        let wi = d / dist;
+        let (wi, dist, dist2) = super::toward(self.position, p)?;
         let cd = self.table_candela(-wi) as f32;
         if cd <= 0.0 || !cd.is_finite() {
             return None;

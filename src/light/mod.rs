@@ -147,14 +147,9 @@ impl Light {
                 position,
                 intensity,
             } => {
-                let d = *position - p;
-                let dist2 = d.length_squared();
-                if dist2 == 0.0 {
-                    return None;
-                }
-                let dist = dist2.sqrt();
+                let (wi, dist, dist2) = toward(*position, p)?;
                 Some(LightSample {
-                    wi: d / dist,
+                    wi,
                     li: intensity.sample(wl) / dist2,
                     pdf: 1.0,
                     dist,
@@ -169,13 +164,7 @@ impl Light {
                 cos_outer,
                 intensity,
             } => {
-                let d = *position - p;
-                let dist2 = d.length_squared();
-                if dist2 == 0.0 {
-                    return None;
-                }
-                let dist = dist2.sqrt();
-                let wi = d / dist;
+                let (wi, dist, dist2) = toward(*position, p)?;
                 let cos_theta = (-wi).dot(frame.n);
                 let falloff = smoothstep(*cos_outer, *cos_inner, cos_theta);
                 if falloff <= 0.0 {
@@ -290,6 +279,18 @@ impl Light {
             _ => SampledSpectrum::ZERO,
         }
     }
+}
+
+/// Unit direction, distance and squared distance from `p` to a point light at `position`
+/// (None if they coincide).
+pub(crate) fn toward(position: Vec3, p: Vec3) -> Option<(Vec3, f32, f32)> {
+    let d = position - p;
+    let dist2 = d.length_squared();
+    if dist2 == 0.0 || !dist2.is_finite() {
+        return None;
+    }
+    let dist = dist2.sqrt();
+    Some((d / dist, dist, dist2))
 }
 
 /// Choose an index from a cumulative distribution (last entry 1); returns it and its probability.
