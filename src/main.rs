@@ -510,7 +510,7 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
             s.min * k,
             s.avg * k,
             s.max * k,
-            s.u0
+            s.u0.unwrap_or(0.0)
         );
     }
     let mean_y = result

@@ -228,30 +228,55 @@ pub fn measure_all(world: &World) -> Measurements {
     out
 }
 
-/// E_min, E_avg, E_max, U0 = E_min/E_avg and E_min/E_max of a grid.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Statistics of a grid, in the units of the values they were computed from.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct GridStats {
+    /// Smallest value (Emin).
     pub min: f64,
+    /// Arithmetic mean over the points (Eavg).
     pub avg: f64,
+    /// Largest value (Emax).
     pub max: f64,
-    pub u0: f64,
-    pub min_over_max: f64,
+    /// Uniformity U₀ = Emin / Eavg (`None` if Eavg = 0).
+    pub u0: Option<f64>,
+    /// Emin / Emax (`None` if Emax = 0).
+    pub min_over_max: Option<f64>,
+    /// Largest standard error of a point (`None` if no errors are given).
+    pub max_stderr: Option<f64>,
 }
 
-pub fn grid_stats(values: &[Estimate]) -> GridStats {
-    let n = values.len().max(1) as f64;
-    let min = values.iter().map(|e| e.mean).fold(f64::INFINITY, f64::min);
-    let max = values
-        .iter()
-        .map(|e| e.mean)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let avg = values.iter().map(|e| e.mean).sum::<f64>() / n;
-    let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
-    GridStats {
-        min,
-        avg,
-        max,
-        u0: ratio(min, avg),
-        min_over_max: ratio(min, max),
+impl GridStats {
+    /// Statistics of `values` (with optional per-point standard errors); `None` if empty.
+    pub fn of(values: &[f64], stderr: &[f64]) -> Option<GridStats> {
+        if values.is_empty() {
+            return None;
+        }
+        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let avg = values.iter().sum::<f64>() / values.len() as f64;
+        let ratio = |a: f64, b: f64| (b != 0.0).then(|| a / b);
+        Some(GridStats {
+            min,
+            avg,
+            max,
+            u0: ratio(min, avg),
+            min_over_max: ratio(min, max),
+            max_stderr: (!stderr.is_empty()).then(|| stderr.iter().copied().fold(0.0f64, f64::max)),
+        })
     }
+}
+
+/// E_min, E_avg, E_max, U0 = E_min/E_avg and E_min/E_max of a grid's estimates (all zero for
+/// an empty grid, which scene validation never builds).
+pub fn grid_stats(values: &[Estimate]) -> GridStats {
+    let means: Vec<f64> = values.iter().map(|e| e.mean).collect();
+    let errors: Vec<f64> = values.iter().map(|e| e.stderr).collect();
+    GridStats::of(&means, &errors).unwrap_or(GridStats {
+        min: 0.0,
+        avg: 0.0,
+        max: 0.0,
+        u0: None,
+        min_over_max: None,
+        max_stderr: None,
+    })
 }

@@ -33,43 +33,9 @@ pub struct GridValues {
     pub size_m: (f64, f64),
 }
 
-/// Statistics of a grid, in the units of the values they were computed from.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct GridStats {
-    /// Smallest value (Emin).
-    pub min: f64,
-    /// Arithmetic mean over the points (Eavg).
-    pub avg: f64,
-    /// Largest value (Emax).
-    pub max: f64,
-    /// Uniformity U₀ = Emin / Eavg (`None` if Eavg = 0).
-    pub u0: Option<f64>,
-    /// Emin / Emax (`None` if Emax = 0).
-    pub min_over_max: Option<f64>,
-    /// Largest standard error of a point (`None` if no errors are given).
-    pub max_stderr: Option<f64>,
-}
+pub use crate::meter::GridStats;
 
 impl GridStats {
-    /// Statistics of `values` (with optional per-point standard errors); `None` if empty.
-    pub fn of(values: &[f64], stderr: &[f64]) -> Option<GridStats> {
-        if values.is_empty() {
-            return None;
-        }
-        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
-        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let avg = values.iter().sum::<f64>() / values.len() as f64;
-        let ratio = |a: f64, b: f64| (b != 0.0).then(|| a / b);
-        Some(GridStats {
-            min,
-            avg,
-            max,
-            u0: ratio(min, avg),
-            min_over_max: ratio(min, max),
-            max_stderr: (!stderr.is_empty()).then(|| stderr.iter().copied().fold(0.0f64, f64::max)),
-        })
-    }
-
     /// The same statistics converted from SI (lx) to `units` (ratios unchanged).
     pub fn in_units(&self, units: UnitSystem) -> GridStats {
         let c = |v: f64| units.from_si(Quantity::Illuminance, v);
