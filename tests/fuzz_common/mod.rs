@@ -19,7 +19,23 @@ pub fn config(default_cases: u32) -> ProptestConfig {
         // Failures are reported with the shrunk input; no persistence files in the source tree.
         failure_persistence: None,
         max_shrink_iters: 2000,
+        rng_seed: rng_seed(),
         ..ProptestConfig::default()
+    }
+}
+
+/// The random seed: fixed by default so that the test suite (and CI) is deterministic;
+/// `PROPTEST_RNG_SEED=<u64>` picks another, `PROPTEST_RNG_SEED=random` a fresh one per run
+/// (for long exploratory runs, see docs/fuzzing.md).
+pub fn rng_seed() -> proptest::test_runner::RngSeed {
+    use proptest::test_runner::RngSeed;
+    match std::env::var("PROPTEST_RNG_SEED").ok().as_deref() {
+        Some("random") => RngSeed::Random,
+        Some(s) => s
+            .parse()
+            .map(RngSeed::Fixed)
+            .unwrap_or(RngSeed::Fixed(0x6361_6e64_656c_61)),
+        None => RngSeed::Fixed(0x6361_6e64_656c_61),
     }
 }
 
