@@ -13,7 +13,7 @@
 //! (ρ = 1) loses nothing (exactly when smooth; to the accuracy of the E table when rough), which
 //! the furnace tests check. f is symmetric in ωo, ωi (reciprocal). Two-sided.
 
-use super::conductor::flip_up;
+use super::conductor::{flip_up, sample_microfacet_reflection};
 use super::fresnel::{fr_dielectric, reflect};
 use super::microfacet::Microfacet;
 use super::{same_hemisphere, sample_cosine_hemisphere, BsdfSample};
@@ -217,13 +217,7 @@ impl Coated {
                     specular: true,
                 });
             }
-            let wo_u = flip_up(wo);
-            let wm = self.mf.sample_wm(wo_u, u);
-            let wi_u = reflect(wo_u, wm);
-            if wi_u.z <= 0.0 {
-                return None;
-            }
-            let wi = Vec3::new(wi_u.x, wi_u.y, wi_u.z.copysign(wo.z));
+            let wi = sample_microfacet_reflection(&self.mf, wo, u)?;
             let pdf = self.pdf(wo, wi);
             if pdf <= 0.0 {
                 return None;

@@ -56,14 +56,7 @@ impl Conductor {
                 specular: true,
             });
         }
-        // Work on the +z side and mirror back.
-        let wo_u = flip_up(wo);
-        let wm = self.mf.sample_wm(wo_u, u);
-        let wi_u = reflect(wo_u, wm);
-        if wi_u.z <= 0.0 {
-            return None;
-        }
-        let wi = Vec3::new(wi_u.x, wi_u.y, wi_u.z.copysign(wo.z));
+        let wi = sample_microfacet_reflection(&self.mf, wo, u)?;
         let pdf = self.pdf(wo, wi);
         if pdf <= 0.0 {
             return None;
@@ -91,6 +84,19 @@ impl Conductor {
         }
         self.mf.pdf_wm(wo_u, wm) / (4.0 * c)
     }
+}
+
+#[inline]
+/// Sample a microfacet normal visible from `wo` and reflect `wo` about it, working on the +z
+/// side and mirroring back: the reflected direction on `wo`'s side, or None if it points
+/// below the surface.
+pub(crate) fn sample_microfacet_reflection(mf: &Microfacet, wo: Vec3, u: Vec2) -> Option<Vec3> {
+    let wo_u = flip_up(wo);
+    let wi_u = reflect(wo_u, mf.sample_wm(wo_u, u));
+    if wi_u.z <= 0.0 {
+        return None;
+    }
+    Some(Vec3::new(wi_u.x, wi_u.y, wi_u.z.copysign(wo.z)))
 }
 
 #[inline]
