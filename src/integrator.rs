@@ -163,10 +163,10 @@ pub fn trace(
             break;
         }
 
-        // Next-event estimation.
-        let u_light = sampler.get1d();
-        let u_prim = sampler.get1d();
-        let u_pt = sampler.get2d();
+        // Next-event estimation. Each bounce takes two sets of four dimensions, each led by its
+        // 2-D pair (see `Sampler`): the point on the light, then the BSDF direction.
+        let [ptx, pty, u_light, u_prim] = sampler.get4();
+        let u_pt = glam::Vec2::new(ptx, pty);
         let light_sample = if material.is_specular() {
             None
         } else {
@@ -195,8 +195,8 @@ pub fn trace(
         }
 
         // Continue the path by sampling the BSDF.
-        let uc = sampler.get1d();
-        let u = sampler.get2d();
+        let [ux, uy, uc, u_rr] = sampler.get4();
+        let u = glam::Vec2::new(ux, uy);
         let Some(bs) = material.sample(wo, uc, u, wl) else {
             break;
         };
@@ -217,7 +217,6 @@ pub fn trace(
         depth += 1;
 
         // Russian roulette.
-        let u_rr = sampler.get1d();
         if depth > settings.rr_depth {
             let m = beta.max_component();
             if m < 1.0 {

@@ -45,9 +45,12 @@ pub fn render_pixel(
     let pixel = (y * cam.width + x) as u64;
     for s in first..first + count {
         let mut sampler = Sampler::new(seed, pixel, s);
-        let u_wl = sampler.get1d();
-        let off = world.settings.filter.sample(sampler.get2d());
-        let u_lens = sampler.get2d();
+        // Dimensions 0–1: position in the pixel (the best-stratified Sobol pair), 2–3: lens,
+        // 4: wavelengths; paths continue from dimension 8.
+        let [fx, fy, lx, ly] = sampler.get4();
+        let [u_wl, ..] = sampler.get4();
+        let off = world.settings.filter.sample(glam::Vec2::new(fx, fy));
+        let u_lens = glam::Vec2::new(lx, ly);
         let mut wl = SampledWavelengths::sample_visible(u_wl);
         let ray = cam.generate_ray(x as f32 + 0.5 + off.x, y as f32 + 0.5 + off.y, u_lens);
         stats.camera_rays += 1;

@@ -16,23 +16,24 @@ pub fn mix64(mut x: u64) -> u64 {
 
 /// Number of samples `sobol_burley` provides per seed; longer runs move to a fresh scramble.
 const BLOCK: u32 = 1 << 16;
-/// Dimensions per seed in `sobol_burley`; deeper dimensions reuse them with a fresh scramble.
-const DIMS: u32 = 256;
 
-/// The sample stream of one camera sample.
+/// The sample stream of one camera sample: *padded* 4-D Owen-scrambled Sobol points (Burley
+/// 2020, "Practical Hash-based Owen Scrambling", §4). Dimensions come in sets of four; every
+/// set uses the first four Sobol dimensions, with its own index shuffle and its own scramble,
+/// so the sets are statistically independent of each other while each set is a
+/// well-stratified 4-D point set. Sobol's first dimensions have the best low-dimensional
+/// projections — (0, 1) is a (0, 2)-sequence — whereas pairs of high Sobol dimensions can be
+/// worse than random at low sample counts; callers therefore put their most important 2-D
+/// pair first in each set (pixel position; light-sample point; BSDF direction).
 ///
-/// Values are exactly `sobol_burley::sample(index, dim, seed)` (tested), but computed four
-/// dimensions at a time with SIMD (`sobol_burley::parts`), and with the per-sample index
-/// shuffle (the same for every dimension) done once: the generator was a quarter of the
-/// render time when every dimension paid for its own shuffle.
+/// Computed four dimensions per SIMD call (`sobol_burley::sample_4d`); hot loops take their
+/// numbers in fours with [`Sampler::get4`].
 #[derive(Clone, Debug)]
 pub struct Sampler {
-    seed: u64,
+    /// Seed of this pixel and block of 2^16 samples.
     block_seed: u32,
     /// Sample index within the block.
     index: u32,
-    /// Bit-reversed, Owen-shuffled sample index under `block_seed`.
-    shuffled_rev: u32,
     /// Next dimension to hand out.
     dim: u32,
     /// Dimensions `dim & !3 ..= dim | 3`, valid when `dim & 3 != 0`.
@@ -42,51 +43,40 @@ pub struct Sampler {
 impl Sampler {
     /// Stream for sample `sample_index` of pixel `pixel` (row-major index) under `seed`.
     pub fn new(seed: u64, pixel: u64, sample_index: u64) -> Self {
-        use sobol_burley::parts::{hash, owen_scramble_rev};
         let pixel_seed = mix64(seed ^ mix64(pixel.wrapping_add(0x9e37_79b9_7f4a_7c15)));
         let block = sample_index / BLOCK as u64;
-        let block_seed = mix64(pixel_seed ^ block) as u32;
-        let index = (sample_index % BLOCK as u64) as u32;
         Self {
-            seed: pixel_seed,
-            block_seed,
-            index,
-            shuffled_rev: owen_scramble_rev(index.reverse_bits(), hash(block_seed ^ 0x79c6_8e4a)),
+            block_seed: mix64(pixel_seed ^ block) as u32,
+            index: (sample_index % BLOCK as u64) as u32,
             dim: 0,
             buf: [0.0; 4],
         }
     }
 
-    /// Dimensions `4·set .. 4·set + 4` of the stream (set < DIMS / 4) under scramble `seed`:
-    /// `sobol_burley::sample_4d` with the index shuffle precomputed.
+    /// Seed of the dimension set `set` (dimensions 4·set .. 4·set + 4).
     #[inline]
-    fn sample_4d(shuffled_rev: u32, set: u32, seed: u32) -> [f32; 4] {
-        use sobol_burley::parts::{hash_int4, owen_scramble_int4_rev, sobol_int4_rev, Int4};
-        let sobol = sobol_int4_rev(shuffled_rev, set);
-        let seed = seed.wrapping_mul(0x9c8f_2d3b);
-        let scramble: Int4 = [
-            seed ^ set ^ 0x912f_69ba,
-            seed ^ set ^ 0x174f_18ab,
-            seed ^ set ^ 0x691e_72ca,
-            seed ^ set ^ 0xb40c_c1b8,
-        ]
-        .into();
-        owen_scramble_int4_rev(sobol, hash_int4(scramble))
-            .reverse_bits()
-            .to_f32_norm()
+    fn set_seed(&self, set: u32) -> u32 {
+        mix64(((set as u64) << 32) ^ self.block_seed as u64) as u32
+    }
+
+    /// Dimensions `d .. d + 4` (`d` a multiple of 4).
+    #[inline]
+    fn block(&self, d: u32) -> [f32; 4] {
+        sobol_burley::sample_4d(self.index, 0, self.set_seed(d / 4))
     }
 
     #[inline]
     fn refill(&mut self) {
-        let d = self.dim;
-        self.buf = if d < DIMS {
-            Self::sample_4d(self.shuffled_rev, d / 4, self.block_seed)
-        } else {
-            // Deeper dimensions: the same Sobol dimensions under a fresh scramble (which also
-            // reshuffles the index).
-            let seed = mix64(self.seed ^ ((d / DIMS) as u64) << 40 ^ self.block_seed as u64) as u32;
-            sobol_burley::sample_4d(self.index, (d % DIMS) / 4, seed)
-        };
+        self.buf = self.block(self.dim);
+    }
+
+    /// The next four dimensions at once, starting at the next multiple of four (dimensions
+    /// skipped to get there are not used). Cheaper than four [`Sampler::get1d`] calls.
+    #[inline]
+    pub fn get4(&mut self) -> [f32; 4] {
+        let d = (self.dim + 3) & !3;
+        self.dim = d + 4;
+        self.block(d).map(|x| x.min(ONE_MINUS_EPSILON))
     }
 
     /// Next uniform number in [0, 1).
@@ -127,28 +117,79 @@ mod tests {
     }
 
     #[test]
-    fn equals_sobol_burley_one_dimension_at_a_time() {
-        // The batched generator must hand out exactly `sobol_burley::sample`'s values,
-        // including past the 256 dimensions of one scramble and past the 2^16-sample block.
-        for (pixel, index) in [(0u64, 0u64), (77, 5), (123, 70_000), (4_000_000, 65_535)] {
-            let mut s = Sampler::new(11, pixel, index);
-            let pixel_seed = mix64(11 ^ mix64(pixel.wrapping_add(0x9e37_79b9_7f4a_7c15)));
-            let block_seed = mix64(pixel_seed ^ (index >> 16)) as u32;
-            let i = (index % (1 << 16)) as u32;
-            for d in 0..600u32 {
-                let want = if d < DIMS {
-                    sobol_burley::sample(i, d, block_seed)
-                } else {
-                    let seed = mix64(pixel_seed ^ ((d / DIMS) as u64) << 40 ^ block_seed as u64);
-                    sobol_burley::sample(i, d % DIMS, seed as u32)
+    fn each_set_is_a_stratified_sobol_net() {
+        // 64 consecutive samples of one pixel: in every dimension set, dimensions (0, 1) form
+        // a (0, 6, 2)-net — exactly one point in each of the 64 elementary intervals of every
+        // shape 2^a × 2^(6−a) — and every single dimension has one point per 1/64 interval.
+        for set in [0u32, 1, 7, 100] {
+            let pts: Vec<[f32; 4]> = (0..64)
+                .map(|i| {
+                    let mut s = Sampler::new(5, 321, i);
+                    for _ in 0..set {
+                        s.get4();
+                    }
+                    s.get4()
+                })
+                .collect();
+            for a in 0..=6 {
+                let (nx, ny) = (1u32 << a, 1u32 << (6 - a));
+                let mut seen = vec![false; 64];
+                for p in &pts {
+                    let cell = (p[0] * nx as f32) as u32 * ny + (p[1] * ny as f32) as u32;
+                    assert!(
+                        !seen[cell as usize],
+                        "set {set}, shape {nx}×{ny}: two points in one cell"
+                    );
+                    seen[cell as usize] = true;
                 }
-                .min(ONE_MINUS_EPSILON);
-                assert_eq!(
-                    s.get1d(),
-                    want,
-                    "pixel {pixel}, index {index}, dimension {d}"
-                );
             }
+            for k in 0..4 {
+                let mut seen = vec![false; 64];
+                for p in &pts {
+                    let cell = (p[k] * 64.0) as usize;
+                    assert!(!seen[cell], "set {set}, dimension {k} not stratified");
+                    seen[cell] = true;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn sets_are_independent() {
+        // Different sets of one sample must not repeat each other's values.
+        let mut s = Sampler::new(1, 2, 3);
+        let a = s.get4();
+        let b = s.get4();
+        assert_ne!(a, b);
+    }
+
+    #[test]
+    fn get4_is_the_next_aligned_four_dimensions() {
+        let mut a = Sampler::new(3, 8, 1234);
+        let mut b = Sampler::new(3, 8, 1234);
+        let x = a.get1d();
+        assert_eq!(x, b.get1d());
+        // get4 skips dimensions 1..4 and hands out 4..8.
+        let four = a.get4();
+        for _ in 1..4 {
+            b.get1d();
+        }
+        for v in four {
+            assert_eq!(v, b.get1d());
+        }
+        assert_eq!(a.get1d(), b.get1d());
+        // Deep dimensions (past one scramble's 256) too.
+        for _ in 0..300 {
+            b.get1d();
+        }
+        let mut c = b.clone();
+        let skip = (4 - c.dim % 4) % 4;
+        for _ in 0..skip {
+            c.get1d();
+        }
+        let four = b.get4();
+        for v in four {
+            assert_eq!(v, c.get1d());
         }
     }
 

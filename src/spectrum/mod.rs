@@ -206,9 +206,11 @@ pub fn visible_wavelength_pdf(lambda: f32) -> f32 {
     if !(LAMBDA_MIN..=LAMBDA_MAX).contains(&lambda) {
         return 0.0;
     }
-    let a = VIS_A as f32;
-    let c = (a * (lambda - VIS_CENTER as f32)).cosh();
-    (VIS_NORM / (c * c) as f64) as f32
+    // sech²(x) = 4e^{2x} / (e^{2x} + 1)²: one exponential (f32: this runs 4× per camera
+    // sample).
+    let e = (2.0 * VIS_A as f32 * (lambda - VIS_CENTER as f32)).exp();
+    let d = e + 1.0;
+    VIS_NORM as f32 * 4.0 * e / (d * d)
 }
 
 const VIS_A: f64 = 0.0072;
@@ -219,11 +221,12 @@ const VIS_NORM: f64 = VIS_A / (0.9705913469402698 + 0.856910625469828);
 /// Inverse-CDF warp for [`visible_wavelength_pdf`]: λ = 538 + atanh(t)/a with
 /// t = lerp(u, tanh(a(360−538)), tanh(a(830−538))).
 pub fn sample_visible_wavelength(u: f32) -> f32 {
-    let t0 = -0.856910625469828_f64; // tanh(0.0072·(360−538))
-    let t1 = 0.9705913469402698_f64; // tanh(0.0072·(830−538))
-    let t = t0 + (u as f64) * (t1 - t0);
-    let l = VIS_CENTER + t.atanh() / VIS_A;
-    (l as f32).clamp(LAMBDA_MIN, LAMBDA_MAX)
+    const T0: f32 = -0.856_910_6; // tanh(0.0072·(360−538))
+    const T1: f32 = 0.970_591_3; // tanh(0.0072·(830−538))
+    let t = T0 + u * (T1 - T0);
+    // atanh(t) = ½ ln((1 + t)/(1 − t)), in f32 (t stays ≥ 0.03 away from ±1).
+    let l = VIS_CENTER as f32 + ((1.0 + t) / (1.0 - t)).ln() * (0.5 / VIS_A as f32);
+    l.clamp(LAMBDA_MIN, LAMBDA_MAX)
 }
 
 /// A spectrum baked at 1 nm steps over 360–830 nm (index i ↔ 360 + i nm).
