@@ -133,7 +133,7 @@ mod tests {
                 .collect();
             for a in 0..=6 {
                 let (nx, ny) = (1u32 << a, 1u32 << (6 - a));
-                let mut seen = vec![false; 64];
+                let mut seen = [false; 64];
                 for p in &pts {
                     let cell = (p[0] * nx as f32) as u32 * ny + (p[1] * ny as f32) as u32;
                     assert!(
@@ -144,7 +144,7 @@ mod tests {
                 }
             }
             for k in 0..4 {
-                let mut seen = vec![false; 64];
+                let mut seen = [false; 64];
                 for p in &pts {
                     let cell = (p[k] * 64.0) as usize;
                     assert!(!seen[cell], "set {set}, dimension {k} not stratified");
