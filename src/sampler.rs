@@ -1,5 +1,5 @@
-//! Sample streams: Owen-scrambled Sobol points (Burley 2020, via `sobol_burley`), one
-//! independent scramble per pixel, addressed by (pixel, sample index, dimension) so that any
+//! Sample streams: padded 4-D Owen-scrambled Sobol points (Burley 2020, via `sobol_burley`),
+//! one independent scramble per pixel and dimension set, addressed by (pixel, sample index, dimension) so that any
 //! sample of any pixel can be regenerated on any thread — the image does not depend on how the
 //! work is split.
 
