@@ -18,7 +18,7 @@
  * Without --serve it traces every batch --reps times for each thread count and prints one
  * `trace ...` line per run. With --serve (used by `candela bench traversal --embree`) it reads
  * commands from stdin, one per line, and answers each with one line on stdout:
- *   trace SET THREADS   ->  trace set=SET threads=THREADS rays=N seconds=S
+ *   trace SET THREADS   ->  trace set=SET threads=THREADS rays=N seconds=S cpu_seconds=C
  *   hits PATH           ->  hits written=PATH      (t of the last run of every batch)
  *   quit
  * Every answer line starts with a keyword; errors are reported as `error: ...` on stderr with
@@ -107,8 +107,15 @@ static void on_error(void *user, enum RTCError code, const char *str) {
 typedef struct {
     RTCScene scene;
     RaySet *set;
-    uint64_t next; /* atomic chunk counter */
+    uint64_t next;     /* atomic chunk counter */
+    uint64_t cpu_ns;   /* atomic: CPU time of the tracing threads */
 } Job;
+
+static uint64_t thread_cpu_ns(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
 
 static void *worker(void *arg) {
     Job *job = arg;
@@ -116,6 +123,7 @@ static void *worker(void *arg) {
     /* As Embree's documentation asks of every thread that traces rays. */
     _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    uint64_t c0 = thread_cpu_ns();
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (;;) {
@@ -162,17 +170,21 @@ static void *worker(void *arg) {
             }
         }
     }
+    __atomic_fetch_add(&job->cpu_ns, thread_cpu_ns() - c0, __ATOMIC_RELAXED);
     return NULL;
 }
 
-static double trace(RTCScene scene, RaySet *s, int threads) {
-    Job job = {scene, s, 0};
+/* Returns the wall time in seconds; *cpu gets the tracing threads' CPU seconds. */
+static double trace(RTCScene scene, RaySet *s, int threads, double *cpu) {
+    Job job = {scene, s, 0, 0};
     pthread_t tid[MAX_THREADS];
     double t0 = now();
     for (int i = 0; i < threads; i++)
         if (pthread_create(&tid[i], NULL, worker, &job) != 0) die("cannot start a thread");
     for (int i = 0; i < threads; i++) pthread_join(tid[i], NULL);
-    return now() - t0;
+    double wall = now() - t0;
+    *cpu = job.cpu_ns * 1e-9;
+    return wall;
 }
 
 static void write_hits(const char *path, RaySet *sets, uint32_t n) {
@@ -325,9 +337,10 @@ int main(int argc, char **argv) {
         for (int r = 0; r < reps; r++)
             for (uint32_t i = 0; i < n_sets; i++)
                 for (int k = 0; k < n_threads; k++) {
-                    double s = trace(scene, &sets[i], thread_list[k]);
-                    printf("trace set=%s threads=%d rays=%u seconds=%.6f mrays=%.3f\n",
-                           sets[i].name, thread_list[k], sets[i].count, s,
+                    double cpu, s = trace(scene, &sets[i], thread_list[k], &cpu);
+                    printf("trace set=%s threads=%d rays=%u seconds=%.6f cpu_seconds=%.6f "
+                           "mrays=%.3f\n",
+                           sets[i].name, thread_list[k], sets[i].count, s, cpu,
                            sets[i].count / s * 1e-6);
                     fflush(stdout);
                 }
@@ -345,9 +358,9 @@ int main(int argc, char **argv) {
                 while (i < n_sets && strcmp(sets[i].name, arg1) != 0) i++;
                 if (i == n_sets) die("no ray batch named '%s' in '%s'", arg1, path);
                 if (threads < 1 || threads > MAX_THREADS) die("bad thread count %d", threads);
-                double s = trace(scene, &sets[i], threads);
-                printf("trace set=%s threads=%d rays=%u seconds=%.6f\n", arg1, threads,
-                       sets[i].count, s);
+                double cpu, s = trace(scene, &sets[i], threads, &cpu);
+                printf("trace set=%s threads=%d rays=%u seconds=%.6f cpu_seconds=%.6f\n", arg1,
+                       threads, sets[i].count, s, cpu);
             } else if (!strcmp(cmd, "hits") && n >= 2) {
                 write_hits(arg1, sets, n_sets);
                 printf("hits written=%s\n", arg1);

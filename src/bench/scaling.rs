@@ -66,10 +66,10 @@ pub fn run(args: &ScalingArgs) -> Result<()> {
         spp: Some(args.spp),
         ..Default::default()
     };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()?;
-    let threads = pool.current_num_threads();
+    let threads = match args.threads {
+        Some(n) if n > 0 => n,
+        _ => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
     let peak_resets = reset_peak_rss();
     println!(
         "Scaling: bumpy sphere of N triangles on a floor quad, sky + sun, {r}×{r} × {spp} spp, {threads} threads. \
@@ -104,10 +104,10 @@ pub fn run(args: &ScalingArgs) -> Result<()> {
         drop(shapes);
         let bytes_per_tri = geo.memory_bytes() as f64 / geo.primitive_count() as f64;
         let batches = generate_batches(&geo, 256);
-        let (tp, _) = trace_batch(&geo, &batches[0], &pool);
-        let (td, _) = trace_batch(&geo, &batches[1], &pool);
-        let primary = batches[0].rays.len() as f64 / tp / 1e6;
-        let diffuse = batches[1].rays.len() as f64 / td / 1e6;
+        let (tp, _) = trace_batch(&geo, &batches[0], threads);
+        let (td, _) = trace_batch(&geo, &batches[1], threads);
+        let primary = batches[0].rays.len() as f64 / tp.wall / 1e6;
+        let diffuse = batches[1].rays.len() as f64 / td.wall / 1e6;
         drop(batches);
         drop(geo);
 
