@@ -1,5 +1,15 @@
 //! `candela bench`: throughput on the Cornell box and on a generated mesh of about a million
-//! triangles. Prints samples/s and rays/s; nothing here is asserted by tests.
+//! triangles (samples/s and rays/s), plus two sub-benchmarks:
+//! * `candela bench traversal` — closest-hit / any-hit rays per second of the BVH on primary,
+//!   diffuse-bounce and shadow rays, optionally against Embree (see `bench/embree/README.md`);
+//! * `candela bench scaling` — the mesh scene at 10 k … 5 M triangles (build time, bytes per
+//!   triangle, peak memory, ns per sample) and a pixels × samples linearity check.
+//!
+//! Nothing here is asserted by tests (timings depend on the machine).
+
+pub mod rayfile;
+pub mod scaling;
+pub mod traversal;
 
 use crate::render::render;
 use crate::scene::{self, schema::*, Overrides};
@@ -7,6 +17,41 @@ use std::path::Path;
 use std::time::Instant;
 
 const CORNELL: &str = include_str!("../scenes/cornell-box.ron");
+
+/// Options of `candela bench`.
+#[derive(clap::Args, Debug, Clone)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    pub mode: Option<BenchMode>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Samples per pixel for each benchmark scene.
+    #[arg(long, default_value_t = 16)]
+    pub spp: u32,
+    /// Triangles in the generated mesh scene (approximate).
+    #[arg(long, default_value_t = 1_000_000)]
+    pub triangles: usize,
+}
+
+/// The sub-benchmarks of `candela bench` (without one: Cornell box and the 1 M-triangle scene).
+#[derive(clap::Subcommand, Debug, Clone)]
+pub enum BenchMode {
+    /// BVH closest-hit / any-hit Mrays/s on primary, diffuse-bounce and shadow rays (1 and 2 threads); --export writes mesh + rays for bench/embree, --embree compares against Embree. See bench/embree/README.md.
+    Traversal(traversal::TraversalArgs),
+    /// The mesh scene at 10 k, 100 k, 1 M and 5 M triangles: BVH build time, bytes/triangle, peak RSS, ns/sample, samples/s, rays/s; plus a pixels × spp linearity check.
+    Scaling(scaling::ScalingArgs),
+}
+
+/// Entry point of `candela bench`.
+pub fn main(args: &BenchArgs) -> anyhow::Result<()> {
+    match &args.mode {
+        None => run(args.threads, args.spp, args.triangles),
+        Some(BenchMode::Traversal(a)) => traversal::run(a),
+        Some(BenchMode::Scaling(a)) => scaling::run(a),
+    }
+}
 
 fn report(name: &str, r: &crate::render::RenderResult) {
     println!(
@@ -21,28 +66,21 @@ fn report(name: &str, r: &crate::render::RenderResult) {
     );
 }
 
-pub fn run(threads: Option<usize>, spp: u32, triangles: usize) -> anyhow::Result<()> {
-    let overrides = Overrides {
-        spp: Some(spp),
-        ..Default::default()
-    };
-    let path = Path::new("scenes/cornell-box.ron");
-    let world = scene::build(&scene::parse(CORNELL, path)?, path, &overrides)?;
-    let r = render(&world, threads, &|_, _| {})?;
-    report("cornell-box", &r);
+/// Cube-sphere subdivisions for about `triangles` triangles (`12·s²`).
+pub fn subdivisions_for(triangles: usize) -> u32 {
+    ((triangles as f64 / 12.0).sqrt().ceil() as u32).max(1)
+}
 
-    // A displaced sphere of ~`triangles` triangles on a floor, under a sky and a sun.
-    let t0 = Instant::now();
-    let subdivisions = ((triangles as f64 / 12.0).sqrt().ceil() as u32).max(1);
-    let mesh = crate::geometry::generate::bumpy_sphere(subdivisions);
-    let n_tris = mesh.indices.len();
-    let scene = SceneFile {
+/// The mesh benchmark scene: `mesh` (the bumpy sphere, lifted by 1 m) on a 20 m floor quad,
+/// grey diffuse, under a D65 sky and a D50 sun, seen by [`traversal::bench_camera`]'s view.
+pub fn mesh_scene(mesh: crate::geometry::TriangleMesh, spp: u32, resolution: u32) -> SceneFile {
+    SceneFile {
         camera: CameraDesc {
             position: [0.0, 1.2, -3.2],
             look_at: [0.0, 0.9, 0.0],
             up: [0.0, 1.0, 0.0],
             vfov_deg: 45.0,
-            resolution: (256, 256),
+            resolution: (resolution, resolution),
             lens: None,
         },
         render: RenderDesc {
@@ -62,7 +100,7 @@ pub fn run(threads: Option<usize>, spp: u32, triangles: usize) -> anyhow::Result
                 name: Some("mesh".into()),
                 shape: ShapeDesc::Triangles {
                     positions: mesh.positions.iter().map(|p| p.to_array()).collect(),
-                    indices: mesh.indices.clone(),
+                    indices: mesh.indices,
                     normals: None,
                 },
                 material: "grey".into(),
@@ -99,9 +137,27 @@ pub fn run(threads: Option<usize>, spp: u32, triangles: usize) -> anyhow::Result
         meters: Vec::new(),
         grids: Vec::new(),
         measure: MeasureDesc::default(),
+    }
+}
+
+/// The default benchmark: the Cornell box, then the mesh scene with about `triangles` triangles.
+pub fn run(threads: Option<usize>, spp: u32, triangles: usize) -> anyhow::Result<()> {
+    let overrides = Overrides {
+        spp: Some(spp),
+        ..Default::default()
     };
-    drop(mesh);
+    let path = Path::new("scenes/cornell-box.ron");
+    let world = scene::build(&scene::parse(CORNELL, path)?, path, &overrides)?;
+    let r = render(&world, threads, &|_, _| {})?;
+    report("cornell-box", &r);
+
+    // A displaced sphere of ~`triangles` triangles on a floor, under a sky and a sun.
+    let t0 = Instant::now();
+    let mesh = crate::geometry::generate::bumpy_sphere(subdivisions_for(triangles));
+    let n_tris = mesh.indices.len();
+    let scene = mesh_scene(mesh, spp, 256);
     let world = scene::build(&scene, Path::new("<generated>"), &overrides)?;
+    drop(scene);
     println!(
         "generated mesh: {n_tris} triangles, scene built (incl. BVH) in {:.2} s, geometry ≈ {:.1} bytes/triangle",
         t0.elapsed().as_secs_f64(),

@@ -65,18 +65,8 @@ enum Command {
         #[arg(long)]
         diagram: Option<PathBuf>,
     },
-    /// Benchmark: samples/s and rays/s on the Cornell box and on a generated 1 M-triangle scene.
-    Bench {
-        /// Worker threads (default: all cores).
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Samples per pixel for each benchmark scene.
-        #[arg(long, default_value_t = 16)]
-        spp: u32,
-        /// Triangles in the generated mesh scene (approximate).
-        #[arg(long, default_value_t = 1_000_000)]
-        triangles: usize,
-    },
+    /// Benchmark: samples/s and rays/s on the Cornell box and on a generated 1 M-triangle scene; `bench traversal` (BVH vs Embree) and `bench scaling` (10 k … 5 M triangles).
+    Bench(candela::bench::BenchArgs),
     /// Luminance, illuminance (95 % CI), XYZ, xy, u′v′, CCT, Duv and sRGB of a pixel or disc of an EXR; see docs/reports.md.
     Probe(candela::report::probe::ProbeArgs),
     /// False-colour PNG of luminance or illuminance with a legend; see docs/reports.md.
@@ -171,11 +161,7 @@ fn main() -> ExitCode {
         Command::Luminaire { file, diagram } => {
             candela::luminaire::cli::run(&file, diagram.as_deref()).map(|s| print!("{s}"))
         }
-        Command::Bench {
-            threads,
-            spp,
-            triangles,
-        } => candela::bench::run(threads, spp, triangles),
+        Command::Bench(args) => candela::bench::main(&args),
         Command::Probe(args) => candela::report::probe::run(&args).map(|s| print!("{s}")),
         Command::Falsecolour(args) => {
             candela::report::falsecolour::run(&args).map(|s| print!("{s}"))
