@@ -120,7 +120,7 @@ def run_mitsuba(variant, spp, seed, out, args, parts=1, sampler=None):
            str(seed), "--threads", str(args.threads), "--parts", str(parts), "--sampler",
            sampler or args.mitsuba_sampler, "--rr-depth", str(args.mitsuba_rr_depth), "--out", out]
     stdout, _, wall, rss = run_process(cmd)
-    info = json.loads(stdout.strip().splitlines()[-1])
+    info = json.loads([l for l in stdout.splitlines() if l.startswith("{")][-1])
     ys = np.load(out) * MITSUBA_Y_TO_CD_M2
     return {"renderer": "mitsuba", "variant": variant, "sampler": sampler or args.mitsuba_sampler,
             "spp": spp, "seed": seed,
@@ -322,10 +322,12 @@ def parse_args():
     ap.add_argument("--spp", type=int, default=64, help="samples per pixel of the timed runs")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--ref-spp", type=int, default=1024, help="reference samples per pixel")
-    ap.add_argument("--ref-parts", type=int, default=8, help="independent Mitsuba reference renders")
+    ap.add_argument("--ref-parts", type=int, default=16,
+                    help="independent Mitsuba reference renders of --ref-spp/--ref-parts spp each")
     ap.add_argument("--fresh-refs", action="store_true", help="re-render the cached references")
     ap.add_argument("--mitsuba-sampler", default="ldsampler",
-                    help="Mitsuba sampler of the main runs (default ldsampler, its low-discrepancy one)")
+                    help="Mitsuba sampler of the main runs (default ldsampler, its low-discrepancy one; "
+                         "it needs spp = 4^k, so --spp and --ref-spp/--ref-parts must be powers of 4)")
     ap.add_argument("--no-independent", action="store_true",
                     help="skip the extra Mitsuba llvm_ad_spectral rows with its default 'independent' sampler")
     ap.add_argument("--mitsuba-rr-depth", type=int, default=5, help="Mitsuba rr_depth (default: its default 5)")

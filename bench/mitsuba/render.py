@@ -31,6 +31,7 @@ def parse_args():
     ap.add_argument("--sampler", default="independent", help="Mitsuba sampler plugin")
     ap.add_argument("--rr-depth", type=int, default=5, help="Mitsuba rr_depth (its default: 5)")
     ap.add_argument("--out", required=True, help=".npy file for the Y images")
+    ap.add_argument("--scene", default=SCENE, help="scene file (default: bench/mitsuba/cornell.xml)")
     return ap.parse_args()
 
 
@@ -46,8 +47,11 @@ def main():
     mi.set_log_level(mi.LogLevel.Warn)
 
     t0 = time.perf_counter()
-    scene = mi.load_file(SCENE, spp=args.spp, sampler=args.sampler, rr_depth=args.rr_depth)
+    scene = mi.load_file(args.scene, spp=args.spp, sampler=args.sampler, rr_depth=args.rr_depth)
     load_s = time.perf_counter() - t0
+    effective = scene.sensors()[0].sampler().sample_count()
+    if effective != args.spp:  # e.g. ldsampler rounds to a square power of two
+        sys.exit(f"render.py: sampler {args.sampler!r} would take {effective} spp instead of {args.spp}")
 
     images, render_s = [], 0.0
     for part in range(args.parts):
@@ -58,6 +62,7 @@ def main():
         assert xyz.shape[2] == 3, xyz.shape  # hdrfilm pixel_format="xyz": X, Y, Z
         images.append(xyz[:, :, 1])
     np.save(args.out, np.stack(images))
+    print()  # Mitsuba's log goes to stdout too: the summary is the last line
     json.dump({"variant": args.variant, "spp": args.spp, "parts": args.parts, "seed": args.seed,
                "threads": args.threads, "sampler": args.sampler, "rr_depth": args.rr_depth,
                "load_s": load_s, "render_s": render_s}, sys.stdout)
