@@ -263,6 +263,18 @@ def summary_of(runs):
     return s
 
 
+def paired_ratios(cruns, mruns):
+    """candela / Mitsuba ratios round by round (each pair ran back to back, so a change of the
+    machine's load between rounds cancels), summarised as median and min-max."""
+    pairs = list(zip(cruns, mruns))
+    def ratio(f):
+        return summarize([f(c) / f(m) for c, m in pairs])
+    return {"throughput": ratio(lambda r: r["samples_per_s"]),
+            "render_time": ratio(lambda r: r["render_s"]),
+            "efficiency": ratio(lambda r: r["efficiency"]),
+            "peak_rss": ratio(lambda r: r["peak_rss_mib"])}
+
+
 # --------------------------------------------------------------------------- output
 def fmt_range(s, f="{:.2f}"):
     return f"{f.format(s['median'])} ({f.format(s['min'])}–{f.format(s['max'])})"
@@ -283,11 +295,12 @@ def markdown(summary, ratios, agree, chi, meta):
                      f"{s['samples_per_s']['median'] / 1e6:.3f} | {s['peak_rss_mib']['median']:.0f} | "
                      f"{fmt_range(s['rmse'])} | {100 * s['rel_rmse']['median']:.1f} % | "
                      f"{s['efficiency']['median']:.3g} |")
-    lines += ["", "| candela ÷ Mitsuba | throughput (samples/s) | render time at equal spp | "
+    lines += ["", "candela ÷ Mitsuba, per round (median, min–max):", "",
+              "| candela ÷ Mitsuba | throughput (samples/s) | render time at equal spp | "
               "efficiency at equal error | peak RSS |", "|---|---:|---:|---:|---:|"]
     for name, r in ratios.items():
-        lines.append(f"| {name} | {r['throughput']:.2f}× | {r['render_time']:.2f}× | "
-                     f"{r['efficiency']:.2f}× | {r['peak_rss']:.2f}× |")
+        cells = [f"{fmt_range(r[k], '{:.2f}')}×" for k in ("throughput", "render_time", "efficiency", "peak_rss")]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
     lines += ["", f"Agreement of the converged references (candela {meta['ref_spp']} spp; Mitsuba "
               f"llvm_ad_spectral {meta['ref_parts']} × {meta['ref_spp'] // meta['ref_parts']} spp), "
               "luminance in cd/m² ± 1σ:", "",
@@ -325,9 +338,9 @@ def parse_args():
     ap.add_argument("--ref-parts", type=int, default=16,
                     help="independent Mitsuba reference renders of --ref-spp/--ref-parts spp each")
     ap.add_argument("--fresh-refs", action="store_true", help="re-render the cached references")
-    ap.add_argument("--mitsuba-sampler", default="ldsampler",
-                    help="Mitsuba sampler of the main runs (default ldsampler, its low-discrepancy one; "
-                         "it needs spp = 4^k, so --spp and --ref-spp/--ref-parts must be powers of 4)")
+    ap.add_argument("--mitsuba-sampler", default="multijitter",
+                    help="Mitsuba sampler of the main runs (default multijitter, stratified; its ldsampler "
+                         "is biased on this scene, see bench/README.md)")
     ap.add_argument("--no-independent", action="store_true",
                     help="skip the extra Mitsuba llvm_ad_spectral rows with its default 'independent' sampler")
     ap.add_argument("--mitsuba-rr-depth", type=int, default=5, help="Mitsuba rr_depth (default: its default 5)")
@@ -425,16 +438,11 @@ def main():
                          + ("; machine shared with other jobs" if max(meta["loadavg_start"][0], meta["loadavg_end"][0]) > 1.5 else ""))
 
     summary = {k: summary_of(v) for k, v in groups.items() if v}
-    ratios = {}
-    c = summary["candela"]
-    for key, name in (("mitsuba-llvm", f"vs llvm_ad_spectral, {samp}"), ("mitsuba-scalar", f"vs scalar_spectral, {samp}"),
-                      ("mitsuba-llvm-independent", "vs llvm_ad_spectral, independent")):
-        if key in summary:
-            m = summary[key]
-            ratios[name] = {"throughput": c["samples_per_s"]["median"] / m["samples_per_s"]["median"],
-                            "render_time": c["render_s"]["median"] / m["render_s"]["median"],
-                            "efficiency": c["efficiency"]["median"] / m["efficiency"]["median"],
-                            "peak_rss": c["peak_rss_mib"]["median"] / m["peak_rss_mib"]["median"]}
+    ratios = {name: paired_ratios(groups["candela"], groups[key])
+              for key, name in (("mitsuba-llvm", f"vs llvm_ad_spectral, {samp}"),
+                                ("mitsuba-scalar", f"vs scalar_spectral, {samp}"),
+                                ("mitsuba-llvm-independent", "vs llvm_ad_spectral, independent"))
+              if groups.get(key)}
     md = markdown(summary, ratios, agree, chi, meta)
     worst = max(abs(a["z"]) for a in agree)
     disagree = [a["region"] for a in agree if abs(a["z"]) > 4 and abs(a["diff_pct"]) > 0.1]
