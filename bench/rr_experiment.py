@@ -21,11 +21,12 @@ import compare as C  # noqa: E402
 
 EXP = os.path.join(C.OUT, "exp")
 NO_RR = 1000  # an rr_depth beyond max_depth: no roulette
+SCENE = C.SCENE_RON  # the benchmark scene (C.SCENE_RON is pointed at the variants below)
 
 
 def candela_scene(rr_depth, sphere):
     """A copy of scenes/bench-cornell.ron with render.rr_depth set, optionally without the sphere."""
-    with open(C.SCENE_RON, encoding="utf-8") as f:
+    with open(SCENE, encoding="utf-8") as f:
         ron = f.read()
     if not sphere:
         start = ron.index('        (\n            name: "glass sphere"')
