@@ -111,6 +111,9 @@ pub fn trace(
     let mut prev_pdf = start.pdf;
     let mut prev_p = start.p;
     let mut depth = start.depth;
+    // Product of η′² over the refractions so far (see `Material::eta_scale`), for Russian
+    // roulette only.
+    let mut eta_scale = 1.0f32;
 
     loop {
         let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
@@ -207,6 +210,7 @@ pub fn trace(
         if beta.is_black() {
             break;
         }
+        eta_scale *= material.eta_scale(wo, bs.wi, wl);
         prev_specular = bs.specular;
         prev_pdf = bs.pdf;
         prev_p = hit.p;
@@ -218,7 +222,7 @@ pub fn trace(
 
         // Russian roulette.
         if depth > settings.rr_depth {
-            let m = beta.max_component();
+            let m = beta.max_component() * eta_scale;
             if m < 1.0 {
                 let q = (1.0 - m).max(0.0);
                 if u_rr < q {

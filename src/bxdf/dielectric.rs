@@ -50,7 +50,7 @@ impl Dielectric {
     }
 
     #[inline]
-    fn eta(&self, wl: &SampledWavelengths) -> f32 {
+    pub(crate) fn eta(&self, wl: &SampledWavelengths) -> f32 {
         self.ior.at(wl.lambda[0])
     }
 

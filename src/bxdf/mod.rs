@@ -139,6 +139,23 @@ impl Material {
             _ => false,
         }
     }
+    /// Squared relative index of refraction η′² of the scattering `wo` → `wi` (local frame):
+    /// (n_inside/n_outside)² when entering a dielectric, its inverse when leaving, 1 for
+    /// reflection and for materials that do not refract. Radiance crossing the interface is
+    /// scaled by 1/η′², which says nothing about the path's expected contribution (it is undone
+    /// on the way out), so Russian roulette multiplies the throughput by the product of these
+    /// (pbrt-v4's `etaScale`; Mitsuba does the same).
+    #[inline]
+    pub fn eta_scale(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> f32 {
+        match self {
+            Material::Dielectric(d) if wo.z * wi.z < 0.0 => {
+                let eta = d.eta(wl);
+                let etap = if wo.z > 0.0 { eta } else { 1.0 / eta };
+                etap * etap
+            }
+            _ => 1.0,
+        }
+    }
     /// True if the material scatters nothing, so paths can stop at it.
     pub fn is_black(&self) -> bool {
         matches!(self, Material::Black)
