@@ -5,9 +5,8 @@ Run it through bench/mitsuba.sh (which installs Mitsuba into target/bench-venv a
 candela first); see bench/README.md for what is measured and how. Outline:
 
   1. converged references, cached in target/bench/refs/ (keyed by a hash of the scene files):
-     candela at --ref-spp (its stderr.Y gives the per-pixel variance) and Mitsuba
-     llvm_ad_spectral at --ref-spp split into --ref-parts independent seeds (their spread gives
-     the variance);
+     candela and Mitsuba llvm_ad_spectral, each at --ref-spp split into --ref-parts independent
+     seeds (their spread gives the variance of region means);
   2. agreement check of the two references, region by region, in units of sigma;
   3. one warm-up render per renderer (Mitsuba's LLVM backend JIT-compiles its kernels on first
      use and caches them in ~/.drjit);
@@ -157,18 +156,32 @@ def tool_version(cmd):
 
 
 def candela_reference(args):
-    """Converged candela image (Y, per-pixel variance of Y), cached by scene hash."""
-    key = files_hash(candela_scene_files(), f"candela {tool_version([CANDELA, '--version'])} {args.ref_spp}")
+    """Converged candela image from --ref-parts independent seeds (as Mitsuba's): mean, per-pixel
+    variance of the mean from the renders' stderr.Y, and the parts, whose spread gives honest
+    region sigmas also where the noise is heavy-tailed (the caustic-lit ceiling). Cached by
+    scene hash."""
+    key = files_hash(candela_scene_files(),
+                     f"candela {tool_version([CANDELA, '--version'])} {args.ref_spp} {args.ref_parts}")
     path = os.path.join(OUT, "refs", f"candela-{key}.npz")
     if os.path.exists(path) and not args.fresh_refs:
         log(f"reference: candela, cached {os.path.relpath(path, ROOT)}")
         z = np.load(path)
-        return {"Y": z["Y"], "var": z["var"], "path": path, "cached": True, "render_s": float(z["render_s"])}
-    log(f"reference: candela {args.ref_spp} spp ...")
-    r = run_candela(args.ref_spp, 1_000_003, os.path.join(OUT, "refs", "candela-ref"), args.threads)
-    np.savez(path, Y=r["Y"], var=r["var"], render_s=r["render_s"])
-    log(f"  {r['render_s']:.1f} s")
-    return {"Y": r["Y"], "var": r["var"], "path": path, "cached": False, "render_s": r["render_s"]}
+        return {"Y": z["parts"].mean(axis=0), "parts": z["parts"], "var": z["var"], "path": path,
+                "cached": True, "render_s": float(z["render_s"])}
+    spp = args.ref_spp // args.ref_parts
+    log(f"reference: candela {args.ref_parts} x {spp} spp ...")
+    parts, var, render_s = [], 0.0, 0.0
+    for k in range(args.ref_parts):
+        r = run_candela(spp, 1_000_003 + k, os.path.join(OUT, "refs", "candela-ref"), args.threads)
+        parts.append(r["Y"])
+        var = var + r["var"]
+        render_s += r["render_s"]
+    parts = np.array(parts)
+    var = var / args.ref_parts ** 2
+    np.savez(path, parts=parts, var=var, render_s=render_s)
+    log(f"  {render_s:.1f} s")
+    return {"Y": parts.mean(axis=0), "parts": parts, "var": var, "path": path, "cached": False,
+            "render_s": render_s}
 
 
 def mitsuba_reference(args):
@@ -218,22 +231,21 @@ def region_mean(img, rect):
 
 def agreement(cref, mref):
     """Compare the converged images region by region and pixel by pixel, in sigma units.
-    candela's sigma from its per-pixel stderr (pixels independent), Mitsuba's from the spread
-    of the region means over its independent parts."""
+    Both sigmas come from the spread of the region means over each renderer's independent
+    reference parts (per-pixel variances understate the error of heavy-tailed regions)."""
     rows = []
     regions = dict(REGIONS, **{"whole image": (0, H, 0, W), "whole image without light": None})
     mask = rmse_mask()
     for name, rect in regions.items():
         if rect is None:
-            c = cref["Y"][mask].mean()
-            sc = np.sqrt(cref["var"][mask].sum()) / mask.sum()
+            cparts = np.array([p[mask].mean() for p in cref["parts"]])
             mparts = np.array([p[mask].mean() for p in mref["parts"]])
         else:
             r0, r1, c0, c1 = rect
-            c = region_mean(cref["Y"], rect)
-            sc = np.sqrt(cref["var"][r0:r1, c0:c1].sum()) / ((r1 - r0) * (c1 - c0))
+            cparts = np.array([region_mean(p, rect) for p in cref["parts"]])
             mparts = np.array([region_mean(p, rect) for p in mref["parts"]])
-        m = mparts.mean()
+        c, m = cparts.mean(), mparts.mean()
+        sc = cparts.std(ddof=1) / np.sqrt(len(cparts))
         sm = mparts.std(ddof=1) / np.sqrt(len(mparts))
         sigma = np.hypot(sc, sm)
         rows.append({"region": name, "candela": c, "candela_sigma": sc, "mitsuba": m,
@@ -301,9 +313,10 @@ def markdown(summary, ratios, agree, chi, meta):
     for name, r in ratios.items():
         cells = [f"{fmt_range(r[k], '{:.2f}')}×" for k in ("throughput", "render_time", "efficiency", "peak_rss")]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    lines += ["", f"Agreement of the converged references (candela {meta['ref_spp']} spp; Mitsuba "
-              f"llvm_ad_spectral {meta['ref_parts']} × {meta['ref_spp'] // meta['ref_parts']} spp), "
-              "luminance in cd/m² ± 1σ:", "",
+    parts = f"{meta['ref_parts']} × {meta['ref_spp'] // meta['ref_parts']} spp"
+    lines += ["", f"Agreement of the converged references (candela {parts}; Mitsuba "
+              f"llvm_ad_spectral {parts}), luminance in cd/m² ± 1σ (σ from the spread of the "
+              "parts' region means):", "",
               "| region | candela | Mitsuba (× 683 × 106.7503) | Δ | Δ/σ |", "|---|---:|---:|---:|---:|"]
     for a in agree:
         lines.append(f"| {a['region']} | {a['candela']:.2f} ± {a['candela_sigma']:.2f} | "
@@ -336,7 +349,7 @@ def parse_args():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--ref-spp", type=int, default=1024, help="reference samples per pixel")
     ap.add_argument("--ref-parts", type=int, default=16,
-                    help="independent Mitsuba reference renders of --ref-spp/--ref-parts spp each")
+                    help="independent reference renders (each renderer) of --ref-spp/--ref-parts spp each")
     ap.add_argument("--fresh-refs", action="store_true", help="re-render the cached references")
     ap.add_argument("--mitsuba-sampler", default="multijitter",
                     help="Mitsuba sampler of the main runs (default multijitter, stratified; its ldsampler "
