@@ -155,6 +155,25 @@ def tool_version(cmd):
     return subprocess.run(cmd, capture_output=True, text=True).stdout.strip()
 
 
+def reference(parts, var, path, cached, render_s):
+    """A converged reference from its independent parts: mean, per-pixel variance of the mean
+    (given, or from the spread of the parts), and the parts themselves."""
+    if var is None:
+        var = parts.var(axis=0, ddof=1) / len(parts)
+    return {"Y": parts.mean(axis=0), "parts": parts, "var": var, "path": path, "cached": cached,
+            "render_s": render_s}
+
+
+def cached_reference(path, name):
+    """The reference cached at `path`, or None."""
+    if not os.path.exists(path):
+        return None
+    log(f"reference: {name}, cached {os.path.relpath(path, ROOT)}")
+    z = np.load(path)
+    return reference(z["parts"], z["var"] if "var" in z.files else None, path, True,
+                     float(z["render_s"]))
+
+
 def candela_reference(args):
     """Converged candela image from --ref-parts independent seeds (as Mitsuba's): mean, per-pixel
     variance of the mean from the renders' stderr.Y, and the parts, whose spread gives honest
@@ -163,11 +182,9 @@ def candela_reference(args):
     key = files_hash(candela_scene_files(),
                      f"candela {tool_version([CANDELA, '--version'])} {args.ref_spp} {args.ref_parts}")
     path = os.path.join(OUT, "refs", f"candela-{key}.npz")
-    if os.path.exists(path) and not args.fresh_refs:
-        log(f"reference: candela, cached {os.path.relpath(path, ROOT)}")
-        z = np.load(path)
-        return {"Y": z["parts"].mean(axis=0), "parts": z["parts"], "var": z["var"], "path": path,
-                "cached": True, "render_s": float(z["render_s"])}
+    cached = None if args.fresh_refs else cached_reference(path, "candela")
+    if cached:
+        return cached
     spp = args.ref_spp // args.ref_parts
     log(f"reference: candela {args.ref_parts} x {spp} spp ...")
     parts, var, render_s = [], 0.0, 0.0
@@ -180,8 +197,7 @@ def candela_reference(args):
     var = var / args.ref_parts ** 2
     np.savez(path, parts=parts, var=var, render_s=render_s)
     log(f"  {render_s:.1f} s")
-    return {"Y": parts.mean(axis=0), "parts": parts, "var": var, "path": path, "cached": False,
-            "render_s": render_s}
+    return reference(parts, var, path, False, render_s)
 
 
 def mitsuba_reference(args):
@@ -191,19 +207,16 @@ def mitsuba_reference(args):
     key = files_hash(mitsuba_scene_files(),
                      f"mitsuba {mi.__version__} {args.ref_spp} {args.ref_parts} {args.mitsuba_sampler} {args.mitsuba_rr_depth}")
     path = os.path.join(OUT, "refs", f"mitsuba-{key}.npz")
-    if os.path.exists(path) and not args.fresh_refs:
-        log(f"reference: Mitsuba, cached {os.path.relpath(path, ROOT)}")
-        z = np.load(path)
-        return {"Y": z["parts"].mean(axis=0), "parts": z["parts"], "var": z["parts"].var(axis=0, ddof=1) / len(z["parts"]),
-                "path": path, "cached": True, "render_s": float(z["render_s"])}
+    cached = None if args.fresh_refs else cached_reference(path, "Mitsuba")
+    if cached:
+        return cached
     spp = args.ref_spp // args.ref_parts
     log(f"reference: Mitsuba llvm_ad_spectral {args.ref_parts} x {spp} spp ...")
     r = run_mitsuba("llvm_ad_spectral", spp, 1_000_000, os.path.join(OUT, "refs", "mitsuba-ref.npy"),
                     args, parts=args.ref_parts)
     np.savez(path, parts=r["parts"], render_s=r["render_s"])
     log(f"  {r['render_s']:.1f} s")
-    return {"Y": r["Y"], "parts": r["parts"], "var": r["parts"].var(axis=0, ddof=1) / args.ref_parts,
-            "path": path, "cached": False, "render_s": r["render_s"]}
+    return reference(r["parts"], None, path, False, r["render_s"])
 
 
 # --------------------------------------------------------------------------- statistics
