@@ -73,8 +73,6 @@ fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32
     let base_near = base - pad;
     let base_far = base + pad;
     let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
-    #[allow(unused_mut, unused_assignments)]
-    let mut hit_mask = 0u32;
 
     // AVX2 (all 8 children at once; built with `target-cpu=native` on any recent x86-64).
     // FMA rounds once where mul + add rounded twice, so the padding stays conservative.
@@ -83,32 +81,59 @@ fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32
         target_feature = "avx2",
         target_feature = "fma"
     ))]
+    // SAFETY: the target features are enabled at compile time; loads stay within the node.
     unsafe {
         use std::arch::x86_64::*;
+        /// Entry and exit distances of the 8 children's slabs on one axis.
         #[inline(always)]
-        fn q8(v: &[u8; 8]) -> __m256 {
-            // SAFETY: reads exactly the 8 bytes of `v`.
+        fn slabs(
+            lo: &[u8; 8],
+            hi: &[u8; 8],
+            neg: bool,
+            s: f32,
+            near: f32,
+            far: f32,
+        ) -> (__m256, __m256) {
+            // SAFETY: reads exactly the 8 bytes of each array.
             unsafe {
-                _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
-                    v.as_ptr() as *const __m128i
-                )))
+                let q8 = |v: &[u8; 8]| {
+                    _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
+                        v.as_ptr() as *const __m128i
+                    )))
+                };
+                let (lo, hi) = (q8(lo), q8(hi));
+                let (qn, qf) = if neg { (hi, lo) } else { (lo, hi) };
+                let s = _mm256_set1_ps(s);
+                (
+                    _mm256_fmadd_ps(qn, s, _mm256_set1_ps(near)),
+                    _mm256_fmadd_ps(qf, s, _mm256_set1_ps(far)),
+                )
             }
         }
-        let (lo, hi) = (q8(&node.child_min_x), q8(&node.child_max_x));
-        let (qn, qf) = if r.neg[0] { (hi, lo) } else { (lo, hi) };
-        let sx = _mm256_set1_ps(scale.x);
-        let tnx = _mm256_fmadd_ps(qn, sx, _mm256_set1_ps(base_near.x));
-        let tfx = _mm256_fmadd_ps(qf, sx, _mm256_set1_ps(base_far.x));
-        let (lo, hi) = (q8(&node.child_min_y), q8(&node.child_max_y));
-        let (qn, qf) = if r.neg[1] { (hi, lo) } else { (lo, hi) };
-        let sy = _mm256_set1_ps(scale.y);
-        let tny = _mm256_fmadd_ps(qn, sy, _mm256_set1_ps(base_near.y));
-        let tfy = _mm256_fmadd_ps(qf, sy, _mm256_set1_ps(base_far.y));
-        let (lo, hi) = (q8(&node.child_min_z), q8(&node.child_max_z));
-        let (qn, qf) = if r.neg[2] { (hi, lo) } else { (lo, hi) };
-        let sz = _mm256_set1_ps(scale.z);
-        let tnz = _mm256_fmadd_ps(qn, sz, _mm256_set1_ps(base_near.z));
-        let tfz = _mm256_fmadd_ps(qf, sz, _mm256_set1_ps(base_far.z));
+        let (tnx, tfx) = slabs(
+            &node.child_min_x,
+            &node.child_max_x,
+            r.neg[0],
+            scale.x,
+            base_near.x,
+            base_far.x,
+        );
+        let (tny, tfy) = slabs(
+            &node.child_min_y,
+            &node.child_max_y,
+            r.neg[1],
+            scale.y,
+            base_near.y,
+            base_far.y,
+        );
+        let (tnz, tfz) = slabs(
+            &node.child_min_z,
+            &node.child_max_z,
+            r.neg[2],
+            scale.z,
+            base_near.z,
+            base_far.z,
+        );
         let tmin = _mm256_max_ps(
             _mm256_max_ps(tnx, tny),
             _mm256_max_ps(tnz, _mm256_setzero_ps()),
@@ -128,91 +153,44 @@ fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32
         );
         let x = _mm_or_si128(x, _mm_shuffle_epi32::<0b01_00_11_10>(x));
         let x = _mm_or_si128(x, _mm_shuffle_epi32::<0b10_11_00_01>(x));
-        hit_mask = _mm_cvtsi128_si32(x) as u32;
+        _mm_cvtsi128_si32(x) as u32
     }
 
-    #[cfg(all(
+    // Portable form of the same test, one child at a time.
+    #[cfg(not(all(
         target_arch = "x86_64",
-        not(all(target_feature = "avx2", target_feature = "fma"))
-    ))]
-    unsafe {
-        use std::arch::x86_64::*;
-        #[inline(always)]
-        fn get_q(v: &[u8; 8], i: usize) -> __m128 {
-            unsafe {
-                _mm_set_ps(
-                    *v.get_unchecked(i * 4 + 3) as f32,
-                    *v.get_unchecked(i * 4 + 2) as f32,
-                    *v.get_unchecked(i * 4 + 1) as f32,
-                    *v.get_unchecked(i * 4) as f32,
-                )
-            }
-        }
-        let sx = _mm_set1_ps(scale.x);
-        let sy = _mm_set1_ps(scale.y);
-        let sz = _mm_set1_ps(scale.z);
-        let bnx = _mm_set1_ps(base_near.x);
-        let bny = _mm_set1_ps(base_near.y);
-        let bnz = _mm_set1_ps(base_near.z);
-        let bfx = _mm_set1_ps(base_far.x);
-        let bfy = _mm_set1_ps(base_far.y);
-        let bfz = _mm_set1_ps(base_far.z);
-        let zero = _mm_setzero_ps();
-        let tm = _mm_set1_ps(t_max);
-        for i in 0..2 {
-            let (lo, hi) = (get_q(&node.child_min_x, i), get_q(&node.child_max_x, i));
-            let (qn, qf) = if r.neg[0] { (hi, lo) } else { (lo, hi) };
-            let tnx = _mm_add_ps(_mm_mul_ps(qn, sx), bnx);
-            let tfx = _mm_add_ps(_mm_mul_ps(qf, sx), bfx);
-            let (lo, hi) = (get_q(&node.child_min_y, i), get_q(&node.child_max_y, i));
-            let (qn, qf) = if r.neg[1] { (hi, lo) } else { (lo, hi) };
-            let tny = _mm_add_ps(_mm_mul_ps(qn, sy), bny);
-            let tfy = _mm_add_ps(_mm_mul_ps(qf, sy), bfy);
-            let (lo, hi) = (get_q(&node.child_min_z, i), get_q(&node.child_max_z, i));
-            let (qn, qf) = if r.neg[2] { (hi, lo) } else { (lo, hi) };
-            let tnz = _mm_add_ps(_mm_mul_ps(qn, sz), bnz);
-            let tfz = _mm_add_ps(_mm_mul_ps(qf, sz), bfz);
-            let tmin = _mm_max_ps(_mm_max_ps(tnx, tny), _mm_max_ps(tnz, zero));
-            let tmax = _mm_min_ps(_mm_min_ps(tfx, tfy), _mm_min_ps(tfz, tm));
-            let mask = _mm_movemask_ps(_mm_cmple_ps(tmin, tmax));
-            for j in 0..4 {
-                if mask & (1 << j) != 0 {
-                    let k = i * 4 + j;
-                    let child_bits = ((child_bits8 >> (k * 8)) as u32) & 0xff;
-                    let bit_index = ((bit_index8 >> (k * 8)) as u32) & 0xff;
-                    hit_mask |= child_bits << bit_index;
+        target_feature = "avx2",
+        target_feature = "fma"
+    )))]
+    {
+        let mut hit_mask = 0u32;
+        for k in 0..8 {
+            let q = |lo: u8, hi: u8, neg: bool| {
+                if neg {
+                    (hi as f32, lo as f32)
+                } else {
+                    (lo as f32, hi as f32)
                 }
+            };
+            let (nx, fx) = q(node.child_min_x[k], node.child_max_x[k], r.neg[0]);
+            let (ny, fy) = q(node.child_min_y[k], node.child_max_y[k], r.neg[1]);
+            let (nz, fz) = q(node.child_min_z[k], node.child_max_z[k], r.neg[2]);
+            let tmin = (nx * scale.x + base_near.x)
+                .max(ny * scale.y + base_near.y)
+                .max(nz * scale.z + base_near.z)
+                .max(0.0);
+            let tmax = (fx * scale.x + base_far.x)
+                .min(fy * scale.y + base_far.y)
+                .min(fz * scale.z + base_far.z)
+                .min(t_max);
+            if tmin <= tmax {
+                let child_bits = ((child_bits8 >> (k * 8)) as u32) & 0xff;
+                let bit_index = ((bit_index8 >> (k * 8)) as u32) & 0xff;
+                hit_mask |= child_bits << bit_index;
             }
         }
+        hit_mask
     }
-
-    #[cfg(not(target_arch = "x86_64"))]
-    for k in 0..8 {
-        let q = |lo: u8, hi: u8, neg: bool| {
-            if neg {
-                (hi as f32, lo as f32)
-            } else {
-                (lo as f32, hi as f32)
-            }
-        };
-        let (nx, fx) = q(node.child_min_x[k], node.child_max_x[k], r.neg[0]);
-        let (ny, fy) = q(node.child_min_y[k], node.child_max_y[k], r.neg[1]);
-        let (nz, fz) = q(node.child_min_z[k], node.child_max_z[k], r.neg[2]);
-        let tmin = (nx * scale.x + base_near.x)
-            .max(ny * scale.y + base_near.y)
-            .max(nz * scale.z + base_near.z)
-            .max(0.0);
-        let tmax = (fx * scale.x + base_far.x)
-            .min(fy * scale.y + base_far.y)
-            .min(fz * scale.z + base_far.z)
-            .min(t_max);
-        if tmin <= tmax {
-            let child_bits = ((child_bits8 >> (k * 8)) as u32) & 0xff;
-            let bit_index = ((bit_index8 >> (k * 8)) as u32) & 0xff;
-            hit_mask |= child_bits << bit_index;
-        }
-    }
-    hit_mask
 }
 
 /// Largest distance from the origin (m, per axis) of any primitive's bounds: beyond it the
