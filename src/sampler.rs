@@ -59,15 +59,11 @@ impl Sampler {
         mix64(((set as u64) << 32) ^ self.block_seed as u64) as u32
     }
 
-    /// Dimensions `d .. d + 4` (`d` a multiple of 4).
+    /// Dimensions `d .. d + 4` (`d` a multiple of 4), each in [0, 1).
     #[inline]
     fn block(&self, d: u32) -> [f32; 4] {
         sobol_burley::sample_4d(self.index, 0, self.set_seed(d / 4))
-    }
-
-    #[inline]
-    fn refill(&mut self) {
-        self.buf = self.block(self.dim);
+            .map(|x| x.min(ONE_MINUS_EPSILON))
     }
 
     /// The next four dimensions at once, starting at the next multiple of four (dimensions
@@ -76,7 +72,7 @@ impl Sampler {
     pub fn get4(&mut self) -> [f32; 4] {
         let d = (self.dim + 3) & !3;
         self.dim = d + 4;
-        self.block(d).map(|x| x.min(ONE_MINUS_EPSILON))
+        self.block(d)
     }
 
     /// Next uniform number in [0, 1).
@@ -84,10 +80,10 @@ impl Sampler {
     pub fn get1d(&mut self) -> f32 {
         let d = self.dim;
         if d & 3 == 0 {
-            self.refill();
+            self.buf = self.block(d);
         }
         self.dim += 1;
-        self.buf[(d & 3) as usize].min(ONE_MINUS_EPSILON)
+        self.buf[(d & 3) as usize]
     }
 
     #[inline]

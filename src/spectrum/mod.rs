@@ -215,15 +215,17 @@ pub fn visible_wavelength_pdf(lambda: f32) -> f32 {
 
 const VIS_A: f64 = 0.0072;
 const VIS_CENTER: f64 = 538.0;
+/// tanh(a(360 − 538)) and tanh(a(830 − 538)): the CDF's ends.
+const VIS_TANH_MIN: f64 = -0.856910625469828;
+const VIS_TANH_MAX: f64 = 0.9705913469402698;
 /// 1 / ∫_{360}^{830} sech²(a(λ−538)) dλ = a / (tanh(a·292) + tanh(a·178)).
-const VIS_NORM: f64 = VIS_A / (0.9705913469402698 + 0.856910625469828);
+const VIS_NORM: f64 = VIS_A / (VIS_TANH_MAX - VIS_TANH_MIN);
 
 /// Inverse-CDF warp for [`visible_wavelength_pdf`]: λ = 538 + atanh(t)/a with
 /// t = lerp(u, tanh(a(360−538)), tanh(a(830−538))).
 pub fn sample_visible_wavelength(u: f32) -> f32 {
-    const T0: f32 = -0.856_910_6; // tanh(0.0072·(360−538))
-    const T1: f32 = 0.970_591_3; // tanh(0.0072·(830−538))
-    let t = T0 + u * (T1 - T0);
+    let (t0, t1) = (VIS_TANH_MIN as f32, VIS_TANH_MAX as f32);
+    let t = t0 + u * (t1 - t0);
     // atanh(t) = ½ ln((1 + t)/(1 − t)), in f32 (t stays ≥ 0.03 away from ±1).
     let l = VIS_CENTER as f32 + ((1.0 + t) / (1.0 - t)).ln() * (0.5 / VIS_A as f32);
     l.clamp(LAMBDA_MIN, LAMBDA_MAX)
