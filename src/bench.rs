@@ -67,6 +67,12 @@ fn report(name: &str, r: &crate::render::RenderResult) {
 }
 
 /// Cube-sphere subdivisions for about `triangles` triangles (`12·s²`).
+/// Median of `v` (the upper one of an even count; NaN if empty). Sorts `v`.
+pub fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
 pub fn subdivisions_for(triangles: usize) -> u32 {
     ((triangles as f64 / 12.0).sqrt().ceil() as u32).max(1)
 }

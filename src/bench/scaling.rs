@@ -4,7 +4,7 @@
 
 use super::rayfile::RayBatch;
 use super::traversal::{bench_camera, generate_batches, trace_batch};
-use super::{mesh_scene, subdivisions_for};
+use super::{median, mesh_scene, subdivisions_for};
 use crate::geometry::generate::bumpy_sphere;
 use crate::geometry::{SceneGeometry, Shape};
 use crate::render::render;
@@ -77,11 +77,6 @@ pub fn process_cpu_seconds() -> Option<f64> {
     Some(ticks as f64 / 100.0)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
 /// One render's cost: wall and CPU nanoseconds per sample, rays per sample, samples.
 #[derive(Clone, Copy)]
 struct RenderCost {
@@ -109,8 +104,8 @@ fn render_cost(world: &World, threads: Option<usize>, reps: usize) -> Result<Ren
     }
     let (samples, rays_per_sample) = last.expect("at least one render");
     Ok(RenderCost {
-        wall_ns: median(wall),
-        cpu_ns: median(cpu),
+        wall_ns: median(&mut wall),
+        cpu_ns: median(&mut cpu),
         samples,
         rays_per_sample,
     })
@@ -119,9 +114,9 @@ fn render_cost(world: &World, threads: Option<usize>, reps: usize) -> Result<Ren
 /// Median Mrays per CPU-second of `batch` over `reps` runs on `threads` threads.
 fn traversal_rate(geo: &SceneGeometry, batch: &RayBatch, threads: usize, reps: usize) -> f64 {
     median(
-        (0..reps.max(1))
+        &mut (0..reps.max(1))
             .map(|_| batch.rays.len() as f64 / trace_batch(geo, batch, threads).0.cpu / 1e6)
-            .collect(),
+            .collect::<Vec<_>>(),
     )
 }
 

@@ -2,6 +2,7 @@
 //! kinds of rays a path tracer shoots, optionally side by side with Embree (the
 //! `bench/embree/embree_trace` program, fed the same mesh and rays through a ray file).
 
+use super::median;
 use super::rayfile::{read_hits, BenchRay, RayBatch, RayFile, RayKind};
 use crate::camera::Camera;
 use crate::geometry::generate::{bumpy_sphere, Rng};
@@ -369,15 +370,6 @@ impl Drop for Embree {
     fn drop(&mut self) {
         let _ = writeln!(self.stdin, "quit").and_then(|_| self.stdin.flush());
         let _ = self.child.wait();
-    }
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[v.len() / 2]
     }
 }
 
