@@ -164,59 +164,57 @@ def reference(parts, var, path, cached, render_s):
             "render_s": render_s}
 
 
-def cached_reference(path, name):
-    """The reference cached at `path`, or None."""
-    if not os.path.exists(path):
-        return None
-    log(f"reference: {name}, cached {os.path.relpath(path, ROOT)}")
-    z = np.load(path)
-    return reference(z["parts"], z["var"] if "var" in z.files else None, path, True,
-                     float(z["render_s"]))
+def cached_reference(name, files, settings, args, render_parts):
+    """The converged reference of one renderer: loaded from target/bench/refs/ when cached
+    under a hash of its scene files and `settings` (unless --fresh-refs), else rendered by
+    `render_parts(spp)` -> (parts, per-pixel variance of the mean or None, render seconds) at
+    --ref-parts × (--ref-spp / --ref-parts) spp and cached."""
+    key = files_hash(files, settings)
+    path = os.path.join(OUT, "refs", f"{name.lower()}-{key}.npz")
+    if os.path.exists(path) and not args.fresh_refs:
+        log(f"reference: {name}, cached {os.path.relpath(path, ROOT)}")
+        z = np.load(path)
+        return reference(z["parts"], z["var"] if "var" in z.files else None, path, True,
+                         float(z["render_s"]))
+    spp = args.ref_spp // args.ref_parts
+    log(f"reference: {name} {args.ref_parts} x {spp} spp ...")
+    parts, var, render_s = render_parts(spp)
+    extra = {} if var is None else {"var": var}
+    np.savez(path, parts=parts, render_s=render_s, **extra)
+    log(f"  {render_s:.1f} s")
+    return reference(parts, var, path, False, render_s)
 
 
 def candela_reference(args):
     """Converged candela image from --ref-parts independent seeds (as Mitsuba's): mean, per-pixel
     variance of the mean from the renders' stderr.Y, and the parts, whose spread gives honest
-    region sigmas also where the noise is heavy-tailed (the caustic-lit ceiling). Cached by
-    scene hash."""
-    key = files_hash(candela_scene_files(),
-                     f"candela {tool_version([CANDELA, '--version'])} {args.ref_spp} {args.ref_parts}")
-    path = os.path.join(OUT, "refs", f"candela-{key}.npz")
-    cached = None if args.fresh_refs else cached_reference(path, "candela")
-    if cached:
-        return cached
-    spp = args.ref_spp // args.ref_parts
-    log(f"reference: candela {args.ref_parts} x {spp} spp ...")
-    parts, var, render_s = [], 0.0, 0.0
-    for k in range(args.ref_parts):
-        r = run_candela(spp, 1_000_003 + k, os.path.join(OUT, "refs", "candela-ref"), args.threads)
-        parts.append(r["Y"])
-        var = var + r["var"]
-        render_s += r["render_s"]
-    parts = np.array(parts)
-    var = var / args.ref_parts ** 2
-    np.savez(path, parts=parts, var=var, render_s=render_s)
-    log(f"  {render_s:.1f} s")
-    return reference(parts, var, path, False, render_s)
+    region sigmas also where the noise is heavy-tailed (the caustic-lit ceiling)."""
+    def render_parts(spp):
+        parts, var, render_s = [], 0.0, 0.0
+        for k in range(args.ref_parts):
+            r = run_candela(spp, 1_000_003 + k, os.path.join(OUT, "refs", "candela-ref"), args.threads)
+            parts.append(r["Y"])
+            var = var + r["var"]
+            render_s += r["render_s"]
+        return np.array(parts), var / args.ref_parts ** 2, render_s
+
+    settings = f"candela {tool_version([CANDELA, '--version'])} {args.ref_spp} {args.ref_parts}"
+    return cached_reference("candela", candela_scene_files(), settings, args, render_parts)
 
 
 def mitsuba_reference(args):
     """Converged Mitsuba llvm_ad_spectral image from --ref-parts independent seeds: mean and
     per-pixel variance of the mean (spread of the parts / parts), and the parts themselves."""
     import mitsuba as mi
-    key = files_hash(mitsuba_scene_files(),
-                     f"mitsuba {mi.__version__} {args.ref_spp} {args.ref_parts} {args.mitsuba_sampler} {args.mitsuba_rr_depth}")
-    path = os.path.join(OUT, "refs", f"mitsuba-{key}.npz")
-    cached = None if args.fresh_refs else cached_reference(path, "Mitsuba")
-    if cached:
-        return cached
-    spp = args.ref_spp // args.ref_parts
-    log(f"reference: Mitsuba llvm_ad_spectral {args.ref_parts} x {spp} spp ...")
-    r = run_mitsuba("llvm_ad_spectral", spp, 1_000_000, os.path.join(OUT, "refs", "mitsuba-ref.npy"),
-                    args, parts=args.ref_parts)
-    np.savez(path, parts=r["parts"], render_s=r["render_s"])
-    log(f"  {r['render_s']:.1f} s")
-    return reference(r["parts"], None, path, False, r["render_s"])
+
+    def render_parts(spp):
+        r = run_mitsuba("llvm_ad_spectral", spp, 1_000_000, os.path.join(OUT, "refs", "mitsuba-ref.npy"),
+                        args, parts=args.ref_parts)
+        return r["parts"], None, r["render_s"]
+
+    settings = (f"mitsuba {mi.__version__} {args.ref_spp} {args.ref_parts} {args.mitsuba_sampler} "
+                f"{args.mitsuba_rr_depth}")
+    return cached_reference("Mitsuba", mitsuba_scene_files(), settings, args, render_parts)
 
 
 # --------------------------------------------------------------------------- statistics
