@@ -28,6 +28,8 @@ pub enum PixelFilter {
 #[derive(Clone, Debug, PartialEq)]
 pub struct GaussianTable {
     inv_cdf: Vec<f32>,
+    /// ∫ exp(−x²/2σ²) dx over [−radius, radius] (the 1-D normalisation of the density).
+    norm: f32,
 }
 
 impl GaussianTable {
@@ -58,7 +60,10 @@ impl GaussianTable {
             };
             inv_cdf.push((xs[j] + t * (xs[j + 1] - xs[j])) as f32);
         }
-        Self { inv_cdf }
+        Self {
+            inv_cdf,
+            norm: total as f32,
+        }
     }
     fn sample(&self, u: f32) -> f32 {
         let n = self.inv_cdf.len() - 1;
@@ -75,6 +80,41 @@ impl PixelFilter {
             sigma,
             radius,
             table: GaussianTable::new(sigma, radius),
+        }
+    }
+
+    /// Half-width of the filter's support, pixels.
+    pub fn radius(&self) -> f32 {
+        match self {
+            PixelFilter::Box => 0.5,
+            PixelFilter::Tent { radius } | PixelFilter::Gaussian { radius, .. } => *radius,
+        }
+    }
+
+    /// The density (px⁻², integrating to 1) with which [`Self::sample`] draws offset `d` from
+    /// the pixel centre: the weight of a film point at `d` in that pixel's value.
+    pub fn density(&self, d: Vec2) -> f32 {
+        let r = self.radius();
+        if d.x.abs() > r || d.y.abs() > r {
+            return 0.0;
+        }
+        match self {
+            // The half-open pixel square [−½, ½)², as `sample` produces.
+            PixelFilter::Box => {
+                if d.x < 0.5 && d.y < 0.5 {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            PixelFilter::Tent { radius } => {
+                let t = |x: f32| (1.0 - x.abs() / radius) / radius;
+                t(d.x) * t(d.y)
+            }
+            PixelFilter::Gaussian { sigma, table, .. } => {
+                let g = |x: f32| (-(x * x) / (2.0 * sigma * sigma)).exp() / table.norm;
+                g(d.x) * g(d.y)
+            }
         }
     }
 
@@ -185,6 +225,75 @@ impl Camera {
     }
 }
 
+/// A connection from a scene point to the camera (light tracing): where it lands on the film
+/// and the importance that converts the radiance leaving the point toward the lens into pixel
+/// values.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraConnection {
+    /// The point on the lens (the pinhole for a pinhole camera).
+    pub lens_point: Vec3,
+    /// Unit direction from the scene point toward `lens_point`.
+    pub wi: Vec3,
+    /// Distance from the scene point to `lens_point`, m.
+    pub dist: f32,
+    /// Film position in pixels (0,0 = top-left corner), as [`Camera::generate_ray`] takes it.
+    pub film: Vec2,
+    /// 1 / (A_pix · d² · cos³θ): with A_pix the area of one pixel on the plane at unit distance
+    /// and θ the angle of the ray to the view axis. A pixel's value is the filter-weighted mean
+    /// of the radiance over its film footprint, and the film position of a ray toward the lens
+    /// maps to the scene point's area as dA_film = cos θ_x dA_x / (d² cos³θ); so radiance L
+    /// leaving the point toward the lens, carried by a light-path weight with area measure at
+    /// the point, adds `L · |cos θ_x| · importance · filter density` to a pixel.
+    pub importance: f32,
+}
+
+impl Camera {
+    /// Connect scene point `p` to the camera through lens point `u_lens` ∈ [0,1)²: None if
+    /// the point is behind the camera or outside the film (farther than `margin` pixels from
+    /// its edge: the reconstruction filter's radius).
+    pub fn connect(&self, p: Vec3, u_lens: Vec2, margin: f32) -> Option<CameraConnection> {
+        let lens_point = if self.lens_radius > 0.0 {
+            let d = concentric_disk(u_lens) * self.lens_radius;
+            self.position + d.x * self.right + d.y * self.up
+        } else {
+            self.position
+        };
+        let v = p - lens_point;
+        let z = v.dot(self.forward);
+        let dist = v.length();
+        if z <= 0.0 || dist == 0.0 || !dist.is_finite() {
+            return None;
+        }
+        // Film coordinates of the ray lens → p: the pinhole direction of the point where it
+        // crosses the plane in focus (for a pinhole, of p itself).
+        let (sx, sy) = if self.lens_radius > 0.0 {
+            let focus = lens_point + v * (self.focus_distance / z) - self.position;
+            (
+                focus.dot(self.right) / self.focus_distance,
+                focus.dot(self.up) / self.focus_distance,
+            )
+        } else {
+            (v.dot(self.right) / z, v.dot(self.up) / z)
+        };
+        let aspect = self.width as f32 / self.height as f32;
+        let (w, h) = (self.width as f32, self.height as f32);
+        let px = (sx / (aspect * self.tan_half_vfov) + 1.0) * 0.5 * w;
+        let py = (1.0 - sy / self.tan_half_vfov) * 0.5 * h;
+        if !(px >= -margin && px < w + margin && py >= -margin && py < h + margin) {
+            return None;
+        }
+        let a_pix = (2.0 * aspect * self.tan_half_vfov / w) * (2.0 * self.tan_half_vfov / h);
+        let cos = z / dist;
+        Some(CameraConnection {
+            lens_point,
+            wi: -v / dist,
+            dist,
+            film: Vec2::new(px, py),
+            importance: 1.0 / (a_pix * dist * dist * cos * cos * cos),
+        })
+    }
+}
+
 /// Shirley–Chiu concentric map from [0,1)² to the unit disk.
 pub fn concentric_disk(u: Vec2) -> Vec2 {
     let o = 2.0 * u - Vec2::ONE;
@@ -240,5 +349,102 @@ mod tests {
             / n as f32;
         // Truncation at 3σ reduces the variance by ~2.7 %.
         assert!((var.sqrt() - 0.5).abs() < 0.01, "σ = {}", var.sqrt());
+    }
+
+    #[test]
+    fn connect_lands_where_the_camera_ray_started() {
+        let lenses = [
+            None,
+            Some(ThinLens {
+                radius: 0.05,
+                focus_distance: 3.0,
+            }),
+        ];
+        for lens in lenses {
+            let c = Camera::new(
+                Vec3::new(0.3, 1.0, -2.0),
+                Vec3::new(0.0, 0.5, 1.0),
+                Vec3::Y,
+                50.0,
+                (160, 90),
+                lens,
+            );
+            for (px, py, u) in [(10.3, 80.1, (0.2, 0.9)), (150.0, 5.5, (0.7, 0.3))] {
+                let u = Vec2::new(u.0, u.1);
+                let r = c.generate_ray(px, py, u);
+                let p = r.origin + r.dir * 4.2;
+                let k = c.connect(p, u, 0.5).expect("in view");
+                assert!((k.film - Vec2::new(px, py)).length() < 2e-3, "{:?}", k.film);
+                assert!((k.lens_point - r.origin).length() < 1e-5);
+                assert!((k.wi + r.dir).length() < 1e-5);
+                assert!((k.dist - 4.2).abs() < 1e-4);
+            }
+            // Behind the camera or outside the film.
+            assert!(c
+                .connect(Vec3::new(0.3, 1.0, -3.0), Vec2::ZERO, 0.5)
+                .is_none());
+            assert!(c
+                .connect(Vec3::new(40.0, 1.0, 0.0), Vec2::ZERO, 0.5)
+                .is_none());
+        }
+    }
+
+    /// The importance of a pinhole integrates to one pixel over the film: the film positions of
+    /// a plane facing the camera cover Σ importance·cos·dA = W·H pixel areas.
+    #[test]
+    fn connect_importance_integrates_to_the_film() {
+        let c = Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 60.0, (64, 48), None);
+        // The plane z = 2 over a grid wide enough to cover the view.
+        let (n, half) = (1200, 3.0f32);
+        let da = (2.0 * half / n as f32).powi(2) as f64;
+        let mut sum = 0.0f64;
+        for j in 0..n {
+            for i in 0..n {
+                let p = Vec3::new(
+                    -half + (i as f32 + 0.5) * 2.0 * half / n as f32,
+                    -half + (j as f32 + 0.5) * 2.0 * half / n as f32,
+                    2.0,
+                );
+                if let Some(k) = c.connect(p, Vec2::ZERO, 0.0) {
+                    sum += (k.importance * k.wi.z.abs()) as f64 * da;
+                }
+            }
+        }
+        let pixels = 64.0 * 48.0;
+        assert!((sum / pixels - 1.0).abs() < 5e-3, "{}", sum / pixels);
+    }
+
+    #[test]
+    fn filter_densities_integrate_to_one_and_match_their_samples() {
+        for f in [
+            PixelFilter::Box,
+            PixelFilter::Tent { radius: 1.5 },
+            PixelFilter::gaussian(0.5, 1.5),
+        ] {
+            let r = f.radius();
+            let n = 600;
+            let h = 2.0 * r / n as f32;
+            let mut total = 0.0f64;
+            let mut second = 0.0f64;
+            for j in 0..n {
+                for i in 0..n {
+                    let d = Vec2::new(-r + (i as f32 + 0.5) * h, -r + (j as f32 + 0.5) * h);
+                    let w = (f.density(d) * h * h) as f64;
+                    total += w;
+                    second += w * (d.x * d.x) as f64;
+                }
+            }
+            assert!((total - 1.0).abs() < 2e-3, "{f:?}: ∫ = {total}");
+            // E[x²] of the samples equals the density's.
+            let m = 4000;
+            let s: f64 = (0..m)
+                .map(|i| (f.sample(Vec2::new((i as f32 + 0.5) / m as f32, 0.5)).x as f64).powi(2))
+                .sum::<f64>()
+                / m as f64;
+            assert!(
+                (s - second).abs() < 2e-3 * (1.0 + second),
+                "{f:?}: {s} vs {second}"
+            );
+        }
     }
 }

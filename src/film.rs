@@ -74,6 +74,15 @@ pub struct PixelSums {
     pub sum_e: f64,
     pub sum_e2: f64,
     pub count_e: u64,
+    /// Σ of the caustic light paths' splats on this pixel (XYZ, Y²) and the number of light
+    /// paths traced for the buffer (see [`crate::caustics`]): they add `splat_xyz / light_paths`
+    /// to the camera samples' mean.
+    #[serde(default)]
+    pub splat_xyz: [f64; 3],
+    #[serde(default)]
+    pub splat_y2: f64,
+    #[serde(default)]
+    pub light_paths: u64,
 }
 
 impl PixelSums {
@@ -84,6 +93,14 @@ impl PixelSums {
         self.sum_xyz[2] += xyz[2];
         self.sum_y2 += xyz[1] * xyz[1];
         self.count += 1;
+    }
+    /// Add one light path's splat (see [`crate::caustics::Splat`]).
+    #[inline]
+    pub fn add_splat(&mut self, xyz: [f64; 3]) {
+        for (s, v) in self.splat_xyz.iter_mut().zip(xyz) {
+            *s += v;
+        }
+        self.splat_y2 += xyz[1] * xyz[1];
     }
     /// Record one illuminance sample (lx) of the surface seen by a camera sample.
     #[inline]
@@ -117,22 +134,33 @@ impl PixelSums {
         }
         self.sum_y2 += o.sum_y2;
         self.count += o.count;
-    }
-    /// Mean absolute XYZ.
-    pub fn mean_xyz(&self) -> [f64; 3] {
-        if self.count == 0 {
-            return [0.0; 3];
+        for k in 0..3 {
+            self.splat_xyz[k] += o.splat_xyz[k];
         }
-        let n = self.count as f64;
-        [
-            self.sum_xyz[0] / n,
-            self.sum_xyz[1] / n,
-            self.sum_xyz[2] / n,
-        ]
+        self.splat_y2 += o.splat_y2;
+        self.light_paths += o.light_paths;
     }
-    /// Standard error of the mean luminance, √(s²/n) with the unbiased sample variance s².
+    /// Mean absolute XYZ: the camera samples' mean plus, with light tracing, the light paths'.
+    pub fn mean_xyz(&self) -> [f64; 3] {
+        let mean = |sum: &[f64; 3], n: u64| {
+            if n == 0 {
+                [0.0; 3]
+            } else {
+                sum.map(|v| v / n as f64)
+            }
+        };
+        let (c, l) = (
+            mean(&self.sum_xyz, self.count),
+            mean(&self.splat_xyz, self.light_paths),
+        );
+        [c[0] + l[0], c[1] + l[1], c[2] + l[2]]
+    }
+    /// Standard error of the mean luminance, √(s²/n) with the unbiased sample variance s², of
+    /// the camera samples and the light paths (independent) combined.
     pub fn y_standard_error(&self) -> f64 {
-        standard_error(self.sum_xyz[1], self.sum_y2, self.count)
+        let cam = standard_error(self.sum_xyz[1], self.sum_y2, self.count);
+        let light = standard_error(self.splat_xyz[1], self.splat_y2, self.light_paths);
+        (cam * cam + light * light).sqrt()
     }
 }
 
@@ -159,6 +187,10 @@ pub struct Film {
     pub height: usize,
     pub pixels: Vec<PixelSums>,
     pub decision: Option<Vec<PixelSums>>,
+    /// Caustic light paths traced so far for `pixels` and for `decision` (the next path
+    /// indices of their streams).
+    #[serde(default)]
+    pub light_paths: [u64; 2],
 }
 
 impl Film {
@@ -168,6 +200,7 @@ impl Film {
             height,
             pixels: vec![PixelSums::default(); width * height],
             decision: None,
+            light_paths: [0; 2],
         }
     }
     pub fn new_adaptive(width: usize, height: usize) -> Self {
@@ -183,6 +216,8 @@ impl Film {
     }
     /// Combine another film of the same size (independent samples: a different seed).
     pub fn merge(&mut self, o: &Film) {
+        self.light_paths[0] += o.light_paths[0];
+        self.light_paths[1] += o.light_paths[1];
         for (a, b) in self.pixels.iter_mut().zip(&o.pixels) {
             a.merge(b);
         }

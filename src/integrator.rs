@@ -19,17 +19,23 @@ pub struct RayStats {
     pub shadow_rays: u64,
     /// Samples whose estimate was not finite and was dropped (should stay 0).
     pub non_finite: u64,
+    /// Light paths traced for caustics (see [`crate::caustics`]) and their rays (the camera
+    /// connections count as shadow rays).
+    pub light_paths: u64,
+    pub light_rays: u64,
 }
 
 impl RayStats {
     pub fn total_rays(&self) -> u64 {
-        self.camera_rays + self.bounce_rays + self.shadow_rays
+        self.camera_rays + self.bounce_rays + self.shadow_rays + self.light_rays
     }
     pub fn merge(&mut self, o: &RayStats) {
         self.camera_rays += o.camera_rays;
         self.bounce_rays += o.bounce_rays;
         self.shadow_rays += o.shadow_rays;
         self.non_finite += o.non_finite;
+        self.light_paths += o.light_paths;
+        self.light_rays += o.light_rays;
     }
 }
 
@@ -66,6 +72,23 @@ pub fn radiance(
     )
 }
 
+/// As [`radiance`], for a camera ray of the image: without the caustic paths that light
+/// tracing estimates when the world has it on (see [`crate::caustics`]).
+pub fn camera_radiance(
+    world: &World,
+    origin: Vec3,
+    dir: Vec3,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+) -> SampledSpectrum {
+    let start = PathStart {
+        caustics_by_light_tracing: world.caustics.is_some(),
+        ..PathStart::camera(origin)
+    };
+    trace(world, origin, dir, start, wl, sampler, stats)
+}
+
 /// How the ray being traced was generated, for MIS of the emission it finds first.
 #[derive(Clone, Copy, Debug)]
 pub struct PathStart {
@@ -78,6 +101,10 @@ pub struct PathStart {
     pub p: Vec3,
     /// Scattering events already on the path (0 for a camera ray).
     pub depth: u32,
+    /// A camera ray whose caustic paths (first surface non-specular, then only specular
+    /// scattering, then a light that [`crate::caustics::CausticLights`] handles) are left to
+    /// light tracing.
+    pub caustics_by_light_tracing: bool,
 }
 
 impl PathStart {
@@ -87,8 +114,22 @@ impl PathStart {
             pdf: 0.0,
             p,
             depth: 0,
+            caustics_by_light_tracing: false,
         }
     }
+}
+
+/// Where a camera path stands with respect to the caustic paths of [`crate::caustics`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum CausticState {
+    /// At the camera: nothing scattered yet.
+    Camera,
+    /// The first surface scattered non-specularly.
+    Receiver,
+    /// …and every scattering since was specular (at least one): a caustic chain.
+    Chain,
+    /// Anything else.
+    Other,
 }
 
 /// Radiance arriving along a ray that starts in state `start`.
@@ -114,6 +155,11 @@ pub fn trace(
     // Product of η′² over the refractions so far (see `Material::eta_scale`), for Russian
     // roulette only.
     let mut eta_scale = 1.0f32;
+    let mut caustic = if start.caustics_by_light_tracing {
+        CausticState::Camera
+    } else {
+        CausticState::Other
+    };
 
     loop {
         let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
@@ -139,7 +185,12 @@ pub fn trace(
         if let Some(li) = object.light {
             let light = &world.lights[li as usize];
             let le = light.emitted(&hit, wl);
-            if !le.is_black() {
+            let light_traced = caustic == CausticState::Chain
+                && world
+                    .caustics
+                    .as_ref()
+                    .is_some_and(|c| c.handles(li as usize));
+            if !le.is_black() && !light_traced {
                 if prev_specular {
                     l += beta * le;
                 } else {
@@ -211,6 +262,11 @@ pub fn trace(
             break;
         }
         eta_scale *= material.eta_scale(wo, bs.wi, wl);
+        caustic = match (caustic, bs.specular) {
+            (CausticState::Camera, false) => CausticState::Receiver,
+            (CausticState::Receiver | CausticState::Chain, true) => CausticState::Chain,
+            _ => CausticState::Other,
+        };
         prev_specular = bs.specular;
         prev_pdf = bs.pdf;
         prev_p = hit.p;
@@ -325,6 +381,7 @@ pub fn irradiance(
                 pdf: local.z * FRAC_1_PI,
                 p: at.p,
                 depth: 1,
+                caustics_by_light_tracing: false,
             };
             // cos θ / pdf = π.
             e += trace(world, origin, wi, start, wl, sampler, stats) * PI;

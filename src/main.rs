@@ -99,6 +99,9 @@ struct RenderOpts {
     /// Also estimate the illuminance (lx) on the surface seen through each pixel (EXR channels E, stderr.E, mask.E).
     #[arg(long)]
     illuminance: bool,
+    /// How caustics (light → smooth glass/metal → surface seen) are rendered: light-tracing (traced from the lights and connected to the camera; the default) or path-tracing (camera paths only). Overrides render.caustics.
+    #[arg(long, value_parser = ["light-tracing", "path-tracing"])]
+    caustics: Option<String>,
     /// Units of the report: si (lx, cd/m²) or imperial (fc, fL).
     #[arg(long, default_value = "si", value_parser = ["si", "imperial"])]
     units: String,
@@ -230,6 +233,10 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
         seed: a.seed,
         max_depth: a.max_depth,
         illuminance: a.illuminance,
+        caustics: a.caustics.as_deref().map(|c| match c {
+            "path-tracing" => candela::world::Caustics::PathTracing,
+            _ => candela::world::Caustics::LightTracing,
+        }),
     };
     let (out, threads, exposure, quiet) = (a.out.as_deref(), a.threads, a.exposure, a.quiet);
     let units = if a.units == "imperial" {
@@ -290,7 +297,7 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
         let st = candela::state::RenderState::load(&state_path)?;
         if st.scene_hash != hash || st.seed != world.settings.seed {
             bail!(
-                "cannot resume from {}: the scene file {} or its settings (seed, max depth, resolution, illuminance) changed since the state was written",
+                "cannot resume from {}: the scene file {} or its settings (seed, max depth, resolution, illuminance, caustics) changed since the state was written",
                 state_path.display(),
                 scene_path.display()
             );

@@ -2,7 +2,7 @@
 //! (seed, pixel, sample index), so the result does not depend on the number of threads.
 
 use crate::film::{radiance_to_xyz, Film, PixelSums};
-use crate::integrator::{radiance, RayStats};
+use crate::integrator::{camera_radiance, RayStats};
 use crate::sampler::Sampler;
 use crate::spectrum::SampledWavelengths;
 use crate::world::World;
@@ -54,7 +54,7 @@ pub fn render_pixel(
         let mut wl = SampledWavelengths::sample_visible(u_wl);
         let ray = cam.generate_ray(x as f32 + 0.5 + off.x, y as f32 + 0.5 + off.y, u_lens);
         stats.camera_rays += 1;
-        let l = radiance(world, ray.origin, ray.dir, &mut wl, &mut sampler, stats);
+        let l = camera_radiance(world, ray.origin, ray.dir, &mut wl, &mut sampler, stats);
         if world.settings.illuminance {
             if let Some(e) = surface_illuminance(world, ray.origin, ray.dir, pixel, s, stats) {
                 sums.add_illuminance(e);
@@ -134,6 +134,8 @@ pub struct TargetError {
 
 /// Stream of the decision buffer's samples (statistically independent of the image's).
 const DECISION_STREAM: u64 = 0xdec1_5104_0000_0000;
+/// Stream of the caustic light paths (see [`crate::caustics`]).
+const CAUSTIC_STREAM: u64 = 0xca05_71c5_0000_0000;
 
 /// Samples a pixel's decision buffer needs before its error estimate is trusted.
 pub const MIN_DECISION_SAMPLES: u64 = 8;
@@ -353,6 +355,35 @@ pub fn render_progressive(
         if results.iter().any(Option::is_none) {
             break 'passes StopReason::Interrupted;
         }
+        // Caustic light paths: as many for each buffer as it received camera samples in this
+        // pass (a pass interrupted here is discarded too).
+        let mut light = Vec::new();
+        if let Some(caustics) = &world.caustics {
+            let per_buffer: u64 = if adaptive {
+                plan.iter().map(|n| n / 2).sum()
+            } else {
+                plan.iter().sum()
+            };
+            let streams: &[u64] = if adaptive {
+                &[CAUSTIC_STREAM, CAUSTIC_STREAM ^ DECISION_STREAM]
+            } else {
+                &[CAUSTIC_STREAM]
+            };
+            for (b, &stream) in streams.iter().enumerate() {
+                let first = film.light_paths[b];
+                let seed = world.settings.seed ^ stream;
+                let traced = pool.install(|| {
+                    crate::caustics::trace_light_paths(
+                        world, caustics, seed, first, per_buffer, stop,
+                    )
+                });
+                let Some((splats, st)) = traced else {
+                    break 'passes StopReason::Interrupted;
+                };
+                stats.merge(&st);
+                light.push((b, splats, per_buffer));
+            }
+        }
         for r in results.into_iter().flatten() {
             stats.merge(&r.stats);
             for (i, est, dec) in r.pixels {
@@ -360,6 +391,20 @@ pub fn render_progressive(
                 if let (Some(d), Some(v)) = (film.decision.as_mut(), dec) {
                     d[i] = v;
                 }
+            }
+        }
+        for (b, splats, paths) in light {
+            film.light_paths[b] += paths;
+            let buf = if b == 0 {
+                &mut film.pixels
+            } else {
+                film.decision.as_mut().expect("adaptive film")
+            };
+            for s in &splats {
+                buf[s.pixel as usize].add_splat(s.xyz);
+            }
+            for p in buf.iter_mut() {
+                p.light_paths += paths;
             }
         }
         debug_assert_eq!(adaptive, film.decision.is_some());

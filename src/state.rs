@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &str = "candela-render-state";
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RenderState {
@@ -39,6 +39,7 @@ pub fn scene_hash(scene_text: &[u8], world: &World) -> u64 {
     h = mix64(h ^ world.settings.max_depth as u64);
     h = mix64(h ^ world.settings.rr_depth as u64);
     h = mix64(h ^ world.settings.illuminance as u64);
+    h = mix64(h ^ world.caustics.is_some() as u64);
     mix64(h ^ ((world.camera.width as u64) << 32 | world.camera.height as u64))
 }
 

@@ -28,6 +28,19 @@ pub struct RenderSettings {
     pub filter: PixelFilter,
     /// Also estimate the illuminance (lx) on the surface seen through each pixel.
     pub illuminance: bool,
+    /// How caustic paths (light → specular chain → surface seen) are estimated.
+    pub caustics: Caustics,
+}
+
+/// Estimator of the caustic paths light → specular surfaces → non-specular surface → camera.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Caustics {
+    /// Traced from the lights and connected to the camera (see [`crate::caustics`]); used
+    /// when the scene has a delta-lobe material and a light at a finite position.
+    #[default]
+    LightTracing,
+    /// Left to the camera paths' BSDF sampling (misses point-light caustics entirely).
+    PathTracing,
 }
 
 impl Default for RenderSettings {
@@ -39,6 +52,7 @@ impl Default for RenderSettings {
             seed: 0,
             filter: PixelFilter::Box,
             illuminance: false,
+            caustics: Caustics::LightTracing,
         }
     }
 }
@@ -56,4 +70,6 @@ pub struct World {
     pub meters: Vec<crate::meter::Meter>,
     pub grids: Vec<crate::meter::Grid>,
     pub measure: crate::meter::MeasureSettings,
+    /// Light tracing of caustics, when on and useful (see [`crate::caustics`]).
+    pub caustics: Option<crate::caustics::CausticLights>,
 }

@@ -139,6 +139,14 @@ impl Material {
             _ => false,
         }
     }
+    /// Whether `sample` can return a delta (specular) lobe: smooth metal and glass, thin
+    /// slabs, smooth coats. Such surfaces make caustics.
+    pub fn has_delta_lobe(&self) -> bool {
+        match self {
+            Material::Coated(m) => m.mf.effectively_smooth(),
+            _ => self.is_specular(),
+        }
+    }
     /// Squared relative index of refraction η′² of the scattering `wo` → `wi` (local frame):
     /// (n_inside/n_outside)² when entering a dielectric, its inverse when leaving, 1 for
     /// reflection and for materials that do not refract. Radiance crossing the interface is

@@ -89,7 +89,121 @@ pub struct LightSample {
     pub delta: bool,
 }
 
+/// A ray of light leaving a source, for light tracing: `weight` = emitted radiance (or
+/// intensity) × |cos θ| / (density of the origin × density of the direction), so that the mean
+/// of `weight · (what the ray's light does)` is the light's contribution.
+#[derive(Clone, Copy, Debug)]
+pub struct EmissionSample {
+    /// Ray origin, already offset off the emitting surface.
+    pub origin: Vec3,
+    /// Unit direction.
+    pub dir: Vec3,
+    /// W·nm⁻¹ per unit of the estimator's measure at each sampled wavelength.
+    pub weight: SampledSpectrum,
+}
+
 impl Light {
+    /// Whether light tracing can start paths at this light: sources at a finite position
+    /// (area, point, spot, goniometric). Lights at infinity cannot.
+    pub fn can_emit_paths(&self) -> bool {
+        !matches!(self, Light::Distant { .. } | Light::Environment { .. })
+    }
+
+    /// Sample a ray leaving the light (light tracing). `uc` chooses the primitive (area lights)
+    /// or drives the goniometric table, `u_pos` the point, `u_dir` the direction. None for
+    /// lights at infinity and for samples that carry nothing.
+    pub fn sample_emission(
+        &self,
+        geom: &SceneGeometry,
+        uc: f32,
+        u_pos: Vec2,
+        u_dir: Vec2,
+        wl: &SampledWavelengths,
+    ) -> Option<EmissionSample> {
+        let from_point = |origin: Vec3, dir: Vec3, weight: SampledSpectrum| {
+            (!weight.is_black()).then_some(EmissionSample {
+                origin,
+                dir,
+                weight,
+            })
+        };
+        match self {
+            Light::Point {
+                position,
+                intensity,
+            } => from_point(
+                *position,
+                sample_uniform_sphere(u_dir),
+                intensity.sample(wl) * (4.0 * PI),
+            ),
+            Light::Spot {
+                position,
+                frame,
+                cos_inner,
+                cos_outer,
+                intensity,
+            } => {
+                // Uniform in the outer cone; the smooth falloff goes into the weight.
+                let cos_t = 1.0 - u_dir.x * (1.0 - cos_outer);
+                let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+                let phi = 2.0 * PI * u_dir.y;
+                let local = Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+                let pdf = 1.0 / (2.0 * PI * (1.0 - cos_outer));
+                let falloff = smoothstep(*cos_outer, *cos_inner, cos_t);
+                from_point(
+                    *position,
+                    frame.to_world(local).normalize(),
+                    intensity.sample(wl) * (falloff / pdf),
+                )
+            }
+            Light::Goniometric(g) => {
+                let (dir, pdf, cd) = g.sample_emission(uc, u_dir)?;
+                if pdf <= 0.0 || !pdf.is_finite() || cd <= 0.0 {
+                    return None;
+                }
+                from_point(g.position, dir, g.spectrum.sample(wl) * (cd as f32 / pdf))
+            }
+            Light::Area {
+                prims,
+                cdf,
+                total_area,
+                radiance,
+                two_sided,
+                ..
+            } => {
+                let (k, _) = pick_from_cdf(cdf, uc);
+                let sp = geom.sample_prim(prims[k], u_pos);
+                // Cosine-distributed about the front normal (either side for two-sided
+                // emitters, chosen by remapping u_dir.x).
+                let (ux, side) = if *two_sided {
+                    if u_dir.x < 0.5 {
+                        (2.0 * u_dir.x, 1.0)
+                    } else {
+                        (2.0 * u_dir.x - 1.0, -1.0)
+                    }
+                } else {
+                    (u_dir.x, 1.0)
+                };
+                let local = crate::bxdf::sample_cosine_hemisphere(Vec2::new(ux, u_dir.y));
+                if local.z <= 0.0 {
+                    return None;
+                }
+                let n = sp.n * side;
+                let dir = Frame::from_normal(n).to_world(local).normalize();
+                // L cos θ / (1/A · cos θ/π [· ½]) = L π A [· 2].
+                let sides = if *two_sided { 2.0 } else { 1.0 };
+                let origin = crate::geometry::offset_ray_origin(
+                    sp.p,
+                    crate::geometry::point_error_bound(sp.p),
+                    sp.n,
+                    dir,
+                );
+                from_point(origin, dir, radiance.sample(wl) * (PI * total_area * sides))
+            }
+            Light::Distant { .. } | Light::Environment { .. } => None,
+        }
+    }
+
     /// Whether the light is a delta distribution (cannot be hit by rays).
     pub fn is_delta(&self) -> bool {
         matches!(

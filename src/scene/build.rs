@@ -25,6 +25,8 @@ pub struct Overrides {
     pub max_depth: Option<u32>,
     /// Force per-pixel illuminance on.
     pub illuminance: bool,
+    /// Override render.caustics.
+    pub caustics: Option<crate::world::Caustics>,
 }
 
 /// Largest image the renderer accepts (pixels), so a typo cannot exhaust memory.
@@ -458,6 +460,10 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         seed: overrides.seed.unwrap_or(r.seed),
         filter,
         illuminance: r.illuminance || overrides.illuminance,
+        caustics: overrides.caustics.unwrap_or(match r.caustics {
+            CausticsDesc::LightTracing => crate::world::Caustics::LightTracing,
+            CausticsDesc::PathTracing => crate::world::Caustics::PathTracing,
+        }),
     };
 
     // Materials.
@@ -606,6 +612,12 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
     }
     let light_sampler = LightSampler::new(&lights, &geometry, scene_radius);
     let (meters, grids, measure) = build_meters(&ctx, scene)?;
+    let caustics = match settings.caustics {
+        crate::world::Caustics::LightTracing => {
+            crate::caustics::CausticLights::new(&lights, &materials, &geometry, scene_radius)
+        }
+        crate::world::Caustics::PathTracing => None,
+    };
 
     Ok(World {
         geometry,
@@ -619,6 +631,7 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         meters,
         grids,
         measure,
+        caustics,
     })
 }
 

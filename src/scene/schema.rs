@@ -146,6 +146,19 @@ pub struct RenderDesc {
     /// Also write per-pixel illuminance (lx) of the surface seen (`--illuminance`).
     #[serde(default)]
     pub illuminance: bool,
+    /// How caustics (light → smooth glass or metal → surface seen) are rendered
+    /// (`--caustics`).
+    #[serde(default)]
+    pub caustics: CausticsDesc,
+}
+
+/// See [`crate::world::Caustics`].
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum CausticsDesc {
+    #[default]
+    LightTracing,
+    PathTracing,
 }
 
 impl Default for RenderDesc {
@@ -157,6 +170,7 @@ impl Default for RenderDesc {
             seed: 0,
             filter: FilterDesc::Box,
             illuminance: false,
+            caustics: CausticsDesc::LightTracing,
         }
     }
 }
