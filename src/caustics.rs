@@ -1,25 +1,33 @@
-//! Caustics by light tracing: the paths light → specular chain → a non-specular surface seen
-//! by the camera (L S⁺ D E in Heckbert's notation) are traced from the light and connected
-//! to the camera (Veach 1997, §10.2, the t = 1 strategy of bidirectional path tracing; pbrt-v4's
-//! `LightPathIntegrator`), instead of being found by the camera path's BSDF sampling.
+//! Caustics by light tracing: the paths whose light leaves the source by a *specular*
+//! scattering (smooth glass, mirror) and reaches the camera from a *non-specular* surface —
+//! L S (S|D)* D E in Heckbert's notation: the caustic under a glass sphere, and the light that
+//! caustic sends on to walls and ceiling, directly or again through the glass — are traced
+//! from the light and connected to the camera at every non-specular surface they reach
+//! (Veach 1997, §10.2, the t = 1 strategy of bidirectional path tracing; pbrt-v4's
+//! `LightPathIntegrator`), instead of being found by the camera paths' BSDF sampling.
 //!
-//! The path tracer finds such a path only when BSDF sampling at the first surface happens to
-//! aim through the specular chain at the (small) light: a few rare samples of very large
-//! value, the bright speckles of a caustic. A light path finds the same light transport with
-//! an ordinary density, so the caustic converges like direct light. Point and spot lights,
-//! whose caustics the path tracer cannot find at all (a delta light behind a delta surface),
-//! get theirs here.
+//! A camera path finds such a path only when BSDF sampling at its last surface happens to aim
+//! through the specular surface at the (small) light: rare samples of very large value, the
+//! bright speckles of caustics. Next-event estimation cannot help (the light is behind glass).
+//! A light path finds the same light transport with an ordinary density, so caustics converge
+//! like direct light. Point and spot lights, whose caustics camera paths cannot find at all (a
+//! delta light behind a delta surface), get theirs here.
 //!
-//! **Partition, not combination.** Path space is split: the camera path's estimator
-//! ([`crate::integrator::trace`]) drops emission reached through "first vertex non-specular,
-//! then only specular vertices" when the light is one the light tracer starts paths from
-//! ([`CausticLights::handles`]); this module estimates exactly those paths and nothing else.
-//! Each estimator is unbiased on its part, so the sum is unbiased, with no MIS weights. The
-//! same max depth applies (the non-specular vertex counts as a scattering event, as it does
-//! for the camera path).
+//! **Partition, not combination.** Path space is split by two vertices: the one next to the
+//! light and the one next to the camera. Paths whose light-side vertex scattered specularly
+//! and whose camera-side vertex scattered non-specularly (with at least two scattering
+//! events), from a light this module starts paths from ([`CausticLights::handles`]), are light
+//! tracing's; the camera paths' estimator ([`crate::integrator::trace`]) drops the emission it
+//! finds along them and keeps every other path (next-event estimation only ever connects a
+//! non-specular vertex to the light, so it keeps all of its own). Each estimator is unbiased on
+//! its part, so the sum is unbiased, without MIS weights. Paths the camera sees through glass
+//! (camera-side vertex specular) stay with the camera paths. The same max depth applies.
 //!
-//! **Estimator.** A light path with weight β (emitted radiance × cos / densities, see
-//! [`crate::light::EmissionSample`]; times f·|cos|/pdf at each specular vertex, with the
+//! **Estimator.** A light path starts at a point on a light and leaves toward the bounding
+//! sphere of one of the objects that can scatter specularly (the other directions cannot start
+//! a path of this part). Its weight β is the emission toward that direction (radiance × cos,
+//! or intensity) over the densities of point and direction ([`crate::light::EmissionPoint`]),
+//! times f·|cos|/pdf at each scattering, with the
 //! adjoint BSDF: refraction is not scaled by 1/η′²) reaching the non-specular point x adds,
 //! to every pixel whose reconstruction filter covers x's film position,
 //! `β · f(x; →camera, →light) · |cos θ_x| · importance · filter density`
@@ -45,7 +53,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The lights light tracing starts paths from (all at a finite position), chosen in
-/// proportion to their luminous power.
+/// proportion to their luminous power, and where their paths are aimed.
 #[derive(Clone, Debug)]
 pub struct CausticLights {
     /// Light indices (into [`World::lights`]).
@@ -53,19 +61,75 @@ pub struct CausticLights {
     cdf: Vec<f32>,
     /// Per light of the world: whether it is one of `lights`.
     handled: Vec<bool>,
+    /// Bounding spheres (centre, radius) of the objects with a delta lobe. A light path is
+    /// only light tracing's if its first scattering is specular, so emission directions are
+    /// sampled only toward these (uniformly within the cones they subtend), not wasted on
+    /// the rest of the scene.
+    targets: Vec<(Vec3, f32)>,
+}
+
+/// Most target spheres kept separately; more are merged into one.
+const MAX_TARGETS: usize = 16;
+
+/// A bounding sphere of a shape (of its bounding box, for flat and meshed shapes).
+pub fn bounding_sphere(shape: &crate::geometry::Shape) -> Option<(Vec3, f32)> {
+    use crate::geometry::Shape;
+    let from_points = |pts: &mut dyn Iterator<Item = Vec3>| {
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for p in pts {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        (lo.cmple(hi).all()).then(|| sphere_of_box(lo, hi))
+    };
+    match shape {
+        Shape::Sphere { center, radius } => Some((*center, *radius)),
+        Shape::Disk { center, radius, .. } => Some((*center, *radius)),
+        Shape::Quad {
+            origin,
+            edge_u,
+            edge_v,
+        } => from_points(
+            &mut [
+                *origin,
+                *origin + *edge_u,
+                *origin + *edge_v,
+                *origin + *edge_u + *edge_v,
+            ]
+            .into_iter(),
+        ),
+        Shape::Mesh(m) => from_points(&mut m.positions.iter().copied()),
+    }
+}
+
+fn sphere_of_box(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
+    let c = 0.5 * (lo + hi);
+    // A little slack: the sphere must contain every point a ray can hit.
+    (c, 0.5 * (hi - lo).length() * (1.0 + 1e-4) + 1e-6)
 }
 
 impl CausticLights {
-    /// None when light tracing has nothing to do: no material with a delta lobe, or no light
-    /// at a finite position with power.
+    /// `targets`: bounding spheres of the objects whose material has a delta lobe. None when
+    /// light tracing has nothing to do: no such object, or no light at a finite position with
+    /// power.
     pub fn new(
         lights: &[Light],
-        materials: &[crate::bxdf::Material],
+        mut targets: Vec<(Vec3, f32)>,
         geom: &SceneGeometry,
         scene_radius: f32,
     ) -> Option<Self> {
-        if !materials.iter().any(|m| m.has_delta_lobe()) {
+        targets.retain(|(c, r)| c.is_finite() && r.is_finite() && *r > 0.0);
+        if targets.is_empty() {
             return None;
+        }
+        if targets.len() > MAX_TARGETS {
+            let lo = targets
+                .iter()
+                .fold(Vec3::splat(f32::INFINITY), |a, (c, r)| a.min(*c - *r));
+            let hi = targets
+                .iter()
+                .fold(Vec3::splat(f32::NEG_INFINITY), |a, (c, r)| a.max(*c + *r));
+            targets = vec![sphere_of_box(lo, hi)];
         }
         let mut chosen = Vec::new();
         let mut powers = Vec::new();
@@ -97,7 +161,64 @@ impl CausticLights {
             lights: chosen,
             cdf,
             handled,
+            targets,
         })
+    }
+
+    /// A direction from `p` toward the targets and its density (solid angle): a cone chosen in
+    /// proportion to its solid angle, uniform within it, so the density is (number of cones
+    /// containing the direction) / (sum of the cones' solid angles). Uniform over the sphere
+    /// when the cones would cover more than it.
+    fn sample_direction(&self, p: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32)> {
+        use std::f32::consts::PI;
+        let mut cones = [(Vec3::ZERO, 0.0f32, 0.0f32); MAX_TARGETS];
+        let mut total = 0.0f32;
+        for (k, &(c, r)) in self.targets.iter().enumerate() {
+            let d = c - p;
+            let dist2 = d.length_squared();
+            let cos_max = if dist2 <= r * r {
+                -1.0
+            } else {
+                (1.0 - r * r / dist2).max(0.0).sqrt()
+            };
+            let axis = if dist2 > 0.0 {
+                d / dist2.sqrt()
+            } else {
+                Vec3::Z
+            };
+            let omega = 2.0 * PI * (1.0 - cos_max);
+            cones[k] = (axis, cos_max, omega);
+            total += omega;
+        }
+        let cones = &cones[..self.targets.len()];
+        if total.is_nan() || total <= 0.0 {
+            return None;
+        }
+        if total >= 4.0 * PI {
+            return Some((crate::light::sample_uniform_sphere(u), 1.0 / (4.0 * PI)));
+        }
+        // Choose a cone.
+        let mut x = uc * total;
+        let mut chosen = cones.len() - 1;
+        for (k, c) in cones.iter().enumerate() {
+            if x < c.2 {
+                chosen = k;
+                break;
+            }
+            x -= c.2;
+        }
+        let (axis, cos_max, _) = cones[chosen];
+        let cos_t = 1.0 - u.x * (1.0 - cos_max);
+        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.y;
+        let local = Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+        let dir = Frame::from_normal(axis).to_world(local).normalize();
+        let count = 1 + cones
+            .iter()
+            .enumerate()
+            .filter(|&(k, c)| k != chosen && dir.dot(c.0) >= c.1)
+            .count();
+        Some((dir, count as f32 / total))
     }
 
     /// Whether emission from light `light` reached through a caustic chain is this module's
@@ -180,9 +301,9 @@ pub fn trace_light_path(
     let settings = &world.settings;
     let mut sampler = Sampler::new(seed, 0, index);
     // Dimension sets led by their 2-D pairs: point on the light and direction; light choice,
-    // primitive, wavelengths; lens point. Bounces take one set each from dimension 12.
+    // primitive, wavelengths, target cone; lens point. Bounces take one set each from dimension 12.
     let [px, py, dx, dy] = sampler.get4();
-    let [u_light, u_prim, u_wl, _] = sampler.get4();
+    let [u_light, u_prim, u_wl, u_dir] = sampler.get4();
     let [lx, ly, _, _] = sampler.get4();
     stats.light_paths += 1;
     let (k, p_select) = pick_from_cdf(&caustics.cdf, u_light);
@@ -191,23 +312,32 @@ pub fn trace_light_path(
     }
     let light = &world.lights[caustics.lights[k] as usize];
     let mut wl = SampledWavelengths::sample_visible(u_wl);
-    let Some(es) = light.sample_emission(
-        &world.geometry,
-        u_prim,
-        Vec2::new(px, py),
-        Vec2::new(dx, dy),
-        &wl,
-    ) else {
+    let Some(at) = light.sample_emission_point(&world.geometry, u_prim, Vec2::new(px, py)) else {
         return;
     };
-    let mut beta = es.weight / p_select;
+    let Some((dir, pdf_dir)) = caustics.sample_direction(at.p, u_dir, Vec2::new(dx, dy)) else {
+        return;
+    };
+    let le = light.emission_toward(&at, dir, &wl);
+    if le.is_black() || pdf_dir.is_nan() || pdf_dir <= 0.0 {
+        return;
+    }
+    let origin = match at.n {
+        Some(n) => crate::geometry::offset_ray_origin(
+            at.p,
+            crate::geometry::point_error_bound(at.p),
+            n,
+            dir,
+        ),
+        None => at.p,
+    };
+    let mut beta = le * (at.inv_pdf / (pdf_dir * p_select));
     // The BSDF factors alone, for Russian roulette.
     let mut throughput = 1.0f32;
-    let (mut ray_o, mut ray_d) = (es.origin, es.dir);
+    let (mut ray_o, mut ray_d) = (origin, dir);
     let filter = &settings.filter;
     let camera = &world.camera;
     let (w, h) = (camera.width as i64, camera.height as i64);
-    let mut n_specular = 0u32;
     // Scattering events so far, counting the surface being processed.
     let mut depth = 0u32;
     loop {
@@ -228,8 +358,8 @@ pub fn trace_light_path(
             return;
         }
 
-        // The caustic's receiver: connect to the camera.
-        if n_specular >= 1 && !material.is_specular() {
+        // A surface after the first (which scattered specularly): connect to the camera.
+        if depth >= 2 && !material.is_specular() {
             if let Some(c) = camera.connect(hit.p, Vec2::new(lx, ly), filter.radius()) {
                 let wi = frame.to_local(c.wi);
                 // Radiance convention: out toward the camera, in from the light.
@@ -269,16 +399,17 @@ pub fn trace_light_path(
             }
         }
 
-        // Only specular scattering continues a caustic chain, and only while the receiver
-        // it may still reach is within the depth limit.
-        if depth >= settings.max_depth || !material.has_delta_lobe() {
+        // Continue while a further surface is within the depth limit; the first scattering
+        // must be specular (the paths whose light-side end is non-specular are the camera
+        // paths' part).
+        if depth >= settings.max_depth || (depth == 1 && !material.has_delta_lobe()) {
             return;
         }
         let [ux, uy, uc, u_rr] = sampler.get4();
         let Some(bs) = material.sample(wo, uc, Vec2::new(ux, uy), &mut wl) else {
             return;
         };
-        if !bs.specular || bs.pdf.is_nan() || bs.pdf <= 0.0 {
+        if (depth == 1 && !bs.specular) || bs.pdf.is_nan() || bs.pdf <= 0.0 {
             return;
         }
         let wi_world = frame.to_world(bs.wi);
@@ -292,7 +423,6 @@ pub fn trace_light_path(
         if beta.is_black() || !k.is_finite() {
             return;
         }
-        n_specular += 1;
         if depth > settings.rr_depth && throughput < 1.0 {
             let q = (1.0 - throughput).max(0.0);
             if u_rr < q {
@@ -303,5 +433,84 @@ pub fn trace_light_path(
         }
         ray_o = hit.spawn_origin(wi_world);
         ray_d = wi_world.normalize();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::sample_uniform_sphere;
+
+    fn lights_with_targets(targets: Vec<(Vec3, f32)>) -> CausticLights {
+        CausticLights {
+            lights: vec![0],
+            cdf: vec![1.0],
+            handled: vec![true],
+            targets,
+        }
+    }
+
+    /// E[1{dir in a cone}/pdf] over the sampled directions is the solid angle of the union of
+    /// the cones, which uniform sampling of the sphere measures independently.
+    #[test]
+    fn target_direction_density_integrates_to_the_union_of_the_cones() {
+        let p = Vec3::new(0.1, 2.0, -0.3);
+        let targets = vec![
+            (Vec3::new(0.0, 0.0, 0.0), 0.5),
+            (Vec3::new(0.4, 0.2, 0.1), 0.3),
+            (Vec3::new(-2.0, 2.5, 1.0), 0.2),
+        ];
+        let c = lights_with_targets(targets.clone());
+        let inside = |d: Vec3| {
+            targets.iter().any(|&(ctr, r)| {
+                let v = ctr - p;
+                let cos_max = (1.0 - r * r / v.length_squared()).sqrt();
+                d.dot(v.normalize()) >= cos_max
+            })
+        };
+        let n = 400_000;
+        let mut est = 0.0f64;
+        let mut uniform = 0.0f64;
+        let mut rng = 0x1234_5678_u64;
+        let mut u = || {
+            rng = crate::sampler::mix64(rng.wrapping_add(0x9e37_79b9_7f4a_7c15));
+            (rng >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for _ in 0..n {
+            let (d, pdf) = c
+                .sample_direction(p, u(), Vec2::new(u(), u()))
+                .expect("a direction");
+            assert!(pdf > 0.0 && pdf.is_finite());
+            if inside(d) {
+                est += 1.0 / pdf as f64;
+            }
+        }
+        // Midpoint quadrature over (z, φ), where the sphere's measure is uniform.
+        let m = 3000;
+        for i in 0..m {
+            for j in 0..m {
+                let d = sample_uniform_sphere(Vec2::new(
+                    (i as f32 + 0.5) / m as f32,
+                    (j as f32 + 0.5) / m as f32,
+                ));
+                if inside(d) {
+                    uniform += 4.0 * std::f64::consts::PI;
+                }
+            }
+        }
+        let (est, uniform) = (est / n as f64, uniform / (m * m) as f64);
+        assert!(
+            (est - uniform).abs() < 0.01 * uniform,
+            "{est} vs {uniform} sr"
+        );
+    }
+
+    #[test]
+    fn a_point_inside_a_target_samples_the_whole_sphere() {
+        let c = lights_with_targets(vec![(Vec3::ZERO, 1.0)]);
+        let (_, pdf) = c
+            .sample_direction(Vec3::new(0.1, 0.2, 0.0), 0.3, Vec2::new(0.4, 0.5))
+            .unwrap();
+        assert!((pdf - 1.0 / (4.0 * std::f32::consts::PI)).abs() < 1e-7);
     }
 }

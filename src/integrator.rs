@@ -101,9 +101,9 @@ pub struct PathStart {
     pub p: Vec3,
     /// Scattering events already on the path (0 for a camera ray).
     pub depth: u32,
-    /// A camera ray whose caustic paths (first surface non-specular, then only specular
-    /// scattering, then a light that [`crate::caustics::CausticLights`] handles) are left to
-    /// light tracing.
+    /// A camera ray whose caustic paths (first surface scattered non-specularly, last
+    /// scattering before a light that [`crate::caustics::CausticLights`] handles specular)
+    /// are left to light tracing.
     pub caustics_by_light_tracing: bool,
 }
 
@@ -117,19 +117,6 @@ impl PathStart {
             caustics_by_light_tracing: false,
         }
     }
-}
-
-/// Where a camera path stands with respect to the caustic paths of [`crate::caustics`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum CausticState {
-    /// At the camera: nothing scattered yet.
-    Camera,
-    /// The first surface scattered non-specularly.
-    Receiver,
-    /// …and every scattering since was specular (at least one): a caustic chain.
-    Chain,
-    /// Anything else.
-    Other,
 }
 
 /// Radiance arriving along a ray that starts in state `start`.
@@ -155,11 +142,10 @@ pub fn trace(
     // Product of η′² over the refractions so far (see `Material::eta_scale`), for Russian
     // roulette only.
     let mut eta_scale = 1.0f32;
-    let mut caustic = if start.caustics_by_light_tracing {
-        CausticState::Camera
-    } else {
-        CausticState::Other
-    };
+    // Whether the path's first scattering (at the surface the camera sees) was non-specular:
+    // with `start.caustics_by_light_tracing`, such paths that reach a light through a
+    // specular scattering are light tracing's part (see `crate::caustics`).
+    let mut first_non_specular = false;
 
     loop {
         let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
@@ -185,7 +171,10 @@ pub fn trace(
         if let Some(li) = object.light {
             let light = &world.lights[li as usize];
             let le = light.emitted(&hit, wl);
-            let light_traced = caustic == CausticState::Chain
+            let light_traced = start.caustics_by_light_tracing
+                && first_non_specular
+                && prev_specular
+                && depth >= 2
                 && world
                     .caustics
                     .as_ref()
@@ -262,11 +251,9 @@ pub fn trace(
             break;
         }
         eta_scale *= material.eta_scale(wo, bs.wi, wl);
-        caustic = match (caustic, bs.specular) {
-            (CausticState::Camera, false) => CausticState::Receiver,
-            (CausticState::Receiver | CausticState::Chain, true) => CausticState::Chain,
-            _ => CausticState::Other,
-        };
+        if depth == 0 {
+            first_non_specular = !bs.specular;
+        }
         prev_specular = bs.specular;
         prev_pdf = bs.pdf;
         prev_p = hit.p;

@@ -355,15 +355,17 @@ pub fn render_progressive(
         if results.iter().any(Option::is_none) {
             break 'passes StopReason::Interrupted;
         }
-        // Caustic light paths: as many for each buffer as it received camera samples in this
-        // pass (a pass interrupted here is discarded too).
+        // Caustic light paths: `light_paths_per_sample` per camera sample each buffer received
+        // in this pass (a pass interrupted here is discarded too).
         let mut light = Vec::new();
         if let Some(caustics) = &world.caustics {
-            let per_buffer: u64 = if adaptive {
+            let samples: u64 = if adaptive {
                 plan.iter().map(|n| n / 2).sum()
             } else {
                 plan.iter().sum()
             };
+            let per_buffer =
+                (samples as f64 * world.settings.light_paths_per_sample as f64).ceil() as u64;
             let streams: &[u64] = if adaptive {
                 &[CAUSTIC_STREAM, CAUSTIC_STREAM ^ DECISION_STREAM]
             } else {

@@ -37,7 +37,7 @@ fn mirror_scene(filter: &str) -> String {
     format!(
         r#"(
         camera: (position: (0.1, 0.9, 0.0), look_at: (0.1, 0, 0), up: (0, 0, 1), vfov_deg: 60, resolution: (16, 16)),
-        render: (spp: 256, max_depth: 2, filter: {filter}),
+        render: (spp: 256, max_depth: 2, filter: {filter}, light_paths_per_sample: 4),
         materials: {{
             "floor": Diffuse(reflectance: Constant({RHO})),
             "mirror": Conductor(n: Constant({N}), k: Constant({K})),

@@ -89,17 +89,15 @@ pub struct LightSample {
     pub delta: bool,
 }
 
-/// A ray of light leaving a source, for light tracing: `weight` = emitted radiance (or
-/// intensity) × |cos θ| / (density of the origin × density of the direction), so that the mean
-/// of `weight · (what the ray's light does)` is the light's contribution.
+/// A point light leaves from, for light tracing (see [`Light::sample_emission_point`]).
 #[derive(Clone, Copy, Debug)]
-pub struct EmissionSample {
-    /// Ray origin, already offset off the emitting surface.
-    pub origin: Vec3,
-    /// Unit direction.
-    pub dir: Vec3,
-    /// W·nm⁻¹ per unit of the estimator's measure at each sampled wavelength.
-    pub weight: SampledSpectrum,
+pub struct EmissionPoint {
+    pub p: Vec3,
+    /// Front normal of an area light's surface (None for point-like sources).
+    pub n: Option<Vec3>,
+    /// 1 / (density of the point w.r.t. area) for area lights (their area), 1 for point-like
+    /// sources.
+    pub inv_pdf: f32,
 }
 
 impl Light {
@@ -109,98 +107,88 @@ impl Light {
         !matches!(self, Light::Distant { .. } | Light::Environment { .. })
     }
 
-    /// Sample a ray leaving the light (light tracing). `uc` chooses the primitive (area lights)
-    /// or drives the goniometric table, `u_pos` the point, `u_dir` the direction. None for
-    /// lights at infinity and for samples that carry nothing.
-    pub fn sample_emission(
+    /// Sample the point light leaves from (light tracing): uniform by area on an area light
+    /// (`uc` chooses the primitive, `u` the point), the position of point-like sources. None
+    /// for lights at infinity.
+    pub fn sample_emission_point(
         &self,
         geom: &SceneGeometry,
         uc: f32,
-        u_pos: Vec2,
-        u_dir: Vec2,
-        wl: &SampledWavelengths,
-    ) -> Option<EmissionSample> {
-        let from_point = |origin: Vec3, dir: Vec3, weight: SampledSpectrum| {
-            (!weight.is_black()).then_some(EmissionSample {
-                origin,
-                dir,
-                weight,
+        u: Vec2,
+    ) -> Option<EmissionPoint> {
+        let at = |p: Vec3| {
+            Some(EmissionPoint {
+                p,
+                n: None,
+                inv_pdf: 1.0,
             })
         };
         match self {
-            Light::Point {
-                position,
-                intensity,
-            } => from_point(
-                *position,
-                sample_uniform_sphere(u_dir),
-                intensity.sample(wl) * (4.0 * PI),
-            ),
-            Light::Spot {
-                position,
-                frame,
-                cos_inner,
-                cos_outer,
-                intensity,
-            } => {
-                // Uniform in the outer cone; the smooth falloff goes into the weight.
-                let cos_t = 1.0 - u_dir.x * (1.0 - cos_outer);
-                let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-                let phi = 2.0 * PI * u_dir.y;
-                let local = Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
-                let pdf = 1.0 / (2.0 * PI * (1.0 - cos_outer));
-                let falloff = smoothstep(*cos_outer, *cos_inner, cos_t);
-                from_point(
-                    *position,
-                    frame.to_world(local).normalize(),
-                    intensity.sample(wl) * (falloff / pdf),
-                )
-            }
-            Light::Goniometric(g) => {
-                let (dir, pdf, cd) = g.sample_emission(uc, u_dir)?;
-                if pdf <= 0.0 || !pdf.is_finite() || cd <= 0.0 {
-                    return None;
-                }
-                from_point(g.position, dir, g.spectrum.sample(wl) * (cd as f32 / pdf))
-            }
+            Light::Point { position, .. } | Light::Spot { position, .. } => at(*position),
+            Light::Goniometric(g) => at(g.position),
             Light::Area {
                 prims,
                 cdf,
                 total_area,
+                ..
+            } => {
+                let (k, _) = pick_from_cdf(cdf, uc);
+                let sp = geom.sample_prim(prims[k], u);
+                Some(EmissionPoint {
+                    p: sp.p,
+                    n: Some(sp.n),
+                    inv_pdf: *total_area,
+                })
+            }
+            Light::Distant { .. } | Light::Environment { .. } => None,
+        }
+    }
+
+    /// What leaves `at` toward unit direction `dir`, per steradian: radiant intensity for
+    /// point-like sources (W·sr⁻¹·nm⁻¹), radiance × |cos θ| for area lights (W·m⁻²·sr⁻¹·nm⁻¹,
+    /// zero behind a one-sided emitter).
+    pub fn emission_toward(
+        &self,
+        at: &EmissionPoint,
+        dir: Vec3,
+        wl: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        match self {
+            Light::Point { intensity, .. } => intensity.sample(wl),
+            Light::Spot {
+                frame,
+                cos_inner,
+                cos_outer,
+                intensity,
+                ..
+            } => {
+                let falloff = smoothstep(*cos_outer, *cos_inner, dir.dot(frame.n));
+                if falloff <= 0.0 {
+                    return SampledSpectrum::ZERO;
+                }
+                intensity.sample(wl) * falloff
+            }
+            Light::Goniometric(g) => {
+                let cd = g.table_candela(dir) as f32;
+                if cd > 0.0 && cd.is_finite() {
+                    g.spectrum.sample(wl) * cd
+                } else {
+                    SampledSpectrum::ZERO
+                }
+            }
+            Light::Area {
                 radiance,
                 two_sided,
                 ..
             } => {
-                let (k, _) = pick_from_cdf(cdf, uc);
-                let sp = geom.sample_prim(prims[k], u_pos);
-                // Cosine-distributed about the front normal (either side for two-sided
-                // emitters, chosen by remapping u_dir.x).
-                let (ux, side) = if *two_sided {
-                    if u_dir.x < 0.5 {
-                        (2.0 * u_dir.x, 1.0)
-                    } else {
-                        (2.0 * u_dir.x - 1.0, -1.0)
-                    }
+                let cos = at.n.map_or(0.0, |n| n.dot(dir));
+                if cos > 0.0 || (*two_sided && cos < 0.0) {
+                    radiance.sample(wl) * cos.abs()
                 } else {
-                    (u_dir.x, 1.0)
-                };
-                let local = crate::bxdf::sample_cosine_hemisphere(Vec2::new(ux, u_dir.y));
-                if local.z <= 0.0 {
-                    return None;
+                    SampledSpectrum::ZERO
                 }
-                let n = sp.n * side;
-                let dir = Frame::from_normal(n).to_world(local).normalize();
-                // L cos θ / (1/A · cos θ/π [· ½]) = L π A [· 2].
-                let sides = if *two_sided { 2.0 } else { 1.0 };
-                let origin = crate::geometry::offset_ray_origin(
-                    sp.p,
-                    crate::geometry::point_error_bound(sp.p),
-                    sp.n,
-                    dir,
-                );
-                from_point(origin, dir, radiance.sample(wl) * (PI * total_area * sides))
             }
-            Light::Distant { .. } | Light::Environment { .. } => None,
+            Light::Distant { .. } | Light::Environment { .. } => SampledSpectrum::ZERO,
         }
     }
 

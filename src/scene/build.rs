@@ -460,6 +460,16 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         seed: overrides.seed.unwrap_or(r.seed),
         filter,
         illuminance: r.illuminance || overrides.illuminance,
+        light_paths_per_sample: {
+            let v = r.light_paths_per_sample as f64;
+            if !(v > 0.0 && v <= 1024.0) {
+                return Err(ctx.err(
+                    "render.light_paths_per_sample",
+                    format!("{v} must be a number in (0, 1024]: light paths traced per camera sample for caustics"),
+                ));
+            }
+            v as f32
+        },
         caustics: overrides.caustics.unwrap_or(match r.caustics {
             CausticsDesc::LightTracing => crate::world::Caustics::LightTracing,
             CausticsDesc::PathTracing => crate::world::Caustics::PathTracing,
@@ -532,6 +542,12 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
             pending_area.push((i as u32, field.clone(), s, e.amount, e.two_sided));
         }
     }
+    // Bounding spheres of the objects that scatter specularly: where light tracing aims.
+    let caustic_targets: Vec<(Vec3, f32)> = shapes
+        .iter()
+        .filter(|(_, o)| materials[objects[*o as usize].material as usize].has_delta_lobe())
+        .filter_map(|(shape, _)| crate::caustics::bounding_sphere(shape))
+        .collect();
     let geometry = SceneGeometry::build(&shapes).map_err(|e| {
         let field = match &e {
             geometry::GeometryError::InvalidShape { object, .. } => scene
@@ -614,7 +630,7 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
     let (meters, grids, measure) = build_meters(&ctx, scene)?;
     let caustics = match settings.caustics {
         crate::world::Caustics::LightTracing => {
-            crate::caustics::CausticLights::new(&lights, &materials, &geometry, scene_radius)
+            crate::caustics::CausticLights::new(&lights, caustic_targets, &geometry, scene_radius)
         }
         crate::world::Caustics::PathTracing => None,
     };

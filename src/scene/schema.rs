@@ -150,6 +150,13 @@ pub struct RenderDesc {
     /// (`--caustics`).
     #[serde(default)]
     pub caustics: CausticsDesc,
+    /// With light-traced caustics: light paths per camera sample.
+    #[serde(default = "default_light_paths_per_sample")]
+    pub light_paths_per_sample: f32,
+}
+
+fn default_light_paths_per_sample() -> f32 {
+    crate::world::DEFAULT_LIGHT_PATHS_PER_SAMPLE
 }
 
 /// See [`crate::world::Caustics`].
@@ -171,6 +178,7 @@ impl Default for RenderDesc {
             filter: FilterDesc::Box,
             illuminance: false,
             caustics: CausticsDesc::LightTracing,
+            light_paths_per_sample: default_light_paths_per_sample(),
         }
     }
 }
