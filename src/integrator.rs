@@ -51,44 +51,6 @@ fn power_heuristic(f: f32, g: f32) -> f32 {
     f2 / (f2 + g2)
 }
 
-/// Spectral radiance (W·m⁻²·sr⁻¹·nm⁻¹ at each of `wl`'s wavelengths) arriving at `origin`
-/// from direction `dir` (unit).
-pub fn radiance(
-    world: &World,
-    origin: Vec3,
-    dir: Vec3,
-    wl: &mut SampledWavelengths,
-    sampler: &mut Sampler,
-    stats: &mut RayStats,
-) -> SampledSpectrum {
-    trace(
-        world,
-        origin,
-        dir,
-        PathStart::camera(origin),
-        wl,
-        sampler,
-        stats,
-    )
-}
-
-/// As [`radiance`], for a camera ray of the image: without the caustic paths that light
-/// tracing estimates when the world has it on (see [`crate::caustics`]).
-pub fn camera_radiance(
-    world: &World,
-    origin: Vec3,
-    dir: Vec3,
-    wl: &mut SampledWavelengths,
-    sampler: &mut Sampler,
-    stats: &mut RayStats,
-) -> SampledSpectrum {
-    let start = PathStart {
-        caustics_by_light_tracing: world.caustics.is_some(),
-        ..PathStart::camera(origin)
-    };
-    trace(world, origin, dir, start, wl, sampler, stats)
-}
-
 /// How the ray being traced was generated, for MIS of the emission it finds first.
 #[derive(Clone, Copy, Debug)]
 pub struct PathStart {
@@ -108,6 +70,7 @@ pub struct PathStart {
 }
 
 impl PathStart {
+    /// A ray from a camera or meter at `p` that counts every path (meters, probes).
     pub fn camera(p: Vec3) -> Self {
         Self {
             specular: true,
@@ -117,9 +80,19 @@ impl PathStart {
             caustics_by_light_tracing: false,
         }
     }
+
+    /// A camera ray of the image: without the caustic paths that light tracing estimates when
+    /// the world has it on (see [`crate::caustics`]).
+    pub fn image(world: &World, p: Vec3) -> Self {
+        Self {
+            caustics_by_light_tracing: world.caustics.is_some(),
+            ..Self::camera(p)
+        }
+    }
 }
 
-/// Radiance arriving along a ray that starts in state `start`.
+/// Spectral radiance (W·m⁻²·sr⁻¹·nm⁻¹ at each of `wl`'s wavelengths) arriving at `origin`
+/// from unit direction `dir`, along a ray that starts in state `start`.
 pub fn trace(
     world: &World,
     origin: Vec3,

@@ -5,7 +5,7 @@
 //! Every meter point has its own random stream, so results do not depend on the thread count.
 
 use crate::film::{radiance_to_xyz, standard_error};
-use crate::integrator::{irradiance, radiance, RayStart, RayStats};
+use crate::integrator::{irradiance, trace, PathStart, RayStart, RayStats};
 use crate::sampler::{mix64, Sampler};
 use crate::spectrum::SampledWavelengths;
 use crate::world::World;
@@ -126,7 +126,8 @@ fn sample_meter(world: &World, kind: &MeterKind, stream: u64, s: u64, stats: &mu
                 .to_world(local)
                 .normalize();
             stats.camera_rays += 1;
-            let l = radiance(world, *position, dir, &mut wl, &mut sampler, stats);
+            let start = PathStart::camera(*position);
+            let l = trace(world, *position, dir, start, &mut wl, &mut sampler, stats);
             radiance_to_xyz(&l, &wl)[1]
         }
     };

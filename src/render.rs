@@ -2,7 +2,7 @@
 //! (seed, pixel, sample index), so the result does not depend on the number of threads.
 
 use crate::film::{radiance_to_xyz, Film, PixelSums};
-use crate::integrator::{camera_radiance, RayStats};
+use crate::integrator::{trace, PathStart, RayStats};
 use crate::sampler::Sampler;
 use crate::spectrum::SampledWavelengths;
 use crate::world::World;
@@ -54,7 +54,16 @@ pub fn render_pixel(
         let mut wl = SampledWavelengths::sample_visible(u_wl);
         let ray = cam.generate_ray(x as f32 + 0.5 + off.x, y as f32 + 0.5 + off.y, u_lens);
         stats.camera_rays += 1;
-        let l = camera_radiance(world, ray.origin, ray.dir, &mut wl, &mut sampler, stats);
+        let start = PathStart::image(world, ray.origin);
+        let l = trace(
+            world,
+            ray.origin,
+            ray.dir,
+            start,
+            &mut wl,
+            &mut sampler,
+            stats,
+        );
         if world.settings.illuminance {
             if let Some(e) = surface_illuminance(world, ray.origin, ray.dir, pixel, s, stats) {
                 sums.add_illuminance(e);

@@ -77,28 +77,18 @@ fn r_conductor(c: f64) -> f64 {
 /// Luminance of the floor seen through pixel (x, y): ρ/π · E averaged over the pixel's
 /// footprint (16×16 midpoint quadrature), with (direct, mirrored) parts.
 fn expected(w: &World, x: usize, y: usize, with_mirror: bool) -> f64 {
-    let n = 16;
-    let mut sum = 0.0;
-    for j in 0..n {
-        for i in 0..n {
-            let r = w.camera.generate_ray(
-                x as f32 + (i as f32 + 0.5) / n as f32,
-                y as f32 + (j as f32 + 0.5) / n as f32,
-                glam::Vec2::ZERO,
-            );
-            let p = r.origin + r.dir * (-r.origin.y / r.dir.y);
-            let mut e = e_from(p, H_LIGHT, I_CD);
-            if with_mirror {
-                // The mirrored ray meets the mirror at the angle its image ray makes with
-                // the vertical.
-                let d = Vec3::new(0.0, (2.0 * H_MIRROR - H_LIGHT) as f32, 0.0) - p;
-                let c = d.y as f64 / d.length() as f64;
-                e += e_from(p, 2.0 * H_MIRROR - H_LIGHT, I_CD * r_conductor(c));
-            }
-            sum += e;
+    let e = |p: Vec3| {
+        let mut e = e_from(p, H_LIGHT, I_CD);
+        if with_mirror {
+            // The mirrored ray meets the mirror at the angle its image ray makes with the
+            // vertical.
+            let d = Vec3::new(0.0, (2.0 * H_MIRROR - H_LIGHT) as f32, 0.0) - p;
+            let c = d.y as f64 / d.length() as f64;
+            e += e_from(p, 2.0 * H_MIRROR - H_LIGHT, I_CD * r_conductor(c));
         }
-    }
-    RHO / PI * sum / (n * n) as f64
+        e
+    };
+    RHO / PI * floor_footprint_mean(w, x, y, e)
 }
 
 fn check_pixels(w: &World, film: &Film, with_mirror: bool, label: &str) {

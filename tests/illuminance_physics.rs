@@ -34,20 +34,7 @@ fn e_point(p: Vec3) -> f64 {
 /// The filter-weighted mean of E over a pixel's footprint on the plane (box filter: the
 /// pixel square), by a 16×16 midpoint quadrature.
 fn e_pixel(w: &candela::world::World, x: usize, y: usize) -> f64 {
-    let n = 16;
-    let mut sum = 0.0;
-    for j in 0..n {
-        for i in 0..n {
-            let r = w.camera.generate_ray(
-                x as f32 + (i as f32 + 0.5) / n as f32,
-                y as f32 + (j as f32 + 0.5) / n as f32,
-                glam::Vec2::ZERO,
-            );
-            let t = -r.origin.y / r.dir.y;
-            sum += e_point(r.origin + r.dir * t);
-        }
-    }
-    sum / (n * n) as f64
+    floor_footprint_mean(w, x, y, e_point)
 }
 
 #[test]

@@ -52,3 +52,21 @@ pub fn assert_every_pixel(film: &Film, expected: f64, k: f64) {
         m[1]
     );
 }
+
+/// The box-filter mean of `f` over pixel (x, y)'s footprint on the plane y = 0: a 16×16
+/// midpoint quadrature over the pixel square of points where the camera rays meet the plane.
+pub fn floor_footprint_mean(w: &World, x: usize, y: usize, f: impl Fn(glam::Vec3) -> f64) -> f64 {
+    let n = 16;
+    let mut sum = 0.0;
+    for j in 0..n {
+        for i in 0..n {
+            let r = w.camera.generate_ray(
+                x as f32 + (i as f32 + 0.5) / n as f32,
+                y as f32 + (j as f32 + 0.5) / n as f32,
+                glam::Vec2::ZERO,
+            );
+            sum += f(r.origin + r.dir * (-r.origin.y / r.dir.y));
+        }
+    }
+    sum / (n * n) as f64
+}
