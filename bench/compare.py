@@ -97,10 +97,13 @@ def read_candela_exr(path):
     return a[:, :, names.index("Y")], a[:, :, names.index("stderr.Y")]
 
 
-def run_candela(spp, seed, stem, threads):
-    """One candela render in its own process; timings from its report.json."""
+def run_candela(spp, seed, stem, threads, caustics="light-tracing"):
+    """One candela render in its own process; timings from its report.json. `caustics`:
+    candela's default light-traced caustics, or "path-tracing" (camera paths only, the same
+    algorithm as Mitsuba's path integrator)."""
     cmd = [CANDELA, "render", SCENE_RON, "--out", stem, "--spp", str(spp), "--threads",
-           str(threads), "--seed", str(seed), "--quiet", "--checkpoint-interval", "0s"]
+           str(threads), "--seed", str(seed), "--quiet", "--checkpoint-interval", "0s",
+           "--caustics", caustics]
     _, err, wall, rss = run_process(cmd)
     m = re.search(r"rendered .* in ([0-9.]+) s", err)
     with open(stem + ".report.json", encoding="utf-8") as f:
@@ -198,7 +201,7 @@ def candela_reference(args):
             render_s += r["render_s"]
         return np.array(parts), var / args.ref_parts ** 2, render_s
 
-    settings = f"candela {tool_version([CANDELA, '--version'])} {args.ref_spp} {args.ref_parts}"
+    settings = f"candela {tool_version([CANDELA, '--version'])} {args.ref_spp} {args.ref_parts} light-tracing"
     return cached_reference("candela", candela_scene_files(), settings, args, render_parts)
 
 
@@ -309,7 +312,7 @@ def markdown(summary, ratios, agree, chi, meta):
              f"medians of {meta['reps']} alternated runs (min–max in brackets).", "",
              "| renderer | spp | render time (s) | process wall (s) | Msamples/s | peak RSS (MiB) | RMSE Y (cd/m²) | rel. RMSE | efficiency 1/(MSE·t) |",
              "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
-    for key in ("candela", "mitsuba-llvm", "mitsuba-scalar", "mitsuba-llvm-independent", "candela-equal-time",
+    for key in ("candela", "candela-pt", "mitsuba-llvm", "mitsuba-scalar", "mitsuba-llvm-independent", "candela-equal-time",
                 "mitsuba-llvm-equal-time"):
         if key not in summary:
             continue
@@ -369,6 +372,8 @@ def parse_args():
                     help="skip the extra Mitsuba llvm_ad_spectral rows with its default 'independent' sampler")
     ap.add_argument("--mitsuba-rr-depth", type=int, default=5, help="Mitsuba rr_depth (default: its default 5)")
     ap.add_argument("--no-scalar", action="store_true", help="skip Mitsuba scalar_spectral")
+    ap.add_argument("--no-candela-pt", action="store_true",
+                    help="skip the candela rows with --caustics path-tracing (camera paths only)")
     ap.add_argument("--check", action="store_true",
                     help="exit 1 if the converged images disagree beyond noise (a region with |z| > 4 and |diff| > 0.1 %%)")
     ap.add_argument("--json", default=os.path.join(OUT, "mitsuba-results.json"))
@@ -421,6 +426,11 @@ def main():
     configs = [("candela", "candela", cref, lambda seed, d: run_candela(args.spp, seed, d + "candela", args.threads)),
                ("mitsuba-llvm", f"{mv} llvm_ad_spectral, {samp}", mref,
                 lambda seed, d: run_mitsuba("llvm_ad_spectral", args.spp, seed, d + "llvm.npy", args))]
+    if not args.no_candela_pt:
+        # Same converged image (both estimators are unbiased), so the same reference.
+        configs.insert(1, ("candela-pt", "candela, path tracing only", cref,
+                           lambda seed, d: run_candela(args.spp, seed, d + "candela-pt", args.threads,
+                                                       caustics="path-tracing")))
     if not args.no_scalar:
         configs.append(("mitsuba-scalar", f"{mv} scalar_spectral, {samp}", mref,
                         lambda seed, d: run_mitsuba("scalar_spectral", args.spp, seed, d + "scalar.npy", args)))
@@ -462,11 +472,14 @@ def main():
                          + ("; machine shared with other jobs" if max(meta["loadavg_start"][0], meta["loadavg_end"][0]) > 1.5 else ""))
 
     summary = {k: summary_of(v) for k, v in groups.items() if v}
-    ratios = {name: paired_ratios(groups["candela"], groups[key])
-              for key, name in (("mitsuba-llvm", f"vs llvm_ad_spectral, {samp}"),
-                                ("mitsuba-scalar", f"vs scalar_spectral, {samp}"),
-                                ("mitsuba-llvm-independent", "vs llvm_ad_spectral, independent"))
-              if groups.get(key)}
+    ratios = {name: paired_ratios(groups[ckey], groups[key])
+              for ckey, key, name in (
+                  ("candela", "mitsuba-llvm", f"candela vs llvm_ad_spectral, {samp}"),
+                  ("candela", "mitsuba-scalar", f"candela vs scalar_spectral, {samp}"),
+                  ("candela", "mitsuba-llvm-independent", "candela vs llvm_ad_spectral, independent"),
+                  ("candela-pt", "mitsuba-llvm", f"candela path tracing only vs llvm_ad_spectral, {samp}"),
+                  ("candela-pt", "mitsuba-scalar", f"candela path tracing only vs scalar_spectral, {samp}"))
+              if groups.get(ckey) and groups.get(key)}
     md = markdown(summary, ratios, agree, chi, meta)
     worst = max(abs(a["z"]) for a in agree)
     disagree = [a["region"] for a in agree if abs(a["z"]) > 4 and abs(a["diff_pct"]) > 0.1]
