@@ -8,11 +8,15 @@ use std::time::Duration;
 const SCENE: &str = r#"(
     camera: (position: (0.1, -0.2, 0.05), look_at: (0, 0, 1), vfov_deg: 120, resolution: (32, 32)),
     render: (spp: 512, max_depth: 64),
-    materials: { "wall": Diffuse(reflectance: Constant(0.7)) },
+    materials: { "wall": Diffuse(reflectance: Constant(0.7)), "glass": Dielectric(ior: Constant(1.5)) },
     objects: [(
         shape: Sphere(center: (0, 0, 0), radius: 1),
         material: "wall",
         emission: (spectrum: Named("E"), amount: Luminance(1.0), two_sided: true),
+    ), (
+        // Glass: light-traced caustics (their light paths) take part in checkpoints too.
+        shape: Sphere(center: (0.3, 0.2, 0.6), radius: 0.15),
+        material: "glass",
     )],
 )"#;
 
