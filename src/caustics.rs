@@ -239,9 +239,13 @@ pub struct Splat {
 
 /// Light paths per work item (the unit of parallelism and of the deterministic order).
 const CHUNK: u64 = 4096;
+/// Work items whose splats are held at once (bounds the memory of a pass's splats).
+const CHUNKS_PER_BATCH: u64 = 64;
 
 /// Trace light paths `first .. first + count` of stream `seed`, in parallel on the current
-/// rayon pool; the splats come back in path order. None if `stop` was raised meanwhile.
+/// rayon pool, and add their splats to `sums` (per pixel: Σ X, Σ Y, Σ Z, Σ Y²) in path order,
+/// so the sums do not depend on the number of threads. None if `stop` was raised meanwhile
+/// (`sums` is then partial).
 pub fn trace_light_paths(
     world: &World,
     caustics: &CausticLights,
@@ -249,32 +253,41 @@ pub fn trace_light_paths(
     first: u64,
     count: u64,
     stop: &AtomicBool,
-) -> Option<(Vec<Splat>, RayStats)> {
-    let chunks = count.div_ceil(CHUNK);
-    let parts: Vec<Option<(Vec<Splat>, RayStats)>> = (0..chunks)
-        .into_par_iter()
-        .map(|c| {
-            if stop.load(Ordering::Relaxed) {
-                return None;
-            }
-            let mut splats = Vec::new();
-            let mut stats = RayStats::default();
-            let lo = first + c * CHUNK;
-            let hi = (lo + CHUNK).min(first + count);
-            for index in lo..hi {
-                trace_light_path(world, caustics, seed, index, &mut splats, &mut stats);
-            }
-            Some((splats, stats))
-        })
-        .collect();
-    let mut splats = Vec::new();
+    sums: &mut [[f64; 4]],
+) -> Option<RayStats> {
     let mut stats = RayStats::default();
-    for part in parts {
-        let (s, st) = part?;
-        splats.extend(s);
-        stats.merge(&st);
+    let chunks = count.div_ceil(CHUNK);
+    for batch in (0..chunks).step_by(CHUNKS_PER_BATCH as usize) {
+        let parts: Vec<Option<(Vec<Splat>, RayStats)>> = (batch
+            ..(batch + CHUNKS_PER_BATCH).min(chunks))
+            .into_par_iter()
+            .map(|c| {
+                if stop.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let mut splats = Vec::new();
+                let mut stats = RayStats::default();
+                let lo = first + c * CHUNK;
+                let hi = (lo + CHUNK).min(first + count);
+                for index in lo..hi {
+                    trace_light_path(world, caustics, seed, index, &mut splats, &mut stats);
+                }
+                Some((splats, stats))
+            })
+            .collect();
+        for part in parts {
+            let (splats, st) = part?;
+            stats.merge(&st);
+            for s in splats {
+                let t = &mut sums[s.pixel as usize];
+                t[0] += s.xyz[0];
+                t[1] += s.xyz[1];
+                t[2] += s.xyz[2];
+                t[3] += s.xyz[1] * s.xyz[1];
+            }
+        }
     }
-    Some((splats, stats))
+    Some(stats)
 }
 
 /// |wo·ns||wi·ng| / (|wo·ng||wi·ns|): the factor that makes a BSDF with shading normals

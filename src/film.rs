@@ -94,13 +94,15 @@ impl PixelSums {
         self.sum_y2 += xyz[1] * xyz[1];
         self.count += 1;
     }
-    /// Add one light path's splat (see [`crate::caustics::Splat`]).
+    /// Add the splats of `paths` light paths (see [`crate::caustics`]): their Σ X, Σ Y, Σ Z
+    /// and Σ Y² on this pixel.
     #[inline]
-    pub fn add_splat(&mut self, xyz: [f64; 3]) {
-        for (s, v) in self.splat_xyz.iter_mut().zip(xyz) {
+    pub fn add_light_paths(&mut self, sums: &[f64; 4], paths: u64) {
+        for (s, v) in self.splat_xyz.iter_mut().zip(sums) {
             *s += v;
         }
-        self.splat_y2 += xyz[1] * xyz[1];
+        self.splat_y2 += sums[3];
+        self.light_paths += paths;
     }
     /// Record one illuminance sample (lx) of the surface seen by a camera sample.
     #[inline]

@@ -383,16 +383,17 @@ pub fn render_progressive(
             for (b, &stream) in streams.iter().enumerate() {
                 let first = film.light_paths[b];
                 let seed = world.settings.seed ^ stream;
+                let mut sums = vec![[0.0f64; 4]; w * h];
                 let traced = pool.install(|| {
                     crate::caustics::trace_light_paths(
-                        world, caustics, seed, first, per_buffer, stop,
+                        world, caustics, seed, first, per_buffer, stop, &mut sums,
                     )
                 });
-                let Some((splats, st)) = traced else {
+                let Some(st) = traced else {
                     break 'passes StopReason::Interrupted;
                 };
                 stats.merge(&st);
-                light.push((b, splats, per_buffer));
+                light.push((b, sums, per_buffer));
             }
         }
         for r in results.into_iter().flatten() {
@@ -404,18 +405,15 @@ pub fn render_progressive(
                 }
             }
         }
-        for (b, splats, paths) in light {
+        for (b, sums, paths) in light {
             film.light_paths[b] += paths;
             let buf = if b == 0 {
                 &mut film.pixels
             } else {
                 film.decision.as_mut().expect("adaptive film")
             };
-            for s in &splats {
-                buf[s.pixel as usize].add_splat(s.xyz);
-            }
-            for p in buf.iter_mut() {
-                p.light_paths += paths;
+            for (p, s) in buf.iter_mut().zip(&sums) {
+                p.add_light_paths(s, paths);
             }
         }
         debug_assert_eq!(adaptive, film.decision.is_some());

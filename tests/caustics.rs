@@ -213,3 +213,14 @@ fn conductor_reflectance_reference_is_the_closed_form_at_normal_incidence() {
     // Grazing incidence reflects everything.
     assert!((r_conductor(1e-9) - 1.0).abs() < 1e-6);
 }
+
+#[test]
+fn light_traced_image_does_not_depend_on_the_thread_count() {
+    let w = world_with(
+        &SPHERE_SCENE.replace("spp: 256", "spp: 16"),
+        Caustics::LightTracing,
+    );
+    let (a, b) = (render(&w, 1), render(&w, 3));
+    assert!(a.light_paths[0] > 0);
+    assert_eq!(a, b);
+}

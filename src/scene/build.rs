@@ -32,9 +32,9 @@ pub struct Overrides {
 /// Largest image the renderer accepts (pixels), so a typo cannot exhaust memory.
 pub const MAX_PIXELS: u64 = 1 << 28;
 
-/// Peak memory of a render per pixel: the tiles' pixel sums and the film (64 B each, both alive
-/// while the film is assembled) plus the EXR and PNG buffers.
-const BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<crate::film::PixelSums>() as u64 + 32;
+/// Peak memory of a render per pixel: the tiles' pixel sums and the film (both alive while the
+/// film is assembled), a pass's light-path sums (32 B), plus the EXR and PNG buffers.
+const BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<crate::film::PixelSums>() as u64 + 64;
 
 /// Memory this process may still allocate (Linux: MemAvailable and the cgroup limit), if known.
 fn available_memory() -> Option<u64> {
