@@ -7,10 +7,10 @@
 //! direction components below `f32::EPSILON` by ±1/ε, which can cull valid boxes for nearly
 //! axis-parallel rays; and its traversal stack (32 entries) is not bounds-checked in release
 //! builds. We therefore keep obvhs as the builder and node layout but traverse its nodes with
-//! our own loop ([`traverse`], the same algorithm as `obvhs::traverse!`, with a 64-entry stack
-//! whose bound the build checks) and our own node test ([`node_hitmask`]): entry clamped to 0,
-//! exact reciprocal directions, and per-node conservative padding of the slab distances by
-//! their floating-point error bound, so no box containing a valid hit is ever culled.
+//! our own loop ([`traverse`]: a distance-ordered stack whose size the build's depth check
+//! bounds) and our own node test ([`node_test`]): entry clamped to 0, exact reciprocal
+//! directions, and per-node conservative padding of the slab distances by their
+//! floating-point error bound, so no box containing a valid hit is ever culled.
 
 use super::prim::{Prim, PrimT, RayPre};
 use super::robust::gamma;
@@ -96,6 +96,9 @@ impl NodeRay {
     }
 }
 
+// The node test loads p and the e bytes as one 16-byte vector.
+const _: () = assert!(offset_of!(CwBvhNode, p) == 0 && offset_of!(CwBvhNode, e) == 12);
+
 /// The 8 plane bytes at byte offset `off` of `node`.
 #[inline(always)]
 fn planes(node: &CwBvhNode, off: usize) -> &[u8; 8] {
@@ -121,26 +124,32 @@ fn node_test(node: &CwBvhNode, r: &NodeRay, t_max: f32, tmin_out: &mut [f32; 8])
     unsafe {
         use std::arch::x86_64::*;
         let np = node as *const CwBvhNode as *const u8;
-        // p (lanes 0–2; lane 3 holds the e bytes, unused) and the extent 2^(e−127) per axis.
-        let p = _mm_loadu_ps(np as *const f32);
-        let e = _mm_castsi128_ps(_mm_slli_epi32::<23>(_mm_cvtepu8_epi32(_mm_cvtsi32_si128(
-            std::ptr::read_unaligned(np.add(offset_of!(CwBvhNode, e)) as *const i32),
-        ))));
-        let o = _mm_load_ps(&r.o as *const Vec3A as *const f32);
-        let inv = _mm_load_ps(&r.inv as *const Vec3A as *const f32);
-        let g7_inv = _mm_load_ps(&r.g7_inv_abs as *const Vec3A as *const f32);
-        let rel = _mm_sub_ps(p, o);
-        let base = _mm_mul_ps(rel, inv);
-        let scale = _mm_mul_ps(e, inv);
-        let rel_abs = _mm_andnot_ps(_mm_set1_ps(-0.0), rel);
-        let pad = _mm_mul_ps(_mm_fmadd_ps(e, _mm_set1_ps(255.0), rel_abs), g7_inv);
-        let near = _mm_sub_ps(base, pad);
-        let far = _mm_add_ps(base, pad);
-        let lane = |v: __m128, a: usize| -> __m256 {
+        // p in lanes 0–2 of both 128-bit halves (lane 3 holds the e bytes and imask), the
+        // extent 2^(e−127) per axis from the e bytes, and the ray data likewise duplicated:
+        // every per-axis value is then one in-lane permute away from a full broadcast.
+        let p = _mm256_broadcast_ps(&*(np as *const __m128));
+        let e_bytes = _mm256_setr_epi8(
+            12, -128, -128, -128, 13, -128, -128, -128, 14, -128, -128, -128, 15, -128, -128, -128,
+            12, -128, -128, -128, 13, -128, -128, -128, 14, -128, -128, -128, 15, -128, -128, -128,
+        );
+        let e = _mm256_castsi256_ps(_mm256_slli_epi32::<23>(_mm256_shuffle_epi8(
+            _mm256_castps_si256(p),
+            e_bytes,
+        )));
+        let dup = |v: &Vec3A| _mm256_broadcast_ps(&*(v as *const Vec3A as *const __m128));
+        let (o, inv, g7_inv) = (dup(&r.o), dup(&r.inv), dup(&r.g7_inv_abs));
+        let rel = _mm256_sub_ps(p, o);
+        let base = _mm256_mul_ps(rel, inv);
+        let scale = _mm256_mul_ps(e, inv);
+        let rel_abs = _mm256_andnot_ps(_mm256_set1_ps(-0.0), rel);
+        let pad = _mm256_mul_ps(_mm256_fmadd_ps(e, _mm256_set1_ps(255.0), rel_abs), g7_inv);
+        let near = _mm256_sub_ps(base, pad);
+        let far = _mm256_add_ps(base, pad);
+        let lane = |v: __m256, a: usize| -> __m256 {
             match a {
-                0 => _mm256_broadcastss_ps(v),
-                1 => _mm256_broadcastss_ps(_mm_permute_ps::<0b01_01_01_01>(v)),
-                _ => _mm256_broadcastss_ps(_mm_permute_ps::<0b10_10_10_10>(v)),
+                0 => _mm256_permute_ps::<0b00_00_00_00>(v),
+                1 => _mm256_permute_ps::<0b01_01_01_01>(v),
+                _ => _mm256_permute_ps::<0b10_10_10_10>(v),
             }
         };
         let q8 = |off: usize| {
