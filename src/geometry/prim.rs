@@ -38,9 +38,10 @@ pub(crate) struct RayPre {
     pub dd: DVec3,
     /// Index of the largest |direction| component (the triangle test's permuted z axis).
     pub kz: usize,
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    /// Shear of the triangle test: x' = x + sx·z, y' = y + sy·z (permuted axes), z' = sz·z.
+    pub sx: f32,
+    pub sy: f32,
+    pub sz: f32,
 }
 
 impl RayPre {
@@ -110,6 +111,16 @@ pub(crate) fn intersect_triangle<const KZ: usize>(
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
         return None;
     }
+    triangle_tail(r, t_max, [p0t, p1t, p2t], [e0, e1, e2])
+}
+
+/// The rest of [`intersect_triangle`] once the edge functions `e` have the same sign: `pt`
+/// are the vertices translated to the ray origin, permuted (z = dominant axis) and sheared in
+/// x and y (not yet scaled in z).
+#[inline(always)]
+pub(crate) fn triangle_tail(r: &RayPre, t_max: f32, pt: [Vec3; 3], e: [f32; 3]) -> Option<PrimT> {
+    let [mut p0t, mut p1t, mut p2t] = pt;
+    let [e0, e1, e2] = e;
     let det = e0 + e1 + e2;
     if det == 0.0 {
         return None;

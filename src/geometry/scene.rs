@@ -7,25 +7,30 @@
 //! direction components below `f32::EPSILON` by ±1/ε, which can cull valid boxes for nearly
 //! axis-parallel rays; and its traversal stack (32 entries) is not bounds-checked in release
 //! builds. We therefore keep obvhs as the builder and node layout but traverse its nodes with
-//! our own loop ([`traverse`], the same algorithm as `obvhs::traverse!`, with a 64-entry stack
-//! whose bound the build checks) and our own node test ([`node_hitmask`]): entry clamped to 0,
-//! exact reciprocal directions, and per-node conservative padding of the slab distances by
-//! their floating-point error bound, so no box containing a valid hit is ever culled.
+//! our own loop ([`traverse`]: a distance-ordered stack whose size the build's depth check
+//! bounds) and our own node test ([`node_test`]): entry clamped to 0, exact reciprocal
+//! directions, and per-node conservative padding of the slab distances by their
+//! floating-point error bound, so no box containing a valid hit is ever culled.
 
-use super::prim::{Prim, RayPre};
+use super::prim::{Prim, PrimT, RayPre};
 use super::robust::gamma;
 use super::{GeometryError, Hit, Shape, SurfacePoint};
-use glam::{UVec2, Vec2, Vec3, Vec3A};
+use glam::{Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 use obvhs::BvhBuildParams;
+use std::mem::{offset_of, MaybeUninit};
 
 /// All primitives of the scene in one BVH.
 pub struct SceneGeometry {
     bvh: CwBvh,
-    /// Primitives in BVH leaf order; the primitive id is the index into this array.
-    prims: Vec<Prim>,
+    /// Primitives in BVH leaf order; the primitive id is the index into this array. Triangles
+    /// are stored inline (their vertices); any other primitive as a marker (NaN first
+    /// coordinate, then its index into `others` as the bits of the second vertex's x).
+    tris: Vec<[Vec3; 3]>,
+    /// The non-triangle primitives.
+    others: Vec<Prim>,
     prim_object: Vec<u32>,
     /// Per primitive vertex-normal indices into `normals` (`u32::MAX` = none). Empty when no
     /// primitive has vertex normals.
@@ -40,7 +45,12 @@ pub struct SceneGeometry {
 struct NodeRay {
     o: Vec3A,
     inv: Vec3A,
-    neg: [bool; 3],
+    /// gamma(7)·|inv|: the rounding-error bound of the slab distances per unit of |p−o| + 255e.
+    g7_inv_abs: Vec3A,
+    /// Byte offsets in a [`CwBvhNode`] of the near and far plane arrays per axis, chosen once
+    /// per ray from the direction's signs (near = min plane for a positive direction).
+    near: [usize; 3],
+    far: [usize; 3],
 }
 
 const INV_LIMIT: f32 = 1e30;
@@ -51,29 +61,58 @@ impl NodeRay {
         // 1/±0 = ±∞ is clamped to ±INV_LIMIT (d is finite and non-zero, so no NaN).
         let inv =
             (Vec3A::ONE / Vec3A::from(d)).clamp(Vec3A::splat(-INV_LIMIT), Vec3A::splat(INV_LIMIT));
+        // From the reciprocal, so that −0 (reciprocal −∞ → −INV_LIMIT) counts as negative.
+        let planes = [
+            (
+                offset_of!(CwBvhNode, child_min_x),
+                offset_of!(CwBvhNode, child_max_x),
+            ),
+            (
+                offset_of!(CwBvhNode, child_min_y),
+                offset_of!(CwBvhNode, child_max_y),
+            ),
+            (
+                offset_of!(CwBvhNode, child_min_z),
+                offset_of!(CwBvhNode, child_max_z),
+            ),
+        ];
+        let pick = |a: usize, neg: bool| {
+            if neg {
+                (planes[a].1, planes[a].0)
+            } else {
+                planes[a]
+            }
+        };
+        let (nx, fx) = pick(0, inv.x < 0.0);
+        let (ny, fy) = pick(1, inv.y < 0.0);
+        let (nz, fz) = pick(2, inv.z < 0.0);
         Self {
             o: o.into(),
             inv,
-            // From the reciprocal, so that −0 (reciprocal −∞ → −INV_LIMIT) counts as negative.
-            neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
+            g7_inv_abs: gamma(7) * inv.abs(),
+            near: [nx, ny, nz],
+            far: [fx, fy, fz],
         }
     }
 }
 
-/// Slab test of the 8 children of `node` against the ray segment [0, t_max]; returns obvhs's
-/// hitmask. The plane distances are computed as `q·(e/d) + (p−o)/d` (q = quantized plane) and
-/// widened by a bound on their rounding error, so the test is conservative.
-#[inline(always)]
-fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32 {
-    let e = node.compute_extent();
-    let rel = Vec3A::from(node.p) - r.o;
-    let scale = e * r.inv;
-    let base = rel * r.inv;
-    let pad = gamma(7) * (rel.abs() + 255.0 * e) * r.inv.abs();
-    let base_near = base - pad;
-    let base_far = base + pad;
-    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
+// The node test loads p and the e bytes as one 16-byte vector.
+const _: () = assert!(offset_of!(CwBvhNode, p) == 0 && offset_of!(CwBvhNode, e) == 12);
 
+/// The 8 plane bytes at byte offset `off` of `node`.
+#[inline(always)]
+fn planes(node: &CwBvhNode, off: usize) -> &[u8; 8] {
+    debug_assert!(off + 8 <= std::mem::size_of::<CwBvhNode>());
+    // SAFETY: `off` is the offset of one of the node's six `[u8; 8]` plane arrays.
+    unsafe { &*((node as *const CwBvhNode as *const u8).add(off) as *const [u8; 8]) }
+}
+
+/// Slab test of the 8 children of `node` against the ray segment [0, t_max]. Returns the
+/// mask of hit (non-empty) child slots and every slot's entry distance. The plane distances
+/// are computed as `q·(e/d) + (p−o)/d` (q = quantized plane) and widened by a bound on their
+/// rounding error, so the test is conservative.
+#[inline(always)]
+fn node_test(node: &CwBvhNode, r: &NodeRay, t_max: f32, tmin_out: &mut [f32; 8]) -> u32 {
     // AVX2 (all 8 children at once; built with `target-cpu=native` on any recent x86-64).
     // FMA rounds once where mul + add rounded twice, so the padding stays conservative.
     #[cfg(all(
@@ -84,56 +123,50 @@ fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32
     // SAFETY: the target features are enabled at compile time; loads stay within the node.
     unsafe {
         use std::arch::x86_64::*;
-        /// Entry and exit distances of the 8 children's slabs on one axis.
-        #[inline(always)]
-        fn slabs(
-            lo: &[u8; 8],
-            hi: &[u8; 8],
-            neg: bool,
-            s: f32,
-            near: f32,
-            far: f32,
-        ) -> (__m256, __m256) {
-            // SAFETY: reads exactly the 8 bytes of each array.
-            unsafe {
-                let q8 = |v: &[u8; 8]| {
-                    _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
-                        v.as_ptr() as *const __m128i
-                    )))
-                };
-                let (lo, hi) = (q8(lo), q8(hi));
-                let (qn, qf) = if neg { (hi, lo) } else { (lo, hi) };
-                let s = _mm256_set1_ps(s);
-                (
-                    _mm256_fmadd_ps(qn, s, _mm256_set1_ps(near)),
-                    _mm256_fmadd_ps(qf, s, _mm256_set1_ps(far)),
-                )
+        let np = node as *const CwBvhNode as *const u8;
+        // p in lanes 0–2 of both 128-bit halves (lane 3 holds the e bytes and imask), the
+        // extent 2^(e−127) per axis from the e bytes, and the ray data likewise duplicated:
+        // every per-axis value is then one in-lane permute away from a full broadcast.
+        let p = _mm256_broadcast_ps(&*(np as *const __m128));
+        let e_bytes = _mm256_setr_epi8(
+            12, -128, -128, -128, 13, -128, -128, -128, 14, -128, -128, -128, 15, -128, -128, -128,
+            12, -128, -128, -128, 13, -128, -128, -128, 14, -128, -128, -128, 15, -128, -128, -128,
+        );
+        let e = _mm256_castsi256_ps(_mm256_slli_epi32::<23>(_mm256_shuffle_epi8(
+            _mm256_castps_si256(p),
+            e_bytes,
+        )));
+        let dup = |v: &Vec3A| _mm256_broadcast_ps(&*(v as *const Vec3A as *const __m128));
+        let (o, inv, g7_inv) = (dup(&r.o), dup(&r.inv), dup(&r.g7_inv_abs));
+        let rel = _mm256_sub_ps(p, o);
+        let base = _mm256_mul_ps(rel, inv);
+        let scale = _mm256_mul_ps(e, inv);
+        let rel_abs = _mm256_andnot_ps(_mm256_set1_ps(-0.0), rel);
+        let pad = _mm256_mul_ps(_mm256_fmadd_ps(e, _mm256_set1_ps(255.0), rel_abs), g7_inv);
+        let near = _mm256_sub_ps(base, pad);
+        let far = _mm256_add_ps(base, pad);
+        let lane = |v: __m256, a: usize| -> __m256 {
+            match a {
+                0 => _mm256_permute_ps::<0b00_00_00_00>(v),
+                1 => _mm256_permute_ps::<0b01_01_01_01>(v),
+                _ => _mm256_permute_ps::<0b10_10_10_10>(v),
             }
-        }
-        let (tnx, tfx) = slabs(
-            &node.child_min_x,
-            &node.child_max_x,
-            r.neg[0],
-            scale.x,
-            base_near.x,
-            base_far.x,
-        );
-        let (tny, tfy) = slabs(
-            &node.child_min_y,
-            &node.child_max_y,
-            r.neg[1],
-            scale.y,
-            base_near.y,
-            base_far.y,
-        );
-        let (tnz, tfz) = slabs(
-            &node.child_min_z,
-            &node.child_max_z,
-            r.neg[2],
-            scale.z,
-            base_near.z,
-            base_far.z,
-        );
+        };
+        let q8 = |off: usize| {
+            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
+                planes(node, off).as_ptr() as *const __m128i,
+            )))
+        };
+        let slab = |a: usize| {
+            let s = lane(scale, a);
+            (
+                _mm256_fmadd_ps(q8(r.near[a]), s, lane(near, a)),
+                _mm256_fmadd_ps(q8(r.far[a]), s, lane(far, a)),
+            )
+        };
+        let (tnx, tfx) = slab(0);
+        let (tny, tfy) = slab(1);
+        let (tnz, tfz) = slab(2);
         let tmin = _mm256_max_ps(
             _mm256_max_ps(tnx, tny),
             _mm256_max_ps(tnz, _mm256_setzero_ps()),
@@ -142,18 +175,10 @@ fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32
             _mm256_min_ps(tfx, tfy),
             _mm256_min_ps(tfz, _mm256_set1_ps(t_max)),
         );
-        let hit = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax));
-        // hit_mask = OR over hit children k of child_bits[k] << bit_index[k], 8 lanes at once.
-        let bits = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(child_bits8 as i64));
-        let index = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(bit_index8 as i64));
-        let lanes = _mm256_and_si256(_mm256_sllv_epi32(bits, index), hit);
-        let x = _mm_or_si128(
-            _mm256_castsi256_si128(lanes),
-            _mm256_extracti128_si256::<1>(lanes),
-        );
-        let x = _mm_or_si128(x, _mm_shuffle_epi32::<0b01_00_11_10>(x));
-        let x = _mm_or_si128(x, _mm_shuffle_epi32::<0b10_11_00_01>(x));
-        _mm_cvtsi128_si32(x) as u32
+        _mm256_storeu_ps(tmin_out.as_mut_ptr(), tmin);
+        // Empty slots have inverted boxes (see `SceneGeometry::build_with_params`), and should
+        // one still pass it decodes as an empty leaf.
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax)) as u32
     }
 
     // Portable form of the same test, one child at a time.
@@ -163,30 +188,36 @@ fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32
         target_feature = "fma"
     )))]
     {
+        let e = node.compute_extent();
+        let rel = Vec3A::from(node.p) - r.o;
+        let scale = e * r.inv;
+        let base = rel * r.inv;
+        let pad = (rel.abs() + 255.0 * e) * r.g7_inv_abs;
+        let base_near = base - pad;
+        let base_far = base + pad;
+        let (nx, ny, nz) = (
+            planes(node, r.near[0]),
+            planes(node, r.near[1]),
+            planes(node, r.near[2]),
+        );
+        let (fx, fy, fz) = (
+            planes(node, r.far[0]),
+            planes(node, r.far[1]),
+            planes(node, r.far[2]),
+        );
         let mut hit_mask = 0u32;
         for k in 0..8 {
-            let q = |lo: u8, hi: u8, neg: bool| {
-                if neg {
-                    (hi as f32, lo as f32)
-                } else {
-                    (lo as f32, hi as f32)
-                }
-            };
-            let (nx, fx) = q(node.child_min_x[k], node.child_max_x[k], r.neg[0]);
-            let (ny, fy) = q(node.child_min_y[k], node.child_max_y[k], r.neg[1]);
-            let (nz, fz) = q(node.child_min_z[k], node.child_max_z[k], r.neg[2]);
-            let tmin = (nx * scale.x + base_near.x)
-                .max(ny * scale.y + base_near.y)
-                .max(nz * scale.z + base_near.z)
+            let tmin = (nx[k] as f32 * scale.x + base_near.x)
+                .max(ny[k] as f32 * scale.y + base_near.y)
+                .max(nz[k] as f32 * scale.z + base_near.z)
                 .max(0.0);
-            let tmax = (fx * scale.x + base_far.x)
-                .min(fy * scale.y + base_far.y)
-                .min(fz * scale.z + base_far.z)
+            let tmax = (fx[k] as f32 * scale.x + base_far.x)
+                .min(fy[k] as f32 * scale.y + base_far.y)
+                .min(fz[k] as f32 * scale.z + base_far.z)
                 .min(t_max);
-            if tmin <= tmax {
-                let child_bits = ((child_bits8 >> (k * 8)) as u32) & 0xff;
-                let bit_index = ((bit_index8 >> (k * 8)) as u32) & 0xff;
-                hit_mask |= child_bits << bit_index;
+            tmin_out[k] = tmin;
+            if tmin <= tmax && node.child_meta[k] & 0x20 != 0 {
+                hit_mask |= 1 << k;
             }
         }
         hit_mask
@@ -197,80 +228,277 @@ fn node_hitmask(node: &CwBvhNode, r: &NodeRay, oct_inv4: u32, t_max: f32) -> u32
 /// BVH builder's f32 surface-area costs overflow (7 astronomical units: room for a sun).
 pub const MAX_COORDINATE: f32 = 1e12;
 
-/// Maximum supported BVH depth (our traversal stack size).
+/// Maximum supported BVH depth.
 const MAX_DEPTH: usize = 64;
 
-#[inline(always)]
-fn firstbithigh(v: u32) -> u32 {
-    31 - v.leading_zeros()
+/// Traversal stack entries: at most 7 pushes per level below the root.
+const STACK_SIZE: usize = 7 * MAX_DEPTH;
+
+/// A traversal item: an inner node (`leaf == 0`; `idx` = node index) or a leaf (`idx` = first
+/// primitive, `leaf` = 8 | its primitive count in unary (1, 3 or 7; 0 for an empty slot)),
+/// with its entry distance.
+#[derive(Clone, Copy)]
+struct Item {
+    idx: u32,
+    leaf: u32,
+    dist: f32,
 }
 
+/// The item for child slot `k` of `node`, entered at distance `dist` (branch-free decode of
+/// the slot's meta byte).
 #[inline(always)]
-fn octant_inv4(d: Vec3) -> u32 {
-    (if d.x < 0.0 { 0 } else { 0x04040404 })
-        | (if d.y < 0.0 { 0 } else { 0x02020202 })
-        | (if d.z < 0.0 { 0 } else { 0x01010101 })
+fn child_item(node: &CwBvhNode, k: u32, dist: f32) -> Item {
+    let meta = node.child_meta[k as usize] as u32;
+    let imask = node.imask as u32;
+    let inner = (imask >> k) & 1 != 0;
+    // Inner children are stored in slot order from child_base_idx.
+    let node_idx = node.child_base_idx + (imask & ((1u32 << k) - 1)).count_ones();
+    let prim_idx = node.primitive_base_idx + (meta & 0x1f);
+    Item {
+        idx: if inner { node_idx } else { prim_idx },
+        leaf: if inner { 0 } else { (meta >> 5) | 8 },
+        dist,
+    }
 }
 
-/// CWBVH traversal (the loop of `obvhs::traverse!`, Ylitie et al. 2017) with our node test and
-/// a 64-entry stack. `prim_fn(id, t_max)` tests primitive `id` and returns the new t_max
-/// (smaller on a closer hit) or `None` to stop traversal (any-hit).
+/// Prefetches the node or the leaf triangles an item refers to.
 #[inline(always)]
-fn traverse(
+fn prefetch(nodes: &[CwBvhNode], tris: &[[Vec3; 3]], it: &Item) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // Prefetching never faults and has no effect on memory; the addresses are computed
+        // with wrapping arithmetic, so no pointer leaves its allocation.
+        let (p, len) = if it.leaf == 0 {
+            (
+                nodes.as_ptr().wrapping_add(it.idx as usize) as *const i8,
+                80,
+            )
+        } else {
+            let n = (it.leaf & 7).count_ones() as usize;
+            (
+                tris.as_ptr().wrapping_add(it.idx as usize) as *const i8,
+                n * 36,
+            )
+        };
+        // SAFETY: see above.
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(p);
+            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
+            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(len.max(1) - 1));
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (nodes, tris, it);
+}
+
+/// CWBVH traversal with a CPU-style stack of (child, entry distance). With `ORDERED`
+/// (closest hit) the hit children of a node are visited nearest first and stack entries that
+/// start beyond the current `t_max` are skipped; without it (any hit) the order is arbitrary.
+/// `leaf_fn(first, count, t_max)` tests the primitives `first..first + count` and returns the
+/// new t_max (smaller on a closer hit) or `None` to stop traversal (any-hit).
+#[inline(always)]
+fn traverse<const ORDERED: bool>(
     bvh: &CwBvh,
+    tris: &[[Vec3; 3]],
     origin: Vec3,
     dir: Vec3,
     mut t_max: f32,
-    mut prim_fn: impl FnMut(u32, f32) -> Option<f32>,
+    mut leaf_fn: impl FnMut(u32, u32, f32) -> Option<f32>,
 ) {
-    if bvh.nodes.is_empty() {
+    let nodes = &bvh.nodes[..];
+    if nodes.is_empty() {
         return;
     }
     let r = NodeRay::new(origin, dir);
-    let oct_inv4 = octant_inv4(dir);
-    let mut stack = [UVec2::ZERO; MAX_DEPTH];
+    let mut stack = [const { MaybeUninit::<Item>::uninit() }; STACK_SIZE];
     let mut sp = 0usize;
-    let mut current = UVec2::new(0, 0x8000_0000);
-    let mut prims = UVec2::ZERO;
+    let mut cur = Item {
+        idx: 0,
+        leaf: 0,
+        dist: 0.0,
+    };
+    let mut tmin = [0.0f32; 8];
+    macro_rules! push {
+        ($it:expr) => {{
+            debug_assert!(sp < STACK_SIZE);
+            // SAFETY: at most 7 entries are pushed per level and the build rejects BVHs
+            // deeper than MAX_DEPTH.
+            unsafe { stack.get_unchecked_mut(sp).write($it) };
+            sp += 1;
+        }};
+    }
     loop {
-        while prims.y != 0 {
-            let local = firstbithigh(prims.y);
-            prims.y &= !(1u32 << local);
-            match prim_fn(prims.x + local, t_max) {
+        if cur.leaf == 0 {
+            // SAFETY: inner child indices are valid node indices (node 0 exists).
+            let node = unsafe { nodes.get_unchecked(cur.idx as usize) };
+            let mut mask = node_test(node, &r, t_max, &mut tmin);
+            if mask != 0 {
+                let c0 = {
+                    let k = mask.trailing_zeros();
+                    child_item(node, k, tmin[k as usize])
+                };
+                mask &= mask - 1;
+                if mask == 0 {
+                    cur = c0;
+                    continue;
+                }
+                let c1 = {
+                    let k = mask.trailing_zeros();
+                    child_item(node, k, tmin[k as usize])
+                };
+                mask &= mask - 1;
+                if !ORDERED {
+                    prefetch(nodes, tris, &c1);
+                    push!(c1);
+                    while mask != 0 {
+                        let k = mask.trailing_zeros();
+                        let c = child_item(node, k, tmin[k as usize]);
+                        prefetch(nodes, tris, &c);
+                        push!(c);
+                        mask &= mask - 1;
+                    }
+                    cur = c0;
+                    continue;
+                }
+                if mask == 0 {
+                    let (near, far) = if c1.dist < c0.dist {
+                        (c1, c0)
+                    } else {
+                        (c0, c1)
+                    };
+                    prefetch(nodes, tris, &far);
+                    push!(far);
+                    cur = near;
+                    continue;
+                }
+                // Three or more: push all, sort the new entries by decreasing distance (the
+                // nearest on top) and continue with the nearest.
+                let first = sp;
+                push!(c0);
+                push!(c1);
+                while mask != 0 {
+                    push!({
+                        let k = mask.trailing_zeros();
+                        child_item(node, k, tmin[k as usize])
+                    });
+                    mask &= mask - 1;
+                }
+                // SAFETY: entries first..sp were just written.
+                unsafe {
+                    for i in first + 1..sp {
+                        let x = stack.get_unchecked(i).assume_init();
+                        let mut j = i;
+                        while j > first
+                            && stack.get_unchecked(j - 1).assume_init_ref().dist < x.dist
+                        {
+                            let y = stack.get_unchecked(j - 1).assume_init();
+                            stack.get_unchecked_mut(j).write(y);
+                            j -= 1;
+                        }
+                        stack.get_unchecked_mut(j).write(x);
+                    }
+                    for i in first..sp - 1 {
+                        prefetch(nodes, tris, stack.get_unchecked(i).assume_init_ref());
+                    }
+                    sp -= 1;
+                    cur = stack.get_unchecked(sp).assume_init();
+                }
+                continue;
+            }
+        } else {
+            match leaf_fn(cur.idx, (cur.leaf & 7).count_ones(), t_max) {
                 Some(t) => t_max = t,
                 None => return,
             }
         }
-        if current.y & 0xff00_0000 != 0 {
-            let hits_imask = current.y;
-            let child_offset = firstbithigh(hits_imask);
-            let child_base = current.x;
-            current.y &= !(1u32 << child_offset);
-            if current.y & 0xff00_0000 != 0 {
-                // SAFETY: the stack holds one entry per level and the build rejects BVHs
-                // deeper than MAX_DEPTH.
-                unsafe { *stack.get_unchecked_mut(sp) = current };
-                sp += 1;
-            }
-            let slot = (child_offset - 24) ^ (oct_inv4 & 0xff);
-            let relative = (hits_imask & !(0xffff_ffffu32 << slot)).count_ones();
-            let node = &bvh.nodes[(child_base + relative) as usize];
-            let hitmask = node_hitmask(node, &r, oct_inv4, t_max);
-            current = UVec2::new(
-                node.child_base_idx,
-                (hitmask & 0xff00_0000) | node.imask as u32,
-            );
-            prims = UVec2::new(node.primitive_base_idx, hitmask & 0x00ff_ffff);
-        } else {
-            current = UVec2::ZERO;
-        }
-        if prims.y == 0 && current.y & 0xff00_0000 == 0 {
+        // Pop the nearest entry that can still hold a hit.
+        loop {
             if sp == 0 {
                 return;
             }
             sp -= 1;
-            current = stack[sp];
+            // SAFETY: entries below sp were written.
+            let it = unsafe { stack.get_unchecked(sp).assume_init() };
+            if !ORDERED || it.dist <= t_max {
+                cur = it;
+                break;
+            }
         }
+    }
+}
+
+/// [`super::prim::intersect_triangle`] with the vertex transform and the edge functions in SIMD (the
+/// three vertices in three lanes); every operation and its rounding is the same as in the
+/// scalar test, so the results are bit-identical.
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+))]
+#[inline(always)]
+fn intersect_triangle_simd<const KZ: usize>(
+    r: &RayPre,
+    t_max: f32,
+    v: &[Vec3; 3],
+) -> Option<PrimT> {
+    use std::arch::x86_64::*;
+    let kx = (KZ + 1) % 3;
+    let ky = (KZ + 2) % 3;
+    // SAFETY: AVX2 and FMA are enabled at compile time; both 8-float loads stay within the 9
+    // floats of `v`.
+    unsafe {
+        let ptr = v.as_ptr() as *const f32;
+        let lo = _mm256_loadu_ps(ptr);
+        let hi = _mm256_loadu_ps(ptr.add(1));
+        // Coordinate c of the three vertices (floats c, c + 3, c + 6) in lanes 0..3.
+        let coord = |c: usize| {
+            let (src, b) = if c == 0 { (lo, 0) } else { (hi, c as i32 - 1) };
+            _mm256_castps256_ps128(_mm256_permutevar8x32_ps(
+                src,
+                _mm256_setr_epi32(b, b + 3, b + 6, b + 6, 0, 0, 0, 0),
+            ))
+        };
+        let o = r.o.to_array();
+        let z = _mm_sub_ps(coord(KZ), _mm_set1_ps(o[KZ]));
+        let x = _mm_add_ps(
+            _mm_sub_ps(coord(kx), _mm_set1_ps(o[kx])),
+            _mm_mul_ps(_mm_set1_ps(r.sx), z),
+        );
+        let y = _mm_add_ps(
+            _mm_sub_ps(coord(ky), _mm_set1_ps(o[ky])),
+            _mm_mul_ps(_mm_set1_ps(r.sy), z),
+        );
+        // e_i = x_{i+1}·y_{i+2} − y_{i+1}·x_{i+2}: exact f64 products, one rounding in f64
+        // (the FMA subtracts an exact product) and one to f32, as `diff_of_products`.
+        let xd = _mm256_cvtps_pd(x);
+        let yd = _mm256_cvtps_pd(y);
+        const NEXT: i32 = 0b11_00_10_01;
+        const NEXT2: i32 = 0b11_01_00_10;
+        let e = _mm256_cvtpd_ps(_mm256_fmsub_pd(
+            _mm256_permute4x64_pd::<NEXT>(xd),
+            _mm256_permute4x64_pd::<NEXT2>(yd),
+            _mm256_mul_pd(
+                _mm256_permute4x64_pd::<NEXT>(yd),
+                _mm256_permute4x64_pd::<NEXT2>(xd),
+            ),
+        ));
+        let zero = _mm_setzero_ps();
+        let neg = _mm_movemask_ps(_mm_cmplt_ps(e, zero)) & 7;
+        let pos = _mm_movemask_ps(_mm_cmpgt_ps(e, zero)) & 7;
+        if neg != 0 && pos != 0 {
+            return None;
+        }
+        let mut xa = [0.0f32; 4];
+        let mut ya = [0.0f32; 4];
+        let mut za = [0.0f32; 4];
+        let mut ea = [0.0f32; 4];
+        _mm_storeu_ps(xa.as_mut_ptr(), x);
+        _mm_storeu_ps(ya.as_mut_ptr(), y);
+        _mm_storeu_ps(za.as_mut_ptr(), z);
+        _mm_storeu_ps(ea.as_mut_ptr(), e);
+        let pt = [0, 1, 2].map(|i| Vec3::new(xa[i], ya[i], za[i]));
+        super::prim::triangle_tail(r, t_max, pt, [ea[0], ea[1], ea[2]])
     }
 }
 
@@ -510,6 +738,20 @@ impl SceneGeometry {
             )
         };
         bvh.nodes.shrink_to_fit();
+        // Empty child slots get inverted boxes (min 255 > max 0) so the node test misses them
+        // (it does not check the slot's meta byte).
+        for node in &mut bvh.nodes {
+            for k in 0..8 {
+                if node.child_meta[k] == 0 {
+                    node.child_min_x[k] = 255;
+                    node.child_min_y[k] = 255;
+                    node.child_min_z[k] = 255;
+                    node.child_max_x[k] = 0;
+                    node.child_max_y[k] = 0;
+                    node.child_max_z[k] = 0;
+                }
+            }
+        }
         // Our traversal stack holds MAX_DEPTH entries; refuse a pathological BVH deeper than that.
         let depth = cwbvh_depth(&bvh);
         if depth as usize >= MAX_DEPTH {
@@ -526,7 +768,19 @@ impl SceneGeometry {
 
         // Lay primitives out in leaf order so the traversal indexes them directly.
         let order = &bvh.primitive_indices;
-        let prims: Vec<Prim> = order.iter().map(|&i| prims[i as usize]).collect();
+        let mut others = Vec::new();
+        let tris: Vec<[Vec3; 3]> = order
+            .iter()
+            .map(|&i| match prims[i as usize] {
+                Prim::Triangle(v) => v,
+                p => {
+                    others.push(p);
+                    let marker = Vec3::new(f32::from_bits((others.len() - 1) as u32), 0.0, 0.0);
+                    [Vec3::NAN, marker, Vec3::ZERO]
+                }
+            })
+            .collect();
+        drop(prims);
         let prim_object: Vec<u32> = order.iter().map(|&i| objects[i as usize]).collect();
         let prim_normals: Vec<[u32; 3]> = if any_normals {
             order.iter().map(|&i| prim_normals[i as usize]).collect()
@@ -551,7 +805,8 @@ impl SceneGeometry {
         }
         Ok(SceneGeometry {
             bvh,
-            prims,
+            tris,
+            others,
             prim_object,
             prim_normals,
             normals,
@@ -569,7 +824,7 @@ impl SceneGeometry {
     /// normalized (any finite non-zero vector); `t` is in units of `|dir|`. Returns `None` for
     /// a miss or an invalid ray (non-finite, zero direction).
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
-        if self.prims.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
             return None;
         }
         let pre = RayPre::new(origin, dir);
@@ -582,26 +837,67 @@ impl SceneGeometry {
 
     #[inline(always)]
     fn closest<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> Option<Hit> {
-        let prims = &self.prims[..];
         let mut best = u32::MAX;
         let (mut tbest, mut ba, mut bb) = (t_max, 0.0f32, 0.0f32);
-        traverse(&self.bvh, pre.o, pre.d, t_max, |id, tmax| {
-            // SAFETY: leaf primitive ids index `prims` (same length as the builder's input).
-            let prim = unsafe { prims.get_unchecked(id as usize) };
-            if let Some((t, a, b)) = prim.intersect::<KZ>(pre, tmax) {
-                best = id;
-                (tbest, ba, bb) = (t, a, b);
-                return Some(t);
-            }
-            Some(tmax)
-        });
+        traverse::<true>(
+            &self.bvh,
+            &self.tris,
+            pre.o,
+            pre.d,
+            t_max,
+            |first, count, mut tmax| {
+                for id in first..first + count {
+                    if let Some((t, a, b)) = self.prim_intersect::<KZ>(id, pre, tmax) {
+                        best = id;
+                        (tbest, ba, bb) = (t, a, b);
+                        tmax = t;
+                    }
+                }
+                Some(tmax)
+            },
+        );
         (best != u32::MAX).then(|| self.make_hit(best, pre, tbest, ba, bb))
+    }
+
+    /// Ray test of primitive `id` (a leaf primitive id from the traversal).
+    #[inline(always)]
+    fn prim_intersect<const KZ: usize>(&self, id: u32, pre: &RayPre, t_max: f32) -> Option<PrimT> {
+        debug_assert!((id as usize) < self.tris.len());
+        // SAFETY: leaf primitive ids index `tris` (same length as the builder's input).
+        let v = unsafe { self.tris.get_unchecked(id as usize) };
+        if v[0].x.is_nan() {
+            self.others[v[1].x.to_bits() as usize].intersect::<KZ>(pre, t_max)
+        } else {
+            #[cfg(all(
+                target_arch = "x86_64",
+                target_feature = "avx2",
+                target_feature = "fma"
+            ))]
+            return intersect_triangle_simd::<KZ>(pre, t_max, v);
+            #[cfg(not(all(
+                target_arch = "x86_64",
+                target_feature = "avx2",
+                target_feature = "fma"
+            )))]
+            super::prim::intersect_triangle::<KZ>(pre, t_max, v)
+        }
+    }
+
+    /// Primitive `id`.
+    #[inline]
+    fn prim(&self, id: u32) -> Prim {
+        let v = &self.tris[id as usize];
+        if v[0].x.is_nan() {
+            self.others[v[1].x.to_bits() as usize]
+        } else {
+            Prim::Triangle(*v)
+        }
     }
 
     /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
     /// brute-force tests).
     fn make_hit(&self, prim: u32, pre: &RayPre, t: f32, a: f32, b: f32) -> Hit {
-        let p = &self.prims[prim as usize];
+        let p = self.prim(prim);
         let g = p.hit_geom(pre, t, a, b);
         let mut ns = g.ng;
         if let Some(idx) = self.prim_normals.get(prim as usize) {
@@ -631,7 +927,7 @@ impl SceneGeometry {
     /// True if anything is hit with `t` in `(0, t_max)` (any-hit traversal, for shadow rays).
     /// Same ray conventions as [`SceneGeometry::intersect`].
     pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        if self.prims.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
             return false;
         }
         let pre = RayPre::new(origin, dir);
@@ -644,17 +940,23 @@ impl SceneGeometry {
 
     #[inline(always)]
     fn any_hit<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> bool {
-        let prims = &self.prims[..];
         let mut hit = false;
-        traverse(&self.bvh, pre.o, pre.d, t_max, |id, tmax| {
-            // SAFETY: see `closest`.
-            let prim = unsafe { prims.get_unchecked(id as usize) };
-            if prim.intersect::<KZ>(pre, tmax).is_some() {
-                hit = true;
-                return None;
-            }
-            Some(tmax)
-        });
+        traverse::<false>(
+            &self.bvh,
+            &self.tris,
+            pre.o,
+            pre.d,
+            t_max,
+            |first, count, tmax| {
+                for id in first..first + count {
+                    if self.prim_intersect::<KZ>(id, pre, tmax).is_some() {
+                        hit = true;
+                        return None;
+                    }
+                }
+                Some(tmax)
+            },
+        );
         hit
     }
 
@@ -666,8 +968,8 @@ impl SceneGeometry {
         let pre = RayPre::new(origin, dir);
         let mut tmax = t_max;
         let mut best = None;
-        for (i, p) in self.prims.iter().enumerate() {
-            if let Some((t, a, b)) = p.intersect_dyn(&pre, tmax) {
+        for i in 0..self.tris.len() {
+            if let Some((t, a, b)) = self.prim(i as u32).intersect_dyn(&pre, tmax) {
                 tmax = t;
                 best = Some((i as u32, a, b));
             }
@@ -695,14 +997,14 @@ impl SceneGeometry {
 
     /// Surface area of a primitive (m²).
     pub fn prim_area(&self, prim: u32) -> f32 {
-        self.prims[prim as usize].area()
+        self.prim(prim).area()
     }
 
     /// Uniform by area on the primitive: point, unit front-face geometric normal; the pdf
     /// w.r.t. area is `1 / prim_area(prim)`. `u` ∈ [0,1)². The point's error bound is
     /// [`super::point_error_bound`] (it is computed in f64).
     pub fn sample_prim(&self, prim: u32, u: Vec2) -> SurfacePoint {
-        let (p, n) = self.prims[prim as usize].sample_area(u);
+        let (p, n) = self.prim(prim).sample_area(u);
         SurfacePoint { p, n }
     }
 
@@ -736,8 +1038,8 @@ impl SceneGeometry {
         reference: Vec3,
         u: Vec2,
     ) -> Option<(SurfacePoint, f32)> {
-        let pr = &self.prims[prim as usize];
-        if let Prim::Sphere { center, radius } = *pr {
+        let pr = self.prim(prim);
+        if let Prim::Sphere { center, radius } = pr {
             if let Some((sin2_max, one_minus_cos_max)) =
                 Self::sphere_cone(center, radius, reference)
             {
@@ -802,8 +1104,8 @@ impl SceneGeometry {
     /// The pdf (solid angle at `reference`) that [`SceneGeometry::sample_prim_solid_angle`]
     /// would have given for the direction that hit `prim` at `hit` (0 when it returns `None`).
     pub fn pdf_prim_solid_angle(&self, prim: u32, reference: Vec3, hit: &Hit) -> f32 {
-        let pr = &self.prims[prim as usize];
-        if let Prim::Sphere { center, radius } = *pr {
+        let pr = self.prim(prim);
+        if let Prim::Sphere { center, radius } = pr {
             if let Some((_, one_minus_cos_max)) = Self::sphere_cone(center, radius, reference) {
                 let pdf = (1.0 / (std::f64::consts::TAU * one_minus_cos_max)) as f32;
                 return if pdf.is_finite() { pdf } else { 0.0 };
@@ -815,7 +1117,7 @@ impl SceneGeometry {
     /// Solid angle (sr) subtended by a sphere primitive from outside, if `prim` is one and the
     /// reference is outside it.
     pub fn sphere_solid_angle(&self, prim: u32, reference: Vec3) -> Option<f32> {
-        if let Prim::Sphere { center, radius } = self.prims[prim as usize] {
+        if let Prim::Sphere { center, radius } = self.prim(prim) {
             let (_, omc) = Self::sphere_cone(center, radius, reference)?;
             return Some((std::f64::consts::TAU * omc) as f32);
         }
@@ -828,7 +1130,7 @@ impl SceneGeometry {
     }
 
     pub fn primitive_count(&self) -> usize {
-        self.prims.len()
+        self.tris.len()
     }
 
     /// Depth of the BVH (number of node levels).
@@ -845,7 +1147,8 @@ impl SceneGeometry {
     pub fn memory_bytes(&self) -> usize {
         self.bvh.nodes.capacity() * std::mem::size_of::<CwBvhNode>()
             + self.bvh.primitive_indices.capacity() * 4
-            + self.prims.capacity() * std::mem::size_of::<Prim>()
+            + self.tris.capacity() * std::mem::size_of::<[Vec3; 3]>()
+            + self.others.capacity() * std::mem::size_of::<Prim>()
             + self.prim_object.capacity() * 4
             + self.prim_normals.capacity() * 12
             + self.normals.capacity() * 12
