@@ -235,6 +235,8 @@ impl CausticLights {
 pub struct Splat {
     pub pixel: u32,
     pub xyz: [f64; 3],
+    /// Illuminance (lx) on the surface, for the per-pixel illuminance channel.
+    pub e: f64,
 }
 
 /// Light paths per work item (the unit of parallelism and of the deterministic order).
@@ -243,7 +245,8 @@ const CHUNK: u64 = 4096;
 const CHUNKS_PER_BATCH: u64 = 64;
 
 /// Trace light paths `first .. first + count` of stream `seed`, in parallel on the current
-/// rayon pool, and add their splats to `sums` (per pixel: Σ X, Σ Y, Σ Z, Σ Y²) in path order,
+/// rayon pool, and add their splats to `sums` (per pixel: Σ X, Σ Y, Σ Z, Σ Y², Σ E, Σ E²) in
+/// path order,
 /// so the sums do not depend on the number of threads. None if `stop` was raised meanwhile
 /// (`sums` is then partial).
 pub fn trace_light_paths(
@@ -253,7 +256,7 @@ pub fn trace_light_paths(
     first: u64,
     count: u64,
     stop: &AtomicBool,
-    sums: &mut [[f64; 4]],
+    sums: &mut [[f64; 6]],
 ) -> Option<RayStats> {
     let mut stats = RayStats::default();
     let chunks = count.div_ceil(CHUNK);
@@ -284,6 +287,8 @@ pub fn trace_light_paths(
                 t[1] += s.xyz[1];
                 t[2] += s.xyz[2];
                 t[3] += s.xyz[1] * s.xyz[1];
+                t[4] += s.e;
+                t[5] += s.e * s.e;
             }
         }
     }
@@ -371,41 +376,53 @@ pub fn trace_light_path(
             return;
         }
 
-        // A surface after the first (which scattered specularly): connect to the camera.
-        if depth >= 2 && !material.is_specular() {
+        // A surface after the first (which scattered specularly): connect to the camera, for
+        // the luminance the surface sends toward it (non-specular surfaces) and, with the
+        // per-pixel illuminance on, for the illuminance on it (any surface but an emitter,
+        // on the side the camera sees).
+        let want_l = !material.is_specular();
+        let want_e = settings.illuminance && world.objects[hit.object as usize].light.is_none();
+        if depth >= 2 && (want_l || want_e) {
             if let Some(c) = camera.connect(hit.p, Vec2::new(lx, ly), filter.radius()) {
-                let wi = frame.to_local(c.wi);
-                // Radiance convention: out toward the camera, in from the light.
-                let f = material.eval(wi, wo, &wl);
-                let g = c.wi.dot(hit.ng).abs() * wo_world.dot(hit.ns).abs()
-                    / wo_world.dot(hit.ng).abs();
-                if !f.is_black() && g > 0.0 && g.is_finite() {
+                let cos_cam = c.wi.dot(hit.ng).abs();
+                let mut xyz = [0.0f64; 3];
+                if want_l {
+                    let wi = frame.to_local(c.wi);
+                    // Radiance convention: out toward the camera, in from the light.
+                    let f = material.eval(wi, wo, &wl);
+                    let g = cos_cam * wo_world.dot(hit.ns).abs() / wo_world.dot(hit.ng).abs();
+                    if !f.is_black() && g > 0.0 && g.is_finite() {
+                        xyz = radiance_to_xyz(&(beta * f * (g * c.importance)), &wl);
+                    }
+                }
+                let mut e = 0.0f64;
+                if want_e && c.wi.dot(hit.ng) * wo_world.dot(hit.ng) > 0.0 {
+                    e = radiance_to_xyz(&(beta * (cos_cam * c.importance)), &wl)[1];
+                }
+                if !(xyz.iter().all(|v| v.is_finite()) && e.is_finite()) {
+                    stats.non_finite += 1;
+                } else if xyz[1] != 0.0 || xyz[0] != 0.0 || xyz[2] != 0.0 || e != 0.0 {
                     stats.shadow_rays += 1;
                     let origin = hit.spawn_origin(c.wi);
                     let t_max = (c.lens_point - origin).length();
                     if !world.geometry.occluded(origin, c.wi, t_max) {
-                        let l = beta * f * (g * c.importance);
-                        let xyz = radiance_to_xyz(&l, &wl);
-                        if xyz.iter().all(|v| v.is_finite()) {
-                            let r = filter.radius();
-                            let x0 = ((c.film.x - r).floor() as i64).max(0);
-                            let x1 = ((c.film.x + r).floor() as i64).min(w - 1);
-                            let y0 = ((c.film.y - r).floor() as i64).max(0);
-                            let y1 = ((c.film.y + r).floor() as i64).min(h - 1);
-                            for y in y0..=y1 {
-                                for x in x0..=x1 {
-                                    let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                                    let wgt = filter.density(c.film - centre) as f64;
-                                    if wgt > 0.0 {
-                                        splats.push(Splat {
-                                            pixel: (y * w + x) as u32,
-                                            xyz: xyz.map(|v| v * wgt),
-                                        });
-                                    }
+                        let r = filter.radius();
+                        let x0 = ((c.film.x - r).floor() as i64).max(0);
+                        let x1 = ((c.film.x + r).floor() as i64).min(w - 1);
+                        let y0 = ((c.film.y - r).floor() as i64).max(0);
+                        let y1 = ((c.film.y + r).floor() as i64).min(h - 1);
+                        for y in y0..=y1 {
+                            for x in x0..=x1 {
+                                let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                                let wgt = filter.density(c.film - centre) as f64;
+                                if wgt > 0.0 {
+                                    splats.push(Splat {
+                                        pixel: (y * w + x) as u32,
+                                        xyz: xyz.map(|v| v * wgt),
+                                        e: e * wgt,
+                                    });
                                 }
                             }
-                        } else {
-                            stats.non_finite += 1;
                         }
                     }
                 }

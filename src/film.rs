@@ -83,6 +83,11 @@ pub struct PixelSums {
     pub splat_y2: f64,
     #[serde(default)]
     pub light_paths: u64,
+    /// Σ and Σ² of the light paths' illuminance splats (lx) on the surface this pixel sees.
+    #[serde(default)]
+    pub splat_e: f64,
+    #[serde(default)]
+    pub splat_e2: f64,
 }
 
 impl PixelSums {
@@ -94,15 +99,21 @@ impl PixelSums {
         self.sum_y2 += xyz[1] * xyz[1];
         self.count += 1;
     }
-    /// Add the splats of `paths` light paths (see [`crate::caustics`]): their Σ X, Σ Y, Σ Z
-    /// and Σ Y² on this pixel.
+    /// Add the splats of `paths` light paths (see [`crate::caustics`]): their Σ X, Σ Y, Σ Z,
+    /// Σ Y², Σ E and Σ E² on this pixel.
     #[inline]
-    pub fn add_light_paths(&mut self, sums: &[f64; 4], paths: u64) {
+    pub fn add_light_paths(&mut self, sums: &[f64; 6], paths: u64) {
         for (s, v) in self.splat_xyz.iter_mut().zip(sums) {
             *s += v;
         }
         self.splat_y2 += sums[3];
+        self.splat_e += sums[4];
+        self.splat_e2 += sums[5];
         self.light_paths += paths;
+    }
+    /// Whether light paths added illuminance to this pixel.
+    fn has_e_splats(&self) -> bool {
+        self.light_paths > 0 && (self.splat_e != 0.0 || self.splat_e2 != 0.0)
     }
     /// Record one illuminance sample (lx) of the surface seen by a camera sample.
     #[inline]
@@ -112,12 +123,28 @@ impl PixelSums {
         self.count_e += 1;
     }
     /// Mean illuminance over the samples that saw a receiving surface.
+    ///
+    /// With light-traced caustics, the light paths' splats estimate the pixel's mean of E over
+    /// *all* its footprint (0 where no receiver is seen), so they are added to the camera
+    /// samples' mean over all samples and the sum divided by the coverage.
     pub fn mean_e(&self) -> Option<f64> {
-        (self.count_e > 0).then(|| self.sum_e / self.count_e as f64)
+        if self.count_e == 0 {
+            return None;
+        }
+        if !self.has_e_splats() {
+            return Some(self.sum_e / self.count_e as f64);
+        }
+        let all = self.sum_e / self.count as f64 + self.splat_e / self.light_paths as f64;
+        Some(all / self.e_coverage())
     }
-    /// Standard error of [`Self::mean_e`].
+    /// Standard error of [`Self::mean_e`] (the coverage taken as exact).
     pub fn e_standard_error(&self) -> f64 {
-        standard_error(self.sum_e, self.sum_e2, self.count_e)
+        if !self.has_e_splats() || self.count_e == 0 {
+            return standard_error(self.sum_e, self.sum_e2, self.count_e);
+        }
+        let cam = standard_error(self.sum_e, self.sum_e2, self.count);
+        let light = standard_error(self.splat_e, self.splat_e2, self.light_paths);
+        (cam * cam + light * light).sqrt() / self.e_coverage()
     }
     /// Fraction of the pixel's samples whose illuminance is defined.
     pub fn e_coverage(&self) -> f64 {
@@ -140,6 +167,8 @@ impl PixelSums {
             self.splat_xyz[k] += o.splat_xyz[k];
         }
         self.splat_y2 += o.splat_y2;
+        self.splat_e += o.splat_e;
+        self.splat_e2 += o.splat_e2;
         self.light_paths += o.light_paths;
     }
     /// Mean absolute XYZ: the camera samples' mean plus, with light tracing, the light paths'.

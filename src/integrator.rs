@@ -118,7 +118,8 @@ pub fn trace(
     // Whether the path's first scattering (at the surface the camera sees) was non-specular:
     // with `start.caustics_by_light_tracing`, such paths that reach a light through a
     // specular scattering are light tracing's part (see `crate::caustics`).
-    let mut first_non_specular = false;
+    // (A receiver's path, started at depth 1, begins at that non-specular receiver.)
+    let mut first_non_specular = start.depth >= 1;
 
     loop {
         let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
@@ -299,10 +300,15 @@ fn unoccluded(world: &World, from: &RayStart, ls: &crate::light::LightSample) ->
 /// directly visible emitters; light reflected by the scene arrives through the cosine-sampled
 /// path. The receiver counts as the first scattering event of its paths, so with the same
 /// `max_depth` a Lambertian surface's luminance is exactly ρE/π of this estimate.
+///
+/// With `caustics_by_light_tracing` (the image's per-pixel illuminance when the world traces
+/// caustics from the lights), the paths whose scattering next to the light is specular are
+/// left out: light tracing estimates them (see [`crate::caustics`]).
 pub fn irradiance(
     world: &World,
     at: &RayStart,
     n: Vec3,
+    caustics_by_light_tracing: bool,
     wl: &mut SampledWavelengths,
     sampler: &mut Sampler,
     stats: &mut RayStats,
@@ -341,7 +347,7 @@ pub fn irradiance(
                 pdf: local.z * FRAC_1_PI,
                 p: at.p,
                 depth: 1,
-                caustics_by_light_tracing: false,
+                caustics_by_light_tracing,
             };
             // cos θ / pdf = π.
             e += trace(world, origin, wi, start, wl, sampler, stats) * PI;

@@ -104,6 +104,7 @@ fn sample_meter(world: &World, kind: &MeterKind, stream: u64, s: u64, stats: &mu
                 world,
                 &RayStart::free(*position),
                 *normal,
+                false,
                 &mut wl,
                 &mut sampler,
                 stats,

@@ -106,7 +106,9 @@ fn surface_illuminance(
     let mut sampler = Sampler::new(world.settings.seed ^ ILLUMINANCE_STREAM, pixel, sample);
     let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
     let at = crate::integrator::RayStart::surface(&hit);
-    let e = crate::integrator::irradiance(world, &at, n, &mut wl, &mut sampler, stats);
+    let light_traced = world.caustics.is_some();
+    let e =
+        crate::integrator::irradiance(world, &at, n, light_traced, &mut wl, &mut sampler, stats);
     let lux = radiance_to_xyz(&e, &wl)[1];
     if lux.is_finite() {
         Some(lux)
@@ -383,7 +385,7 @@ pub fn render_progressive(
             for (b, &stream) in streams.iter().enumerate() {
                 let first = film.light_paths[b];
                 let seed = world.settings.seed ^ stream;
-                let mut sums = vec![[0.0f64; 4]; w * h];
+                let mut sums = vec![[0.0f64; 6]; w * h];
                 let traced = pool.install(|| {
                     crate::caustics::trace_light_paths(
                         world, caustics, seed, first, per_buffer, stop, &mut sums,

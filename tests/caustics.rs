@@ -224,3 +224,43 @@ fn light_traced_image_does_not_depend_on_the_thread_count() {
     assert!(a.light_paths[0] > 0);
     assert_eq!(a, b);
 }
+
+/// The per-pixel illuminance channel gets the light-traced caustic too: E = direct + mirror
+/// image, and L = ρE/π on the Lambertian floor.
+#[test]
+fn illuminance_channel_includes_the_light_traced_caustic() {
+    let text = mirror_scene("Box").replace("filter: Box,", "filter: Box, illuminance: true,");
+    let w = world_with(&text, Caustics::LightTracing);
+    assert!(w.settings.illuminance && w.caustics.is_some());
+    let film = render(&w, 2);
+    let (mut sum, mut sum_exp, mut var) = (0.0, 0.0, 0.0);
+    for y in 0..film.height {
+        for x in 0..film.width {
+            let p = &film.pixels[y * film.width + x];
+            let e = p.mean_e().expect("every pixel sees the floor");
+            let se = p.e_standard_error();
+            let expected = expected(&w, x, y, true) * PI / RHO;
+            assert!(
+                (e - expected).abs() <= 5.0 * se,
+                "pixel ({x}, {y}): E = {e} ± {se} lx, expected {expected}"
+            );
+            // The luminance and the illuminance see the same light.
+            let l = p.mean_xyz()[1];
+            let sl = p.y_standard_error();
+            assert!(
+                (l - RHO / PI * e).abs() <= 5.0 * (sl + RHO / PI * se),
+                "pixel ({x}, {y}): L = {l}, ρE/π = {}",
+                RHO / PI * e
+            );
+            sum += e;
+            sum_exp += expected;
+            var += se * se;
+        }
+    }
+    let n = film.pixels.len() as f64;
+    let (m, e, se) = (sum / n, sum_exp / n, var.sqrt() / n);
+    assert!(
+        (m - e).abs() <= 4.0 * se && se < 0.01 * e,
+        "mean E = {m} ± {se} lx, expected {e}"
+    );
+}
