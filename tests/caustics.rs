@@ -91,19 +91,24 @@ fn expected(w: &World, x: usize, y: usize, with_mirror: bool) -> f64 {
     RHO / PI * floor_footprint_mean(w, x, y, e)
 }
 
-fn check_pixels(w: &World, film: &Film, with_mirror: bool, label: &str) {
+/// Every pixel's value (mean, standard error) within 5σ of `expected(x, y)`, and the image
+/// mean within 4σ with a standard error below 1 %.
+fn check_pixels(
+    film: &Film,
+    label: &str,
+    value: impl Fn(&candela::film::PixelSums) -> (f64, f64),
+    expected: impl Fn(usize, usize) -> f64,
+) {
     let (mut sum, mut sum_exp, mut var) = (0.0, 0.0, 0.0);
     for y in 0..film.height {
         for x in 0..film.width {
-            let p = &film.pixels[y * film.width + x];
-            let l = p.mean_xyz()[1];
-            let se = p.y_standard_error();
-            let e = expected(w, x, y, with_mirror);
+            let (v, se) = value(&film.pixels[y * film.width + x]);
+            let e = expected(x, y);
             assert!(
-                (l - e).abs() <= 5.0 * se,
-                "{label}, pixel ({x}, {y}): L = {l} ± {se} cd/m², expected {e}"
+                (v - e).abs() <= 5.0 * se,
+                "{label}, pixel ({x}, {y}): {v} ± {se}, expected {e}"
             );
-            sum += l;
+            sum += v;
             sum_exp += e;
             var += se * se;
         }
@@ -112,8 +117,12 @@ fn check_pixels(w: &World, film: &Film, with_mirror: bool, label: &str) {
     let (m, e, se) = (sum / n, sum_exp / n, var.sqrt() / n);
     assert!(
         (m - e).abs() <= 4.0 * se && se < 0.01 * e,
-        "{label}: mean L = {m} ± {se} cd/m², expected {e}"
+        "{label}: mean {m} ± {se}, expected {e}"
     );
+}
+
+fn luminance(p: &candela::film::PixelSums) -> (f64, f64) {
+    (p.mean_xyz()[1], p.y_standard_error())
 }
 
 #[test]
@@ -126,7 +135,7 @@ fn point_light_caustic_of_a_mirror_follows_the_image_source_law() {
         let w = world_with(&mirror_scene(filter), Caustics::LightTracing);
         assert!(w.caustics.is_some());
         let film = render(&w, 2);
-        check_pixels(&w, &film, true, filter);
+        check_pixels(&film, filter, luminance, |x, y| expected(&w, x, y, true));
         // The mirrored light is a sizeable part of the answer, so the check can fail.
         let direct = expected(&w, 8, 8, false);
         assert!(expected(&w, 8, 8, true) > 1.05 * direct);
@@ -140,7 +149,9 @@ fn path_tracing_cannot_see_a_point_light_through_a_mirror() {
     let w = world_with(&mirror_scene("Box"), Caustics::PathTracing);
     assert!(w.caustics.is_none());
     let film = render(&w, 2);
-    check_pixels(&w, &film, false, "path tracing");
+    check_pixels(&film, "path tracing", luminance, |x, y| {
+        expected(&w, x, y, false)
+    });
 }
 
 /// An area light above a glass sphere over a Lambertian floor; the camera sees the floor with
@@ -233,34 +244,22 @@ fn illuminance_channel_includes_the_light_traced_caustic() {
     let w = world_with(&text, Caustics::LightTracing);
     assert!(w.settings.illuminance && w.caustics.is_some());
     let film = render(&w, 2);
-    let (mut sum, mut sum_exp, mut var) = (0.0, 0.0, 0.0);
-    for y in 0..film.height {
-        for x in 0..film.width {
-            let p = &film.pixels[y * film.width + x];
-            let e = p.mean_e().expect("every pixel sees the floor");
-            let se = p.e_standard_error();
-            let expected = expected(&w, x, y, true) * PI / RHO;
-            assert!(
-                (e - expected).abs() <= 5.0 * se,
-                "pixel ({x}, {y}): E = {e} ± {se} lx, expected {expected}"
-            );
-            // The luminance and the illuminance see the same light.
-            let l = p.mean_xyz()[1];
-            let sl = p.y_standard_error();
-            assert!(
-                (l - RHO / PI * e).abs() <= 5.0 * (sl + RHO / PI * se),
-                "pixel ({x}, {y}): L = {l}, ρE/π = {}",
-                RHO / PI * e
-            );
-            sum += e;
-            sum_exp += expected;
-            var += se * se;
-        }
+    let illuminance = |p: &candela::film::PixelSums| {
+        (
+            p.mean_e().expect("every pixel sees the floor"),
+            p.e_standard_error(),
+        )
+    };
+    check_pixels(&film, "E", illuminance, |x, y| {
+        expected(&w, x, y, true) * PI / RHO
+    });
+    // The luminance and the illuminance see the same light.
+    for p in &film.pixels {
+        let ((l, sl), (e, se)) = (luminance(p), illuminance(p));
+        assert!(
+            (l - RHO / PI * e).abs() <= 5.0 * (sl + RHO / PI * se),
+            "L = {l}, ρE/π = {}",
+            RHO / PI * e
+        );
     }
-    let n = film.pixels.len() as f64;
-    let (m, e, se) = (sum / n, sum_exp / n, var.sqrt() / n);
-    assert!(
-        (m - e).abs() <= 4.0 * se && se < 0.01 * e,
-        "mean E = {m} ± {se} lx, expected {e}"
-    );
 }
