@@ -216,8 +216,7 @@ impl Camera {
             };
         }
         let focus = self.position + dir * (self.focus_distance / dir.dot(self.forward));
-        let d = concentric_disk(u_lens) * self.lens_radius;
-        let origin = self.position + d.x * self.right + d.y * self.up;
+        let origin = self.lens_point(u_lens);
         CameraRay {
             origin,
             dir: (focus - origin).normalize(),
@@ -248,16 +247,21 @@ pub struct CameraConnection {
 }
 
 impl Camera {
+    /// The point of the lens for lens sample `u_lens` ∈ [0,1)² (the pinhole for a pinhole
+    /// camera).
+    fn lens_point(&self, u_lens: Vec2) -> Vec3 {
+        if self.lens_radius <= 0.0 {
+            return self.position;
+        }
+        let d = concentric_disk(u_lens) * self.lens_radius;
+        self.position + d.x * self.right + d.y * self.up
+    }
+
     /// Connect scene point `p` to the camera through lens point `u_lens` ∈ [0,1)²: None if
     /// the point is behind the camera or outside the film (farther than `margin` pixels from
     /// its edge: the reconstruction filter's radius).
     pub fn connect(&self, p: Vec3, u_lens: Vec2, margin: f32) -> Option<CameraConnection> {
-        let lens_point = if self.lens_radius > 0.0 {
-            let d = concentric_disk(u_lens) * self.lens_radius;
-            self.position + d.x * self.right + d.y * self.up
-        } else {
-            self.position
-        };
+        let lens_point = self.lens_point(u_lens);
         let v = p - lens_point;
         let z = v.dot(self.forward);
         let dist = v.length();

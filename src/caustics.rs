@@ -143,16 +143,7 @@ impl CausticLights {
         if chosen.is_empty() {
             return None;
         }
-        let total: f64 = powers.iter().sum();
-        let mut acc = 0.0;
-        let mut cdf: Vec<f32> = powers
-            .iter()
-            .map(|p| {
-                acc += p / total;
-                acc as f32
-            })
-            .collect();
-        *cdf.last_mut().unwrap() = 1.0;
+        let cdf = crate::light::cdf_from_weights(&powers);
         let mut handled = vec![false; lights.len()];
         for &i in &chosen {
             handled[i as usize] = true;
@@ -246,8 +237,7 @@ const CHUNKS_PER_BATCH: u64 = 64;
 
 /// Trace light paths `first .. first + count` of stream `seed`, in parallel on the current
 /// rayon pool, and add their splats to `sums` (per pixel: Σ X, Σ Y, Σ Z, Σ Y², Σ E, Σ E²) in
-/// path order,
-/// so the sums do not depend on the number of threads. None if `stop` was raised meanwhile
+/// path order, so the sums do not depend on the number of threads. None if `stop` was raised meanwhile
 /// (`sums` is then partial).
 pub fn trace_light_paths(
     world: &World,
@@ -363,7 +353,8 @@ pub fn trace_light_path(
         let Some(hit) = world.geometry.intersect(ray_o, ray_d, f32::INFINITY) else {
             return;
         };
-        let material = &world.materials[world.objects[hit.object as usize].material as usize];
+        let object = world.objects[hit.object as usize];
+        let material = &world.materials[object.material as usize];
         if material.is_black() {
             return;
         }
@@ -381,7 +372,7 @@ pub fn trace_light_path(
         // per-pixel illuminance on, for the illuminance on it (any surface but an emitter,
         // on the side the camera sees).
         let want_l = !material.is_specular();
-        let want_e = settings.illuminance && world.objects[hit.object as usize].light.is_none();
+        let want_e = settings.illuminance && object.light.is_none();
         if depth >= 2 && (want_l || want_e) {
             if let Some(c) = camera.connect(hit.p, Vec2::new(lx, ly), filter.radius()) {
                 let cos_cam = c.wi.dot(hit.ng).abs();

@@ -13,9 +13,9 @@
 //! table cell ([`crate::luminaire::Distribution::sample`]); the light sampler chooses between
 //! lights by their integrated lumens.
 
-use super::{luminous_integral, LightSample};
+use super::luminous_integral;
 use crate::luminaire::Distribution;
-use crate::spectrum::{DenseSpectrum, SampledWavelengths};
+use crate::spectrum::DenseSpectrum;
 use glam::{Mat3, Vec2, Vec3};
 use std::sync::Arc;
 
@@ -44,23 +44,6 @@ impl Goniometric {
     /// Total luminous flux, lm.
     pub fn power_lm(&self) -> f64 {
         self.distribution.lumens() * luminous_integral(&self.spectrum)
-    }
-
-    /// The (single) direction from `p` toward the light with li = I_e(ω)/d².
-    pub fn sample_li(&self, p: Vec3, wl: &SampledWavelengths) -> Option<LightSample> {
-        let (wi, dist, dist2) = super::toward(self.position, p)?;
-        let cd = self.table_candela(-wi) as f32;
-        if cd <= 0.0 || !cd.is_finite() {
-            return None;
-        }
-        Some(LightSample {
-            wi,
-            li: self.spectrum.sample(wl) * (cd / dist2),
-            pdf: 1.0,
-            dist,
-            point: None,
-            delta: true,
-        })
     }
 
     /// Emission direction (world) sampled by the intensity distribution, its density per

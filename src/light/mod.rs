@@ -245,42 +245,10 @@ impl Light {
         wl: &SampledWavelengths,
     ) -> Option<LightSample> {
         match self {
-            Light::Point {
-                position,
-                intensity,
-            } => {
-                let (wi, dist, dist2) = toward(*position, p)?;
-                Some(LightSample {
-                    wi,
-                    li: intensity.sample(wl) / dist2,
-                    pdf: 1.0,
-                    dist,
-                    point: None,
-                    delta: true,
-                })
+            Light::Point { position, .. } | Light::Spot { position, .. } => {
+                self.sample_li_from(*position, p, wl)
             }
-            Light::Spot {
-                position,
-                frame,
-                cos_inner,
-                cos_outer,
-                intensity,
-            } => {
-                let (wi, dist, dist2) = toward(*position, p)?;
-                let cos_theta = (-wi).dot(frame.n);
-                let falloff = smoothstep(*cos_outer, *cos_inner, cos_theta);
-                if falloff <= 0.0 {
-                    return None;
-                }
-                Some(LightSample {
-                    wi,
-                    li: intensity.sample(wl) * (falloff / dist2),
-                    pdf: 1.0,
-                    dist,
-                    point: None,
-                    delta: true,
-                })
-            }
+            Light::Goniometric(g) => self.sample_li_from(g.position, p, wl),
             Light::Distant {
                 to_light,
                 irradiance,
@@ -332,8 +300,35 @@ impl Light {
                     delta: false,
                 })
             }
-            Light::Goniometric(g) => g.sample_li(p, wl),
         }
+    }
+
+    /// The single direction from `p` toward a point-like source at `position`, with
+    /// li = I_e(ω)/d² (None if the source sends nothing toward `p`).
+    fn sample_li_from(
+        &self,
+        position: Vec3,
+        p: Vec3,
+        wl: &SampledWavelengths,
+    ) -> Option<LightSample> {
+        let (wi, dist, dist2) = toward(position, p)?;
+        let at = EmissionPoint {
+            p: position,
+            n: None,
+            inv_pdf: 1.0,
+        };
+        let intensity = self.emission_toward(&at, -wi, wl);
+        if intensity.is_black() {
+            return None;
+        }
+        Some(LightSample {
+            wi,
+            li: intensity / dist2,
+            pdf: 1.0,
+            dist,
+            point: None,
+            delta: true,
+        })
     }
 
     /// Density (solid angle, excluding light selection) with which `sample_li` from `p` would
@@ -393,6 +388,24 @@ pub(crate) fn toward(position: Vec3, p: Vec3) -> Option<(Vec3, f32, f32)> {
     }
     let dist = dist2.sqrt();
     Some((d / dist, dist, dist2))
+}
+
+/// The cumulative distribution (last entry exactly 1) of non-negative weights with a positive,
+/// finite sum, accumulated in f64.
+pub fn cdf_from_weights(weights: &[f64]) -> Vec<f32> {
+    let total: f64 = weights.iter().sum();
+    let mut acc = 0.0;
+    let mut cdf: Vec<f32> = weights
+        .iter()
+        .map(|w| {
+            acc += w / total;
+            acc as f32
+        })
+        .collect();
+    if let Some(last) = cdf.last_mut() {
+        *last = 1.0;
+    }
+    cdf
 }
 
 /// Choose an index from a cumulative distribution (last entry 1); returns it and its probability.

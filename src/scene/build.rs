@@ -33,8 +33,9 @@ pub struct Overrides {
 pub const MAX_PIXELS: u64 = 1 << 28;
 
 /// Peak memory of a render per pixel: the tiles' pixel sums and the film (both alive while the
-/// film is assembled), a pass's light-path sums (32 B), plus the EXR and PNG buffers.
-const BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<crate::film::PixelSums>() as u64 + 64;
+/// film is assembled), a pass's light-path sums (48 B for each of up to two buffers), plus the
+/// EXR and PNG buffers (32 B).
+const BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<crate::film::PixelSums>() as u64 + 2 * 48 + 32;
 
 /// Memory this process may still allocate (Linux: MemAvailable and the cgroup limit), if known.
 fn available_memory() -> Option<u64> {
@@ -599,15 +600,7 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         let k = photometric_scale(&s, luminance)
             .map_err(|m| ctx.err(format!("{field}.emission.spectrum"), m))?;
         representable(&ctx, &afield, &s, k)?;
-        let mut cdf = Vec::with_capacity(areas.len());
-        let mut acc = 0.0;
-        for a in &areas {
-            acc += a / total;
-            cdf.push(acc as f32);
-        }
-        if let Some(last) = cdf.last_mut() {
-            *last = 1.0;
-        }
+        let cdf = crate::light::cdf_from_weights(&areas);
         objects[object as usize].light = Some(lights.len() as u32);
         lights.push(Light::Area {
             object,
