@@ -174,7 +174,7 @@ mod tests {
             assert_eq!(v, b.get1d());
         }
         assert_eq!(a.get1d(), b.get1d());
-        // Deep dimensions (past one scramble's 256) too.
+        // Deep dimensions too (every set has its own scramble).
         for _ in 0..300 {
             b.get1d();
         }
