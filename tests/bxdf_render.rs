@@ -61,6 +61,92 @@ fn white_furnace_rough_materials_gain_nothing() {
     }
 }
 
+/// Unpolarised Fresnel reflectance of a smooth dielectric (relative index `eta`) at incidence
+/// cosine `cos_i` (from outside), written out here independently of the renderer's.
+fn fresnel_unpolarised(cos_i: f64, eta: f64) -> f64 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+#[test]
+fn glass_sphere_truncated_furnace() {
+    // A smooth glass sphere (η = 1.5) in a uniform environment of luminance 1 cd/m², with the
+    // path length capped. A ray meeting a sphere at incidence θ meets it at the same internal
+    // angle at every later crossing, and R(θ) inside equals R(θ) outside, so after at most N
+    // scattering events the camera sees exactly L_N = R + T² Σ_{j=0}^{N−2} Rʲ (T = 1 − R).
+    // This checks the Fresnel weights of every bounce; the untruncated furnace cannot (any R
+    // sums to R + T²/(1 − R) = 1). Each pixel's expectation is a 16×16 quadrature over its box
+    // footprint. The check is on the sum over all pixels: near the silhouette the samples that
+    // end inside the sphere are rare (probability T·R² ≈ 0.5 % at depth 3), and a pixel that
+    // drew none of them reports a standard error that does not cover them.
+    let res = 24;
+    for depth in [1u32, 2, 3, 6] {
+        let w = world(&format!(
+            r#"(
+            camera: (position: (0.3, 0.2, -3.0), look_at: (0, 0, 0), vfov_deg: 45, resolution: ({res}, {res})),
+            render: (spp: 256, max_depth: {depth}, rr_depth: 1000),
+            materials: {{ "glass": Dielectric(ior: Constant(1.5)) }},
+            objects: [(shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass")],
+            lights: [Environment(spectrum: Named("E"), amount: Luminance(1.0))],
+        )"#
+        ));
+        let film = render(&w, 2);
+        let expected_ray = |o: Vec3, d: Vec3| -> f64 {
+            let (o, d) = (o.as_dvec3(), d.as_dvec3().normalize());
+            let b2 = o.cross(d).length_squared();
+            if o.dot(d) >= 0.0 || b2 >= 1.0 {
+                return 1.0;
+            }
+            let r = fresnel_unpolarised((1.0 - b2).sqrt(), 1.5);
+            let t = 1.0 - r;
+            r + (0..depth as i32 - 1)
+                .map(|j| t * t * r.powi(j))
+                .sum::<f64>()
+        };
+        let (mut sum_d, mut var_d, mut sum_e) = (0.0, 0.0, 0.0);
+        for y in 0..res {
+            for x in 0..res {
+                let n = 16;
+                let mut e = 0.0;
+                for j in 0..n {
+                    for i in 0..n {
+                        let r = w.camera.generate_ray(
+                            x as f32 + (i as f32 + 0.5) / n as f32,
+                            y as f32 + (j as f32 + 0.5) / n as f32,
+                            Vec2::ZERO,
+                        );
+                        e += expected_ray(r.origin, r.dir);
+                    }
+                }
+                e /= (n * n) as f64;
+                let p = &film.pixels[y * res + x];
+                let (v, se) = (p.mean_xyz()[1], p.y_standard_error());
+                sum_d += v - e;
+                var_d += se * se;
+                sum_e += e;
+            }
+        }
+        let n = (res * res) as f64;
+        let z = sum_d / var_d.sqrt();
+        println!(
+            "depth {depth}: image mean {:.5} ± {:.5}, expected {:.5} (z = {z:.2})",
+            (sum_e + sum_d) / n,
+            var_d.sqrt() / n,
+            sum_e / n
+        );
+        assert!(
+            z.abs() < 4.0,
+            "depth {depth}: image mean {} ± {}, expected {}",
+            (sum_e + sum_d) / n,
+            var_d.sqrt() / n,
+            sum_e / n
+        );
+    }
+}
+
 /// Follow a ray through the prism scene at one wavelength, always refracting.
 fn deviation_deg(lambda: f32) -> f32 {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/prism.ron");

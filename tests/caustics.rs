@@ -263,3 +263,55 @@ fn illuminance_channel_includes_the_light_traced_caustic() {
         );
     }
 }
+
+#[test]
+fn glass_sphere_in_an_emitting_furnace_is_invisible_to_both_estimators() {
+    // A lossless glass sphere inside a closed Lambertian enclosure (ρ = 0.5) that emits 1 cd/m²
+    // on its inside: in equilibrium every ray sees L = Lₑ/(1 − ρ) = 2 cd/m², through the glass
+    // or not. Here light reaches the walls through the sphere (L S S D, owned by light
+    // tracing in the default mode) as much as directly, so a wrong weight on either side of
+    // the split between light paths and camera paths, or a path counted twice or dropped,
+    // moves the image away from 2. The camera sees the sphere and the walls around it.
+    let text = r#"(
+        camera: (position: (0.0, 0.3, -2.5), look_at: (0, 0, 0), vfov_deg: 60, resolution: (16, 16)),
+        render: (spp: 1024, max_depth: 200, light_paths_per_sample: 1),
+        materials: { "wall": Diffuse(reflectance: Constant(0.5)), "glass": Dielectric(ior: Constant(1.5)) },
+        objects: [
+            (shape: Sphere(center: (0, 0, 0), radius: 3), material: "wall",
+             emission: (spectrum: Named("E"), amount: Luminance(1.0), two_sided: true)),
+            (shape: Sphere(center: (0.2, 0, 0), radius: 1), material: "glass"),
+        ],
+    )"#;
+    for mode in [Caustics::LightTracing, Caustics::PathTracing] {
+        let w = world_with(text, mode);
+        let film = render(&w, 2);
+        assert!(film.light_paths.iter().sum::<u64>() > 0 || mode == Caustics::PathTracing);
+        // Pixels whose centre ray meets the glass, and the others.
+        let mut groups = [(0.0, 0.0, 0usize); 2];
+        for y in 0..16 {
+            for x in 0..16 {
+                let r = w
+                    .camera
+                    .generate_ray(x as f32 + 0.5, y as f32 + 0.5, glam::Vec2::ZERO);
+                let glass = w
+                    .geometry
+                    .intersect(r.origin, r.dir, f32::INFINITY)
+                    .is_some_and(|h| (h.p - Vec3::new(0.2, 0.0, 0.0)).length() < 1.001);
+                let (v, se) = luminance(&film.pixels[y * 16 + x]);
+                let g = &mut groups[glass as usize];
+                g.0 += v;
+                g.1 += se * se;
+                g.2 += 1;
+            }
+        }
+        for (name, (sum, var, n)) in ["walls", "through the glass"].iter().zip(groups) {
+            let (m, se) = (sum / n as f64, var.sqrt() / n as f64);
+            println!("{mode:?}, {name} ({n} pixels): {m:.5} ± {se:.5} cd/m²");
+            assert!(n > 20, "{name}: only {n} pixels");
+            assert!(
+                (m - 2.0).abs() <= 4.0 * se && se < 0.005,
+                "{mode:?}, {name}: {m} ± {se} cd/m², expected 2"
+            );
+        }
+    }
+}
