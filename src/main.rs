@@ -297,7 +297,7 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
         let st = candela::state::RenderState::load(&state_path)?;
         if st.scene_hash != hash || st.seed != world.settings.seed {
             bail!(
-                "cannot resume from {}: the scene file {} or its settings (seed, max depth, resolution, illuminance, caustics) changed since the state was written",
+                "cannot resume from {}: the scene file {}, a file it refers to (mesh, spectrum, luminaire data) or its settings (seed, max depth, resolution, illuminance, caustics) changed since the state was written",
                 state_path.display(),
                 scene_path.display()
             );

@@ -28,13 +28,29 @@ pub struct RenderState {
     pub film: Film,
 }
 
-/// Hash of the scene text and the estimator's settings (seed excluded: merging combines seeds).
+/// Hash of the scene text, the contents of every file it refers to ([`World::sources`]) and the
+/// estimator's settings (seed excluded: merging combines seeds). A referenced file that can no
+/// longer be read hashes as its path alone, so the state then no longer matches.
 pub fn scene_hash(scene_text: &[u8], world: &World) -> u64 {
+    let eat = |h: &mut u64, bytes: &[u8]| {
+        for chunk in bytes.chunks(8) {
+            let mut b = [0u8; 8];
+            b[..chunk.len()].copy_from_slice(chunk);
+            *h = mix64(*h ^ u64::from_le_bytes(b));
+        }
+    };
     let mut h = 0x0063_616e_6465_6c61_u64;
-    for chunk in scene_text.chunks(8) {
-        let mut b = [0u8; 8];
-        b[..chunk.len()].copy_from_slice(chunk);
-        h = mix64(h ^ u64::from_le_bytes(b));
+    eat(&mut h, scene_text);
+    // (A scene without referenced files hashes as before they were included.)
+    for source in &world.sources {
+        eat(&mut h, source.to_string_lossy().as_bytes());
+        match std::fs::read(source) {
+            Ok(bytes) => {
+                eat(&mut h, &bytes);
+                h = mix64(h ^ bytes.len() as u64);
+            }
+            Err(_) => h = mix64(h ^ 0xdead),
+        }
     }
     h = mix64(h ^ world.settings.max_depth as u64);
     h = mix64(h ^ world.settings.rr_depth as u64);

@@ -80,4 +80,7 @@ pub struct World {
     pub measure: crate::meter::MeasureSettings,
     /// Light tracing of caustics, when on and useful (see [`crate::caustics`]).
     pub caustics: Option<crate::caustics::CausticLights>,
+    /// The files the scene refers to (meshes, spectra, luminaire data, …), as resolved when it
+    /// was built; a render state's scene hash covers their contents.
+    pub sources: Vec<std::path::PathBuf>,
 }

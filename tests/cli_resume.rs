@@ -116,6 +116,58 @@ fn sigint_checkpoint_then_resume_matches_uninterrupted() {
 }
 
 #[test]
+fn a_changed_referenced_file_is_refused_on_resume() {
+    // The scene text stays the same; the spectrum file it refers to changes.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = SCENE
+        .replace("spp: 512", "spp: 4")
+        .replace("Constant(0.7)", "Csv(\"wall.csv\")");
+    std::fs::write(dir.path().join("s.ron"), scene).unwrap();
+    std::fs::write(dir.path().join("wall.csv"), "nm,value\n360,0.7\n830,0.7\n").unwrap();
+    let args = [
+        "render",
+        "--quiet",
+        "--checkpoint-interval",
+        "1ms",
+        "--out",
+        "r",
+        "s.ron",
+    ];
+    let first = candela(dir.path(), &args);
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    assert!(dir.path().join("r.state").exists());
+    let resume = [
+        "render",
+        "--quiet",
+        "--resume",
+        "--max-spp",
+        "8",
+        "--out",
+        "r",
+        "s.ron",
+    ];
+    // Unchanged: the state is accepted.
+    let same = candela(dir.path(), &resume);
+    assert!(
+        same.status.success(),
+        "{}",
+        String::from_utf8_lossy(&same.stderr)
+    );
+    std::fs::write(dir.path().join("wall.csv"), "nm,value\n360,0.6\n830,0.6\n").unwrap();
+    let refused = candela(dir.path(), &resume);
+    assert_eq!(refused.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        err.contains("changed") && err.contains("refers to"),
+        "{err}"
+    );
+}
+
+#[test]
 fn merge_combines_two_seeds() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(

@@ -68,6 +68,8 @@ pub fn load_world(path: &Path, overrides: &Overrides) -> Result<World, SceneErro
 struct Ctx<'a> {
     path: &'a Path,
     dir: PathBuf,
+    /// Every file the scene refers to, in the order first resolved (see [`World::sources`]).
+    sources: std::cell::RefCell<Vec<PathBuf>>,
 }
 
 impl Ctx<'_> {
@@ -105,7 +107,12 @@ impl Ctx<'_> {
         Ok(Vec3::from_array(v))
     }
     fn resolve(&self, rel: &str) -> PathBuf {
-        self.dir.join(rel)
+        let p = self.dir.join(rel);
+        let mut sources = self.sources.borrow_mut();
+        if !sources.contains(&p) {
+            sources.push(p.clone());
+        }
+        p
     }
 }
 
@@ -355,6 +362,7 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
     let ctx = Ctx {
         path,
         dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        sources: Default::default(),
     };
 
     // Camera.
@@ -641,6 +649,7 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         grids,
         measure,
         caustics,
+        sources: ctx.sources.into_inner(),
     })
 }
 
