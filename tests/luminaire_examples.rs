@@ -256,4 +256,16 @@ fn luminaire_command_reports_and_draws() {
     let red = img.pixels().filter(|p| p[0] > 180 && p[1] < 80).count();
     let blue = img.pixels().filter(|p| p[2] > 180 && p[0] < 80).count();
     assert!(red > 100 && blue > 100, "red {red}, blue {blue}");
+    // The peak, 5000 cd at nadir, is the outer ring (5 rings of 1000 cd over 320 px): the curves
+    // end 320 px below the centre (400, 410), and no curve pixel lies below that on the axis.
+    let coloured = |x: u32, y: u32| {
+        let p = img.get_pixel(x, y);
+        (p[0] > 150 && p[1] < 120) || (p[2] > 150 && p[0] < 120)
+    };
+    let tip = (396..=404).any(|x| (726..=734).any(|y| coloured(x, y)));
+    let beyond = (396..=404).any(|x| (738..780).any(|y| coloured(x, y)));
+    assert!(
+        tip && !beyond,
+        "nadir tip drawn: {tip}, beyond the peak: {beyond}"
+    );
 }
