@@ -65,7 +65,8 @@ pub fn render_pixel(
             stats,
         );
         if world.settings.illuminance {
-            if let Some(e) = surface_illuminance(world, ray.origin, ray.dir, pixel, s, stats) {
+            if let Some(e) = surface_illuminance(world, seed, ray.origin, ray.dir, pixel, s, stats)
+            {
                 sums.add_illuminance(e);
             }
         }
@@ -83,9 +84,11 @@ pub fn render_pixel(
 const ILLUMINANCE_STREAM: u64 = 0x11_1c_e5_7a_u64 << 20;
 
 /// Illuminance (lx) on the surface a camera ray sees, or None if it sees no receiving surface
-/// (nothing, the sky, or an emitter).
+/// (nothing, the sky, or an emitter). `seed` is the buffer's stream (the decision buffer of
+/// adaptive mode has its own), so each buffer's illuminance samples are independent.
 fn surface_illuminance(
     world: &World,
+    seed: u64,
     origin: glam::Vec3,
     dir: glam::Vec3,
     pixel: u64,
@@ -103,7 +106,7 @@ fn surface_illuminance(
     } else {
         hit.ng
     };
-    let mut sampler = Sampler::new(world.settings.seed ^ ILLUMINANCE_STREAM, pixel, sample);
+    let mut sampler = Sampler::new(seed ^ ILLUMINANCE_STREAM, pixel, sample);
     let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
     let at = crate::integrator::RayStart::surface(&hit);
     let light_traced = world.caustics.is_some();

@@ -136,3 +136,44 @@ fn corrupt_state_file_is_an_error() {
         .to_string();
     assert!(e.contains("bad.state"), "{e}");
 }
+
+#[test]
+fn adaptive_buffers_have_independent_illuminance_samples() {
+    // The decision buffer decides when a pixel stops; if its illuminance samples repeated the
+    // image's, the stopping time would depend on the image's own estimate (biased). A floor
+    // under a sky: every sample's illuminance estimate is random.
+    let w = world(
+        r#"(
+        camera: (position: (0, 1, -1), look_at: (0, 0, 0), vfov_deg: 40, resolution: (6, 6)),
+        render: (spp: 16, illuminance: true),
+        materials: { "floor": Diffuse(reflectance: Constant(0.5)) },
+        objects: [(shape: Quad(origin: (-5, 0, -5), edge_u: (0, 0, 10), edge_v: (10, 0, 0)), material: "floor")],
+        lights: [Environment(spectrum: Named("D65"), amount: Luminance(1000.0)),
+                 Point(position: (0.3, 0.5, 0.2), spectrum: Named("A"), amount: Intensity(50.0))],
+    )"#,
+    );
+    let mut film = Film::new_adaptive(6, 6);
+    let prog = Progressive {
+        max_spp: 64,
+        target: Some(TargetError {
+            relative: 1e-4,
+            fraction: 1.0,
+            floor_cd_m2: None,
+        }),
+        ..Default::default()
+    };
+    run(&w, &mut film, &prog, None);
+    let d = film.decision.as_ref().unwrap();
+    let (mut both, mut differ) = (0, 0);
+    for (a, b) in film.pixels.iter().zip(d) {
+        assert_eq!(a.count_e, b.count_e);
+        if a.count_e > 0 {
+            both += 1;
+            differ += (a.sum_e != b.sum_e) as usize;
+        }
+    }
+    assert!(
+        both == 36 && differ == both,
+        "{differ} of {both} pixels differ"
+    );
+}
