@@ -66,6 +66,8 @@ pub struct CausticLights {
     /// sampled only toward these (uniformly within the cones they subtend), not wasted on
     /// the rest of the scene.
     targets: Vec<(Vec3, f32)>,
+    /// Bounding sphere (centre, radius) of the scene: paths of distant lights start outside it.
+    scene: (Vec3, f32),
 }
 
 /// Most target spheres kept separately; more are merged into one.
@@ -83,8 +85,10 @@ pub fn bounding_sphere(shape: &crate::geometry::Shape) -> Option<(Vec3, f32)> {
         (lo.cmple(hi).all()).then(|| sphere_of_box(lo, hi))
     };
     match shape {
-        Shape::Sphere { center, radius } => Some((*center, *radius)),
-        Shape::Disk { center, radius, .. } => Some((*center, *radius)),
+        // The same slack as boxes get (rays may hit a hair outside the exact radius).
+        Shape::Sphere { center, radius } | Shape::Disk { center, radius, .. } => {
+            Some((*center, *radius * (1.0 + 1e-4) + 1e-6))
+        }
         Shape::Quad {
             origin,
             edge_u,
@@ -135,7 +139,9 @@ impl CausticLights {
         let mut powers = Vec::new();
         for (i, l) in lights.iter().enumerate() {
             let p = l.power_lm(geom, scene_radius);
-            if l.can_emit_paths() && p > 0.0 && p.is_finite() {
+            // Distant lights (the sun) too: their paths start on the targets' shadow disks.
+            let emits = l.can_emit_paths() || matches!(l, Light::Distant { .. });
+            if emits && p > 0.0 && p.is_finite() {
                 chosen.push(i as u32);
                 powers.push(p);
             }
@@ -148,12 +154,58 @@ impl CausticLights {
         for &i in &chosen {
             handled[i as usize] = true;
         }
+        let (lo, hi) = geom.bounds();
+        let scene = if lo.is_finite() && hi.is_finite() && hi.cmpge(lo).all() {
+            sphere_of_box(lo, hi)
+        } else {
+            (Vec3::ZERO, scene_radius)
+        };
         Some(Self {
             lights: chosen,
             cdf,
             handled,
             targets,
+            scene,
         })
+    }
+
+    /// Where a path of a distant light travelling along `dir` starts: a point of the disks the
+    /// targets' bounding spheres project onto a plane normal to `dir` (a disk chosen in
+    /// proportion to its area, uniform within it), moved back along `dir` to outside the
+    /// scene. Returns the origin and the density per unit area normal to `dir`: (number of
+    /// disks containing the point) / (sum of the disks' areas).
+    fn sample_parallel(&self, dir: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32)> {
+        use std::f32::consts::PI;
+        let total: f32 = self.targets.iter().map(|(_, r)| PI * r * r).sum();
+        if total.is_nan() || total <= 0.0 {
+            return None;
+        }
+        let mut x = uc * total;
+        let mut chosen = self.targets.len() - 1;
+        for (k, (_, r)) in self.targets.iter().enumerate() {
+            if x < PI * r * r {
+                chosen = k;
+                break;
+            }
+            x -= PI * r * r;
+        }
+        let (c, r) = self.targets[chosen];
+        let (t, b) = dir.any_orthonormal_pair();
+        let (rad, phi) = (r * u.x.sqrt(), 2.0 * PI * u.y);
+        let p = c + rad * (phi.cos() * t + phi.sin() * b);
+        let count = 1 + self
+            .targets
+            .iter()
+            .enumerate()
+            .filter(|&(k, &(cj, rj))| {
+                let v = p - cj;
+                k != chosen && (v - v.dot(dir) * dir).length_squared() <= rj * rj
+            })
+            .count();
+        // Back along the line to outside the scene's bounding sphere.
+        let (cs, rs) = self.scene;
+        let back = (p - cs).dot(dir) + 1.01 * rs + 1e-3;
+        Some((p - back * dir, count as f32 / total))
     }
 
     /// A direction from `p` toward the targets and its density (solid angle): a cone chosen in
@@ -161,55 +213,72 @@ impl CausticLights {
     /// containing the direction) / (sum of the cones' solid angles). Uniform over the sphere
     /// when the cones would cover more than it.
     fn sample_direction(&self, p: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32)> {
-        use std::f32::consts::PI;
-        let mut cones = [(Vec3::ZERO, 0.0f32, 0.0f32); MAX_TARGETS];
-        let mut total = 0.0f32;
+        use glam::DVec3;
+        use std::f64::consts::PI;
+        // In f64 and without cancellation, so that small or distant targets (r/d down to
+        // ~1e-150) keep their exact cones: per cone, the axis, sin²θmax = r²/d² (≥ 1: the
+        // point is inside, the cone is the whole sphere) and 1 − cos θmax = s / (1 + √(1 − s)).
+        let p = p.as_dvec3();
+        let mut cones = [(DVec3::ZERO, 0.0f64, 0.0f64); MAX_TARGETS];
+        let mut total = 0.0f64;
         for (k, &(c, r)) in self.targets.iter().enumerate() {
-            let d = c - p;
+            let d = c.as_dvec3() - p;
             let dist2 = d.length_squared();
-            let cos_max = if dist2 <= r * r {
-                -1.0
+            let r = r as f64;
+            let sin2 = if dist2 > 0.0 { r * r / dist2 } else { 1.0 };
+            let omc = if sin2 >= 1.0 {
+                2.0
             } else {
-                (1.0 - r * r / dist2).max(0.0).sqrt()
+                sin2 / (1.0 + (1.0 - sin2).sqrt())
             };
             let axis = if dist2 > 0.0 {
                 d / dist2.sqrt()
             } else {
-                Vec3::Z
+                DVec3::Z
             };
-            let omega = 2.0 * PI * (1.0 - cos_max);
-            cones[k] = (axis, cos_max, omega);
-            total += omega;
+            cones[k] = (axis, sin2, omc);
+            total += 2.0 * PI * omc;
         }
         let cones = &cones[..self.targets.len()];
         if total.is_nan() || total <= 0.0 {
             return None;
         }
         if total >= 4.0 * PI {
-            return Some((crate::light::sample_uniform_sphere(u), 1.0 / (4.0 * PI)));
+            return Some((
+                crate::light::sample_uniform_sphere(u),
+                (1.0 / (4.0 * PI)) as f32,
+            ));
         }
-        // Choose a cone.
-        let mut x = uc * total;
+        // Choose a cone in proportion to its solid angle.
+        let mut x = uc as f64 * total;
         let mut chosen = cones.len() - 1;
         for (k, c) in cones.iter().enumerate() {
-            if x < c.2 {
+            let omega = 2.0 * PI * c.2;
+            if x < omega {
                 chosen = k;
                 break;
             }
-            x -= c.2;
+            x -= omega;
         }
-        let (axis, cos_max, _) = cones[chosen];
-        let cos_t = 1.0 - u.x * (1.0 - cos_max);
-        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-        let phi = 2.0 * PI * u.y;
-        let local = Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
-        let dir = Frame::from_normal(axis).to_world(local).normalize();
+        let (axis, _, omc) = cones[chosen];
+        // Uniform within the cone: 1 − cos θ uniform in [0, 1 − cos θmax].
+        let omc_t = u.x as f64 * omc;
+        let cos_t = 1.0 - omc_t;
+        let sin_t = (omc_t * (2.0 - omc_t)).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.y as f64;
+        let (t, b) = axis.any_orthonormal_pair();
+        let dir = (sin_t * phi.cos() * t + sin_t * phi.sin() * b + cos_t * axis).normalize();
+        // Inside cone k: the whole sphere, or on the axis' side within sin²θ ≤ sin²θmax.
         let count = 1 + cones
             .iter()
             .enumerate()
-            .filter(|&(k, c)| k != chosen && dir.dot(c.0) >= c.1)
+            .filter(|&(k, c)| {
+                k != chosen
+                    && (c.1 >= 1.0
+                        || (dir.dot(c.0) > 0.0 && dir.cross(c.0).length_squared() <= c.1))
+            })
             .count();
-        Some((dir, count as f32 / total))
+        Some((dir.as_vec3(), (count as f64 / total) as f32))
     }
 
     /// Whether emission from light `light` reached through a caustic chain is this module's
@@ -220,11 +289,15 @@ impl CausticLights {
     }
 }
 
-/// One light path's contribution to one pixel: absolute XYZ (Y in cd/m²) before division by
-/// the number of light paths.
+/// One camera connection of a light path: its film position and its contribution (absolute
+/// XYZ, Y in cd/m², before the pixel filter's density and the division by the number of light
+/// paths), expanded over the pixels the filter covers when the splats are applied.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Splat {
-    pub pixel: u32,
+    /// Index of the light path (consecutive splats of one path share it).
+    pub path: u64,
+    /// Film position (pixels).
+    pub film: Vec2,
     pub xyz: [f64; 3],
     /// Illuminance (lx) on the surface, for the per-pixel illuminance channel.
     pub e: f64,
@@ -268,21 +341,57 @@ pub fn trace_light_paths(
                 Some((splats, stats))
             })
             .collect();
+        let mut path_pixels = Vec::new();
         for part in parts {
             let (splats, st) = part?;
             stats.merge(&st);
-            for s in splats {
-                let t = &mut sums[s.pixel as usize];
-                t[0] += s.xyz[0];
-                t[1] += s.xyz[1];
-                t[2] += s.xyz[2];
-                t[3] += s.xyz[1] * s.xyz[1];
-                t[4] += s.e;
-                t[5] += s.e * s.e;
+            // One path at a time: its contributions per pixel are summed before they are
+            // squared (the variance is over paths, and one path may reach a pixel twice).
+            for path in splats.chunk_by(|a, b| a.path == b.path) {
+                for s in path {
+                    expand_splat(world, s, &mut path_pixels);
+                }
+                path_pixels.sort_unstable_by_key(|&(pixel, _, _)| pixel);
+                for run in path_pixels.chunk_by(|a, b| a.0 == b.0) {
+                    let (mut xyz, mut e) = ([0.0f64; 3], 0.0f64);
+                    for &(_, x, ei) in run {
+                        (0..3).for_each(|k| xyz[k] += x[k]);
+                        e += ei;
+                    }
+                    let t = &mut sums[run[0].0 as usize];
+                    t[0] += xyz[0];
+                    t[1] += xyz[1];
+                    t[2] += xyz[2];
+                    t[3] += xyz[1] * xyz[1];
+                    t[4] += e;
+                    t[5] += e * e;
+                }
+                path_pixels.clear();
             }
         }
     }
     Some(stats)
+}
+
+/// The pixels a splat's filter footprint covers, with the splat weighted by the filter
+/// density at each pixel centre, appended to `out` as (pixel, XYZ, E).
+fn expand_splat(world: &World, s: &Splat, out: &mut Vec<(u32, [f64; 3], f64)>) {
+    let filter = &world.settings.filter;
+    let (w, h) = (world.camera.width as i64, world.camera.height as i64);
+    let r = filter.radius();
+    let x0 = ((s.film.x - r).floor() as i64).max(0);
+    let x1 = ((s.film.x + r).floor() as i64).min(w - 1);
+    let y0 = ((s.film.y - r).floor() as i64).max(0);
+    let y1 = ((s.film.y + r).floor() as i64).min(h - 1);
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let wgt = filter.density(s.film - centre) as f64;
+            if wgt > 0.0 {
+                out.push(((y * w + x) as u32, s.xyz.map(|v| v * wgt), s.e * wgt));
+            }
+        }
+    }
 }
 
 /// |wo·ns||wi·ng| / (|wo·ng||wi·ns|): the factor that makes a BSDF with shading normals
@@ -320,32 +429,50 @@ pub fn trace_light_path(
     }
     let light = &world.lights[caustics.lights[k] as usize];
     let mut wl = SampledWavelengths::sample_visible(u_wl);
-    let Some(at) = light.sample_emission_point(&world.geometry, u_prim, Vec2::new(px, py)) else {
-        return;
+    let (origin, dir, mut beta) = if let Light::Distant {
+        to_light,
+        irradiance,
+    } = light
+    {
+        // Parallel light: flux per path = irradiance normal to the beam / density per area.
+        let dir = -*to_light;
+        let Some((origin, pdf_area)) = caustics.sample_parallel(dir, u_dir, Vec2::new(dx, dy))
+        else {
+            return;
+        };
+        let e = irradiance.sample(&wl);
+        if e.is_black() || pdf_area.is_nan() || pdf_area <= 0.0 {
+            return;
+        }
+        (origin, dir, e * (1.0 / (pdf_area * p_select)))
+    } else {
+        let Some(at) = light.sample_emission_point(&world.geometry, u_prim, Vec2::new(px, py))
+        else {
+            return;
+        };
+        let Some((dir, pdf_dir)) = caustics.sample_direction(at.p, u_dir, Vec2::new(dx, dy)) else {
+            return;
+        };
+        let le = light.emission_toward(&at, dir, &wl);
+        if le.is_black() || pdf_dir.is_nan() || pdf_dir <= 0.0 {
+            return;
+        }
+        let origin = match at.n {
+            Some(n) => crate::geometry::offset_ray_origin(
+                at.p,
+                crate::geometry::point_error_bound(at.p),
+                n,
+                dir,
+            ),
+            None => at.p,
+        };
+        (origin, dir, le * (at.inv_pdf / (pdf_dir * p_select)))
     };
-    let Some((dir, pdf_dir)) = caustics.sample_direction(at.p, u_dir, Vec2::new(dx, dy)) else {
-        return;
-    };
-    let le = light.emission_toward(&at, dir, &wl);
-    if le.is_black() || pdf_dir.is_nan() || pdf_dir <= 0.0 {
-        return;
-    }
-    let origin = match at.n {
-        Some(n) => crate::geometry::offset_ray_origin(
-            at.p,
-            crate::geometry::point_error_bound(at.p),
-            n,
-            dir,
-        ),
-        None => at.p,
-    };
-    let mut beta = le * (at.inv_pdf / (pdf_dir * p_select));
     // The BSDF factors alone, for Russian roulette.
     let mut throughput = 1.0f32;
     let (mut ray_o, mut ray_d) = (origin, dir);
     let filter = &settings.filter;
     let camera = &world.camera;
-    let (w, h) = (camera.width as i64, camera.height as i64);
     // Scattering events so far, counting the surface being processed.
     let mut depth = 0u32;
     loop {
@@ -355,9 +482,8 @@ pub fn trace_light_path(
         };
         let object = world.objects[hit.object as usize];
         let material = &world.materials[object.material as usize];
-        if material.is_black() {
-            return;
-        }
+        // A black surface ends the path, but still receives illuminance (below).
+        let black = material.is_black();
         depth += 1;
         material.prepare(&mut wl);
         let frame = Frame::from_normal(hit.ns);
@@ -371,7 +497,7 @@ pub fn trace_light_path(
         // the luminance the surface sends toward it (non-specular surfaces) and, with the
         // per-pixel illuminance on, for the illuminance on it (any surface but an emitter,
         // on the side the camera sees).
-        let want_l = !material.is_specular();
+        let want_l = !black && !material.is_specular();
         let want_e = settings.illuminance && object.light.is_none();
         if depth >= 2 && (want_l || want_e) {
             if let Some(c) = camera.connect(hit.p, Vec2::new(lx, ly), filter.radius()) {
@@ -397,24 +523,12 @@ pub fn trace_light_path(
                     let origin = hit.spawn_origin(c.wi);
                     let t_max = (c.lens_point - origin).length();
                     if !world.geometry.occluded(origin, c.wi, t_max) {
-                        let r = filter.radius();
-                        let x0 = ((c.film.x - r).floor() as i64).max(0);
-                        let x1 = ((c.film.x + r).floor() as i64).min(w - 1);
-                        let y0 = ((c.film.y - r).floor() as i64).max(0);
-                        let y1 = ((c.film.y + r).floor() as i64).min(h - 1);
-                        for y in y0..=y1 {
-                            for x in x0..=x1 {
-                                let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                                let wgt = filter.density(c.film - centre) as f64;
-                                if wgt > 0.0 {
-                                    splats.push(Splat {
-                                        pixel: (y * w + x) as u32,
-                                        xyz: xyz.map(|v| v * wgt),
-                                        e: e * wgt,
-                                    });
-                                }
-                            }
-                        }
+                        splats.push(Splat {
+                            path: index,
+                            film: c.film,
+                            xyz,
+                            e,
+                        });
                     }
                 }
             }
@@ -423,7 +537,7 @@ pub fn trace_light_path(
         // Continue while a further surface is within the depth limit; the first scattering
         // must be specular (the paths whose light-side end is non-specular are the camera
         // paths' part).
-        if depth >= settings.max_depth || (depth == 1 && !material.has_delta_lobe()) {
+        if black || depth >= settings.max_depth || (depth == 1 && !material.has_delta_lobe()) {
             return;
         }
         let [ux, uy, uc, u_rr] = sampler.get4();
@@ -468,6 +582,7 @@ mod tests {
             cdf: vec![1.0],
             handled: vec![true],
             targets,
+            scene: (Vec3::ZERO, 1e5),
         }
     }
 
@@ -524,6 +639,37 @@ mod tests {
             (est - uniform).abs() < 0.01 * uniform,
             "{est} vs {uniform} sr"
         );
+    }
+
+    #[test]
+    fn small_distant_targets_keep_their_exact_cones() {
+        // r/d from 1e-2 down to 1e-7: f32's 1 − √(1 − r²/d²) loses the cone below ~2e-4 (and
+        // collapsed it to nothing below 1.7e-4, dropping such a target's caustics).
+        for (r, d) in [(0.01f32, 1.0f32), (0.01, 100.0), (0.01, 1e4), (1e-3, 1e4)] {
+            let c = lights_with_targets(vec![(Vec3::new(0.0, 0.0, d), r)]);
+            let omega = std::f64::consts::PI * (r as f64 / d as f64).powi(2);
+            for k in 0..64 {
+                let u = |i: u32| ((k * 7 + i * 13) % 64) as f32 / 64.0 + 1.0 / 128.0;
+                let (dir, pdf) = c
+                    .sample_direction(Vec3::ZERO, u(0), Vec2::new(u(1), u(2)))
+                    .unwrap();
+                // Density: 1/Ω within 1e-3 (Ω ≈ π r²/d² for small cones).
+                assert!(
+                    ((pdf as f64 * omega) - 1.0).abs() < 1e-3,
+                    "r {r}, d {d}: pdf·Ω = {}",
+                    pdf as f64 * omega
+                );
+                // The direction passes within the (slightly padded) sphere.
+                let miss = dir
+                    .as_dvec3()
+                    .cross(glam::DVec3::new(0.0, 0.0, d as f64))
+                    .length();
+                assert!(
+                    miss <= r as f64 * 1.001 + 1e-6,
+                    "r {r}, d {d}: passes at {miss}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -265,6 +265,29 @@ fn illuminance_channel_includes_the_light_traced_caustic() {
 }
 
 #[test]
+fn illuminance_on_a_black_floor_includes_the_light_traced_caustic() {
+    // Illuminance does not depend on the receiver's reflectance: a black floor receives the
+    // same E (direct + mirror image) as the grey one, although it reflects nothing.
+    let text = mirror_scene("Box")
+        .replace("filter: Box,", "filter: Box, illuminance: true,")
+        .replace(r#"material: "floor")"#, r#"material: "black")"#);
+    let w = world_with(&text, Caustics::LightTracing);
+    let film = render(&w, 2);
+    check_pixels(
+        &film,
+        "E on black",
+        |p| {
+            (
+                p.mean_e().expect("every pixel sees the floor"),
+                p.e_standard_error(),
+            )
+        },
+        |x, y| expected(&w, x, y, true) * PI / RHO,
+    );
+    assert!(film.pixels.iter().all(|p| p.mean_xyz()[1] == 0.0));
+}
+
+#[test]
 fn glass_sphere_in_an_emitting_furnace_is_invisible_to_both_estimators() {
     // A lossless glass sphere inside a closed Lambertian enclosure (ρ = 0.5) that emits 1 cd/m²
     // on its inside: in equilibrium every ray sees L = Lₑ/(1 − ρ) = 2 cd/m², through the glass
@@ -314,4 +337,56 @@ fn glass_sphere_in_an_emitting_furnace_is_invisible_to_both_estimators() {
             );
         }
     }
+}
+
+#[test]
+fn sunlight_through_a_window_pane_is_light_traced() {
+    // The sun (a distant light, 100 klx normal to the beam) shines through a thin glass pane
+    // onto a Lambertian floor. Under the pane the floor receives E⊥·cos θ·T with the thin
+    // slab's transmittance T = (1 − R)/(1 + R) (both faces and their inter-reflections), R the
+    // unpolarised Fresnel reflectance at θ; elsewhere E⊥·cos θ. The first part comes only from
+    // light paths (a camera path cannot find a delta direction through glass), the second
+    // from the camera paths' next-event estimation; each pixel is the box-filter mean over its
+    // footprint, so the pane's shadow edge checks both at once.
+    let sun = Vec3::new(0.2, -1.0, 0.1);
+    let text = format!(
+        r#"(
+        camera: (position: (0, 0.6, -1.2), look_at: (0, 0, 0.1), vfov_deg: 36, resolution: (16, 16)),
+        render: (spp: 64, max_depth: 2, light_paths_per_sample: 16),
+        materials: {{ "floor": Diffuse(reflectance: Constant({RHO})), "pane": ThinDielectric(ior: Constant(1.5)) }},
+        objects: [
+            (shape: Quad(origin: (-50, 0, -50), edge_u: (0, 0, 100), edge_v: (100, 0, 0)), material: "floor"),
+            (shape: Quad(origin: (-0.5, 1, -0.5), edge_u: (1, 0, 0), edge_v: (0, 0, 1)), material: "pane"),
+        ],
+        lights: [Distant(direction: ({}, {}, {}), spectrum: Named("D65"), amount: Illuminance(100000.0))],
+    )"#,
+        sun.x, sun.y, sun.z
+    );
+    let w = world_with(&text, Caustics::LightTracing);
+    assert!(
+        w.caustics.is_some(),
+        "the sun must take part in light tracing"
+    );
+    let film = render(&w, 2);
+    let to_sun = -sun.normalize();
+    let cos = to_sun.y as f64;
+    let (eta, c) = (1.5f64, cos);
+    let cos_t = (1.0 - (1.0 - c * c) / (eta * eta)).sqrt();
+    let rs = (c - eta * cos_t) / (c + eta * cos_t);
+    let rp = (eta * c - cos_t) / (eta * c + cos_t);
+    let r = 0.5 * (rs * rs + rp * rp);
+    let t = (1.0 - r) / (1.0 + r);
+    let e_floor = |p: Vec3| {
+        let q = p + to_sun * ((1.0 - p.y) / to_sun.y);
+        let under = q.x.abs() <= 0.5 && q.z.abs() <= 0.5;
+        1e5 * cos * if under { t } else { 1.0 }
+    };
+    check_pixels(&film, "sun through a pane", luminance, |x, y| {
+        RHO / PI * floor_footprint_mean(&w, x, y, e_floor)
+    });
+    // And some pixels do see the floor under the pane.
+    let under = (0..16 * 16)
+        .filter(|&i| floor_footprint_mean(&w, i % 16, i / 16, e_floor) < 1e5 * cos * 0.95)
+        .count();
+    assert!(under > 40, "{under} pixels under the pane");
 }
