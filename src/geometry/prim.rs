@@ -271,6 +271,29 @@ pub(crate) fn basis(n: DVec3) -> (DVec3, DVec3) {
     )
 }
 
+/// Unit normal of the triangle's front face (computed in f64).
+#[inline(always)]
+fn triangle_normal(v: &[Vec3; 3]) -> Vec3 {
+    let (a, b, c) = (v[0].as_dvec3(), v[1].as_dvec3(), v[2].as_dvec3());
+    (b - a).cross(c - a).normalize().as_vec3()
+}
+
+/// [`Prim::hit_geom`] of a triangle with vertices `v` and barycentrics (b1, b2) = (a, b).
+#[inline(always)]
+pub(crate) fn triangle_hit_geom(v: &[Vec3; 3], a: f32, b: f32) -> HitGeom {
+    let [p0, p1, p2] = *v;
+    let b0 = 1.0 - a - b;
+    let p = b0 * p0 + a * p1 + b * p2;
+    let error = gamma(7) * ((b0 * p0).abs() + (a * p1).abs() + (b * p2).abs());
+    HitGeom {
+        p,
+        ng: triangle_normal(v),
+        uv: Vec2::new(a, b),
+        error,
+        bary: Vec3::new(b0, a, b),
+    }
+}
+
 /// Geometric data of a hit, before shading normals and ids are filled in.
 pub(crate) struct HitGeom {
     pub p: Vec3,
@@ -375,10 +398,7 @@ impl Prim {
     /// Unit front-face normal (for flat primitives; spheres: at `p`).
     pub fn normal_at(&self, p: Vec3) -> Vec3 {
         match *self {
-            Prim::Triangle([a, b, c]) => {
-                let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
-                (b - a).cross(c - a).normalize().as_vec3()
-            }
+            Prim::Triangle(v) => triangle_normal(&v),
             Prim::Sphere { center, .. } => (p.as_dvec3() - center.as_dvec3()).normalize().as_vec3(),
             Prim::Quad { edge_u, edge_v, .. } => edge_u
                 .as_dvec3()
@@ -392,18 +412,7 @@ impl Prim {
     /// Full hit geometry for a hit found by [`Prim::intersect`].
     pub fn hit_geom(&self, r: &RayPre, t: f32, a: f32, b: f32) -> HitGeom {
         match *self {
-            Prim::Triangle([p0, p1, p2]) => {
-                let b0 = 1.0 - a - b;
-                let p = b0 * p0 + a * p1 + b * p2;
-                let error = gamma(7) * ((b0 * p0).abs() + (a * p1).abs() + (b * p2).abs());
-                HitGeom {
-                    p,
-                    ng: self.normal_at(p),
-                    uv: Vec2::new(a, b),
-                    error,
-                    bary: Vec3::new(b0, a, b),
-                }
-            }
+            Prim::Triangle(v) => triangle_hit_geom(&v, a, b),
             Prim::Sphere { center, radius } => {
                 let c = center.as_dvec3();
                 let ph = r.od + t as f64 * r.dd;

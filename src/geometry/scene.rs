@@ -951,8 +951,12 @@ impl SceneGeometry {
     /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
     /// brute-force tests).
     fn make_hit(&self, prim: u32, pre: &RayPre, t: f32, a: f32, b: f32) -> Hit {
-        let p = self.prim(prim);
-        let g = p.hit_geom(pre, t, a, b);
+        let v = &self.tris[prim as usize];
+        let g = if v[0].x.is_nan() {
+            self.others[v[1].x.to_bits() as usize].hit_geom(pre, t, a, b)
+        } else {
+            super::prim::triangle_hit_geom(v, a, b)
+        };
         let mut ns = g.ng;
         if let Some(idx) = self.prim_normals.get(prim as usize) {
             if idx[0] != u32::MAX {
