@@ -244,10 +244,11 @@ const STACK_SIZE: usize = 7 * MAX_DEPTH;
 /// order as integers, and entries order by distance with integer compares.
 type Key = u64;
 
-/// The key of an inner node entered at distance `dist` (≥ 0).
+/// The key of an inner node entered at distance `dist` (≥ 0). The sign bit is cleared, so that
+/// a −0 (which `f32::max(−0, 0)` may return) orders as +0.
 #[inline(always)]
 fn node_key(dist: f32, idx: u32) -> Key {
-    ((dist.to_bits() as u64) << 32) | idx as u64
+    (((dist.to_bits() & 0x7fff_ffff) as u64) << 32) | idx as u64
 }
 
 /// The largest key whose entry distance does not exceed `t` (> 0): entries above it cannot
