@@ -396,7 +396,9 @@ fn traverse<const ORDERED: bool>(
             while mask != 0 {
                 let x = key(mask.trailing_zeros());
                 mask &= mask - 1;
-                // SAFETY: entries first..sp were just written; j stays in first..=sp.
+                debug_assert!(sp < STACK_SIZE);
+                // SAFETY: entries first..sp were just written; j stays in first..=sp, and sp
+                // is below STACK_SIZE as in `push!`.
                 unsafe {
                     let mut j = sp;
                     while j > first && stack.get_unchecked(j - 1).assume_init() < x {
