@@ -133,14 +133,13 @@ fn node_test(node: &CwBvhNode, r: &NodeRay, t_max: f32, tmin_out: &mut [f32; 8])
         // extent 2^(e−127) per axis from the e bytes, and the ray data likewise duplicated:
         // every per-axis value is then one in-lane permute away from a full broadcast.
         let p = _mm256_broadcast_ps(&*(np as *const __m128));
+        // The e bytes and imask (bytes 12–15), broadcast from memory, one byte per lane.
+        let e4 = _mm256_set1_epi32((np.add(12) as *const i32).read_unaligned());
         let e_bytes = _mm256_setr_epi8(
-            12, -128, -128, -128, 13, -128, -128, -128, 14, -128, -128, -128, 15, -128, -128, -128,
-            12, -128, -128, -128, 13, -128, -128, -128, 14, -128, -128, -128, 15, -128, -128, -128,
+            0, -128, -128, -128, 1, -128, -128, -128, 2, -128, -128, -128, 3, -128, -128, -128, 0,
+            -128, -128, -128, 1, -128, -128, -128, 2, -128, -128, -128, 3, -128, -128, -128,
         );
-        let e = _mm256_castsi256_ps(_mm256_slli_epi32::<23>(_mm256_shuffle_epi8(
-            _mm256_castps_si256(p),
-            e_bytes,
-        )));
+        let e = _mm256_castsi256_ps(_mm256_slli_epi32::<23>(_mm256_shuffle_epi8(e4, e_bytes)));
         let dup = |v: &Vec3A| _mm256_broadcast_ps(&*(v as *const Vec3A as *const __m128));
         let (o, inv, g7_inv) = (dup(&r.o), dup(&r.inv), dup(&r.g7_inv_abs));
         let rel = _mm256_sub_ps(p, o);
