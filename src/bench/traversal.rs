@@ -52,6 +52,20 @@ pub struct TraversalArgs {
     /// BVH builds to time (median reported), for candela and Embree alike.
     #[arg(long, default_value_t = 3)]
     pub build_reps: usize,
+    /// What candela's closest-hit rays compute: `basic` (`SceneGeometry::intersect_basic`: t,
+    /// u, v, unnormalized Ng, primitive and object id, as Embree's rtcIntersect1), `full`
+    /// (`SceneGeometry::intersect`: the renderer's full `Hit`) or `both` (basic in the main
+    /// tables, full in an extra table).
+    #[arg(long, value_enum, default_value_t = Record::Both)]
+    pub record: Record,
+}
+
+/// What candela computes per closest-hit ray (see [`TraversalArgs::record`]).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Record {
+    Basic,
+    Full,
+    Both,
 }
 
 /// Rays are handed to threads in chunks of this many (embree_trace uses the same).
@@ -204,10 +218,22 @@ pub struct Timing {
     pub cpu: f64,
 }
 
-/// Traces `batch` on `threads` threads that take chunks of [`CHUNK`] consecutive rays from a
-/// shared counter (as embree_trace does). Returns the timing and, per ray, the hit `t` (+∞ for
-/// a miss; for any-hit rays 0 when occluded, +∞ when not).
+/// [`trace_batch_record`] with the full `Hit` (what the renderer computes).
 pub fn trace_batch(geo: &SceneGeometry, batch: &RayBatch, threads: usize) -> (Timing, Vec<f32>) {
+    trace_batch_record(geo, batch, threads, true)
+}
+
+/// Traces `batch` on `threads` threads that take chunks of [`CHUNK`] consecutive rays from a
+/// shared counter (as embree_trace does). Closest-hit rays build the full `Hit` with `full`,
+/// else only what Embree's rtcIntersect1 returns ([`SceneGeometry::intersect_basic`]). Returns
+/// the timing and, per ray, the hit `t` (+∞ for a miss; for any-hit rays 0 when occluded, +∞
+/// when not).
+pub fn trace_batch_record(
+    geo: &SceneGeometry,
+    batch: &RayBatch,
+    threads: usize,
+    full: bool,
+) -> (Timing, Vec<f32>) {
     let mut out = vec![f32::NAN; batch.rays.len()];
     let chunks: Vec<Mutex<(&[BenchRay], &mut [f32])>> = batch
         .rays
@@ -228,10 +254,17 @@ pub fn trace_batch(geo: &SceneGeometry, batch: &RayBatch, threads: usize) -> (Ti
                         let mut guard = chunk.lock().unwrap_or_else(|e| e.into_inner());
                         let (rays, ts) = &mut *guard;
                         match batch.kind {
-                            RayKind::Closest => {
+                            RayKind::Closest if full => {
                                 for (r, t) in rays.iter().zip(ts.iter_mut()) {
                                     *t = geo
                                         .intersect(r.origin, r.dir, r.tfar)
+                                        .map_or(f32::INFINITY, |h| h.t);
+                                }
+                            }
+                            RayKind::Closest => {
+                                for (r, t) in rays.iter().zip(ts.iter_mut()) {
+                                    *t = geo
+                                        .intersect_basic(r.origin, r.dir, r.tfar)
                                         .map_or(f32::INFINITY, |h| h.t);
                                 }
                             }
@@ -488,18 +521,31 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
     let mut candela_t: Vec<Vec<Vec<Timing>>> = vec![vec![Vec::new(); nt]; nb];
     let mut embree_t: Vec<Vec<Vec<Vec<Timing>>>> =
         vec![vec![vec![Vec::new(); embrees.len()]; nt]; nb];
+    // With --record both: the full-Hit timings of the closest-hit batches.
+    let mut candela_full_t: Vec<Vec<Vec<Timing>>> = vec![vec![Vec::new(); nt]; nb];
     let mut candela_hits: Vec<Vec<f32>> = vec![Vec::new(); nb];
+    let main_full = args.record == Record::Full;
     for rep in 0..reps {
         eprintln!("repetition {}/{reps}…", rep + 1);
         for (b, batch) in file.batches.iter().enumerate() {
             for (k, &threads) in args.threads.iter().enumerate() {
-                let (s, hits) = trace_batch(&geo, batch, threads);
+                let (s, hits) = trace_batch_record(&geo, batch, threads, main_full);
                 candela_t[b][k].push(s);
                 if candela_hits[b].is_empty() {
                     candela_hits[b] = hits;
                 }
                 for (e, emb) in embrees.iter_mut().enumerate() {
                     embree_t[b][k][e].push(emb.trace(&batch.name, threads)?);
+                }
+                if args.record == Record::Both && batch.kind == RayKind::Closest {
+                    let (s, hits) = trace_batch_record(&geo, batch, threads, true);
+                    candela_full_t[b][k].push(s);
+                    if hits != candela_hits[b] {
+                        bail!(
+                            "intersect and intersect_basic disagree on batch {}",
+                            batch.name
+                        );
+                    }
                 }
             }
         }
@@ -544,6 +590,38 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
                 for times in &embree_t[b][k] {
                     let s = median(&mut times.iter().map(metric).collect::<Vec<_>>());
                     row += &format!(" {:.2} | {:.2} |", mrays(batch.rays.len(), s), c / s);
+                }
+                println!("{row}");
+            }
+        }
+    }
+    if args.record == Record::Both {
+        let mut head = "| rays | threads | candela, full Hit |".to_string();
+        let mut rule = "|---|---:|---:|".to_string();
+        for e in &embrees {
+            head += &format!(" ratio vs {q} |", q = e.quality);
+            rule += "---:|";
+        }
+        println!("\nCPU time with the full `Hit` record (`SceneGeometry::intersect`, what the renderer calls: adds the hit point, unit normals, shading normal and error bounds): Mrays per CPU-second; ratio = candela CPU time ÷ Embree CPU time (Embree as above).\n\n{head}\n{rule}");
+        for (b, batch) in file.batches.iter().enumerate() {
+            if batch.kind != RayKind::Closest {
+                continue;
+            }
+            for (k, &threads) in args.threads.iter().enumerate() {
+                let c = median(
+                    &mut candela_full_t[b][k]
+                        .iter()
+                        .map(|t| t.cpu)
+                        .collect::<Vec<_>>(),
+                );
+                let mut row = format!(
+                    "| {} | {threads} | {:.2} |",
+                    batch.name,
+                    mrays(batch.rays.len(), c)
+                );
+                for times in &embree_t[b][k] {
+                    let s = median(&mut times.iter().map(|t| t.cpu).collect::<Vec<_>>());
+                    row += &format!(" {:.2} |", c / s);
                 }
                 println!("{row}");
             }
@@ -626,10 +704,11 @@ mod tests {
         assert_eq!(b[0].rays.len(), 32 * 32);
         assert!(b[1].rays.len() > 500 && b[1].rays.len() <= 1024);
         assert!(!b[2].rays.is_empty() && b[2].rays.len() <= b[1].rays.len());
-        let (_, t) = trace_batch(&geo, &b[0], 2);
+        let (_, t) = trace_batch_record(&geo, &b[0], 2, false);
+        assert_eq!(trace_batch(&geo, &b[0], 1).1, t);
         assert_eq!(t.iter().filter(|t| t.is_finite()).count(), b[1].rays.len());
         // Diffuse rays leave the surface: none may hit at t ≈ 0.
-        let (_, t) = trace_batch(&geo, &b[1], 2);
+        let (_, t) = trace_batch_record(&geo, &b[1], 2, false);
         assert!(t.iter().all(|&t| t >= 1e-4));
     }
 }

@@ -48,17 +48,9 @@ impl RayPre {
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
         let ad = d.abs();
-        let kz = if ad.x > ad.y {
-            if ad.x > ad.z {
-                0
-            } else {
-                2
-            }
-        } else if ad.y > ad.z {
-            1
-        } else {
-            2
-        };
+        // The largest |component| (the first of equal ones, z on ties with z), branch-free.
+        let (m, i) = if ad.x > ad.y { (ad.x, 0) } else { (ad.y, 1) };
+        let kz = if m > ad.z { i } else { 2 };
         let kx = (kz + 1) % 3;
         let ky = (kx + 1) % 3;
         let sz = 1.0 / d[kz];
@@ -114,6 +106,20 @@ pub(crate) fn intersect_triangle<const KZ: usize>(
     triangle_tail(r, t_max, [p0t, p1t, p2t], [e0, e1, e2])
 }
 
+/// max(max(a, b), c) of values that are not NaN, without `f32::max`'s NaN handling (one
+/// `maxss` each). In [`triangle_tail`] every NaN operand would already have made `t` NaN and
+/// the test return `None`, and all operands are absolute values (no signed zeros), so this
+/// gives the same results as `f32::max`.
+#[inline(always)]
+fn max3(a: f32, b: f32, c: f32) -> f32 {
+    let m = if a > b { a } else { b };
+    if m > c {
+        m
+    } else {
+        c
+    }
+}
+
 /// The rest of [`intersect_triangle`] once the edge functions `e` have the same sign: `pt`
 /// are the vertices translated to the ray origin, permuted (z = dominant axis) and sheared in
 /// x and y (not yet scaled in z).
@@ -127,7 +133,7 @@ pub(crate) fn triangle_tail(r: &RayPre, t_max: f32, pt: [Vec3; 3], e: [f32; 3]) 
     }
     // Largest |z| before scaling by 1/d_z, in spatial units (pbrt uses the scaled z in δx/δy,
     // which mixes units and rejects valid hits for short, unnormalised directions).
-    let max_zs = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
+    let max_zs = max3(p0t.z.abs(), p1t.z.abs(), p2t.z.abs());
     p0t.z *= r.sz;
     p1t.z *= r.sz;
     p2t.z *= r.sz;
@@ -145,14 +151,14 @@ pub(crate) fn triangle_tail(r: &RayPre, t_max: f32, pt: [Vec3; 3], e: [f32; 3]) 
     }
     // Conservative check that t is positive despite rounding (pbrt-v4 §6.8.7; δx, δy in
     // spatial units, δz and t in ray-parameter units).
-    let max_zt = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
+    let max_zt = max3(p0t.z.abs(), p1t.z.abs(), p2t.z.abs());
     let delta_z = gamma(3) * max_zt;
-    let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
-    let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
+    let max_xt = max3(p0t.x.abs(), p1t.x.abs(), p2t.x.abs());
+    let max_yt = max3(p0t.y.abs(), p1t.y.abs(), p2t.y.abs());
     let delta_x = gamma(5) * (max_xt + max_zs);
     let delta_y = gamma(5) * (max_yt + max_zs);
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+    let max_e = max3(e0.abs(), e1.abs(), e2.abs());
     let delta_t =
         3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
     if t <= delta_t {
@@ -265,6 +271,29 @@ pub(crate) fn basis(n: DVec3) -> (DVec3, DVec3) {
     )
 }
 
+/// Unit normal of the triangle's front face (computed in f64).
+#[inline(always)]
+fn triangle_normal(v: &[Vec3; 3]) -> Vec3 {
+    let (a, b, c) = (v[0].as_dvec3(), v[1].as_dvec3(), v[2].as_dvec3());
+    (b - a).cross(c - a).normalize().as_vec3()
+}
+
+/// [`Prim::hit_geom`] of a triangle with vertices `v` and barycentrics (b1, b2) = (a, b).
+#[inline(always)]
+pub(crate) fn triangle_hit_geom(v: &[Vec3; 3], a: f32, b: f32) -> HitGeom {
+    let [p0, p1, p2] = *v;
+    let b0 = 1.0 - a - b;
+    let p = b0 * p0 + a * p1 + b * p2;
+    let error = gamma(7) * ((b0 * p0).abs() + (a * p1).abs() + (b * p2).abs());
+    HitGeom {
+        p,
+        ng: triangle_normal(v),
+        uv: Vec2::new(a, b),
+        error,
+        bary: Vec3::new(b0, a, b),
+    }
+}
+
 /// Geometric data of a hit, before shading normals and ids are filled in.
 pub(crate) struct HitGeom {
     pub p: Vec3,
@@ -369,10 +398,7 @@ impl Prim {
     /// Unit front-face normal (for flat primitives; spheres: at `p`).
     pub fn normal_at(&self, p: Vec3) -> Vec3 {
         match *self {
-            Prim::Triangle([a, b, c]) => {
-                let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
-                (b - a).cross(c - a).normalize().as_vec3()
-            }
+            Prim::Triangle(v) => triangle_normal(&v),
             Prim::Sphere { center, .. } => (p.as_dvec3() - center.as_dvec3()).normalize().as_vec3(),
             Prim::Quad { edge_u, edge_v, .. } => edge_u
                 .as_dvec3()
@@ -386,18 +412,7 @@ impl Prim {
     /// Full hit geometry for a hit found by [`Prim::intersect`].
     pub fn hit_geom(&self, r: &RayPre, t: f32, a: f32, b: f32) -> HitGeom {
         match *self {
-            Prim::Triangle([p0, p1, p2]) => {
-                let b0 = 1.0 - a - b;
-                let p = b0 * p0 + a * p1 + b * p2;
-                let error = gamma(7) * ((b0 * p0).abs() + (a * p1).abs() + (b * p2).abs());
-                HitGeom {
-                    p,
-                    ng: self.normal_at(p),
-                    uv: Vec2::new(a, b),
-                    error,
-                    bary: Vec3::new(b0, a, b),
-                }
-            }
+            Prim::Triangle(v) => triangle_hit_geom(&v, a, b),
             Prim::Sphere { center, radius } => {
                 let c = center.as_dvec3();
                 let ph = r.od + t as f64 * r.dd;

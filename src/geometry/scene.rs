@@ -41,6 +41,23 @@ pub struct SceneGeometry {
     bounds: (Vec3, Vec3),
 }
 
+/// A closest hit as [`SceneGeometry::intersect_basic`] returns it: what Embree's
+/// `rtcIntersect1` returns (t, u, v, Ng, primID, geomID).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Surface parameters, as [`Hit::uv`] (triangles: barycentrics b1, b2).
+    pub u: f32,
+    pub v: f32,
+    /// Geometric normal of the front face, not normalized (triangles: (v1 − v0) × (v2 − v0)).
+    pub ng: Vec3,
+    /// Primitive id, as [`Hit::prim`].
+    pub prim: u32,
+    /// Object id, as [`Hit::object`].
+    pub object: u32,
+}
+
 /// Ray data for the node test.
 struct NodeRay {
     o: Vec3A,
@@ -62,36 +79,24 @@ impl NodeRay {
         let inv =
             (Vec3A::ONE / Vec3A::from(d)).clamp(Vec3A::splat(-INV_LIMIT), Vec3A::splat(INV_LIMIT));
         // From the reciprocal, so that −0 (reciprocal −∞ → −INV_LIMIT) counts as negative.
-        let planes = [
-            (
-                offset_of!(CwBvhNode, child_min_x),
-                offset_of!(CwBvhNode, child_max_x),
-            ),
-            (
-                offset_of!(CwBvhNode, child_min_y),
-                offset_of!(CwBvhNode, child_max_y),
-            ),
-            (
-                offset_of!(CwBvhNode, child_min_z),
-                offset_of!(CwBvhNode, child_max_z),
-            ),
-        ];
-        let pick = |a: usize, neg: bool| {
-            if neg {
-                (planes[a].1, planes[a].0)
-            } else {
-                planes[a]
-            }
-        };
-        let (nx, fx) = pick(0, inv.x < 0.0);
-        let (ny, fy) = pick(1, inv.y < 0.0);
-        let (nz, fz) = pick(2, inv.z < 0.0);
+        // The min and max plane arrays of axis a are at MIN_X + 16a and MIN_X + 16a + 8.
+        let neg = inv.cmplt(Vec3A::ZERO).bitmask() as usize;
+        const MIN_X: usize = offset_of!(CwBvhNode, child_min_x);
+        const _: () = assert!(
+            offset_of!(CwBvhNode, child_max_x) == MIN_X + 8
+                && offset_of!(CwBvhNode, child_min_y) == MIN_X + 16
+                && offset_of!(CwBvhNode, child_max_y) == MIN_X + 24
+                && offset_of!(CwBvhNode, child_min_z) == MIN_X + 32
+                && offset_of!(CwBvhNode, child_max_z) == MIN_X + 40
+        );
+        let near = |a: usize| MIN_X + 16 * a + 8 * ((neg >> a) & 1);
+        let far = |a: usize| near(a) ^ 8;
         Self {
             o: o.into(),
             inv,
             g7_inv_abs: gamma(7) * inv.abs(),
-            near: [nx, ny, nz],
-            far: [fx, fy, fz],
+            near: [near(0), near(1), near(2)],
+            far: [far(0), far(1), far(2)],
         }
     }
 }
@@ -128,14 +133,13 @@ fn node_test(node: &CwBvhNode, r: &NodeRay, t_max: f32, tmin_out: &mut [f32; 8])
         // extent 2^(e−127) per axis from the e bytes, and the ray data likewise duplicated:
         // every per-axis value is then one in-lane permute away from a full broadcast.
         let p = _mm256_broadcast_ps(&*(np as *const __m128));
+        // The e bytes and imask (bytes 12–15), broadcast from memory, one byte per lane.
+        let e4 = _mm256_set1_epi32((np.add(12) as *const i32).read_unaligned());
         let e_bytes = _mm256_setr_epi8(
-            12, -128, -128, -128, 13, -128, -128, -128, 14, -128, -128, -128, 15, -128, -128, -128,
-            12, -128, -128, -128, 13, -128, -128, -128, 14, -128, -128, -128, 15, -128, -128, -128,
+            0, -128, -128, -128, 1, -128, -128, -128, 2, -128, -128, -128, 3, -128, -128, -128, 0,
+            -128, -128, -128, 1, -128, -128, -128, 2, -128, -128, -128, 3, -128, -128, -128,
         );
-        let e = _mm256_castsi256_ps(_mm256_slli_epi32::<23>(_mm256_shuffle_epi8(
-            _mm256_castps_si256(p),
-            e_bytes,
-        )));
+        let e = _mm256_castsi256_ps(_mm256_slli_epi32::<23>(_mm256_shuffle_epi8(e4, e_bytes)));
         let dup = |v: &Vec3A| _mm256_broadcast_ps(&*(v as *const Vec3A as *const __m128));
         let (o, inv, g7_inv) = (dup(&r.o), dup(&r.inv), dup(&r.g7_inv_abs));
         let rel = _mm256_sub_ps(p, o);
@@ -234,203 +238,200 @@ const MAX_DEPTH: usize = 64;
 /// Traversal stack entries: at most 7 pushes per level below the root.
 const STACK_SIZE: usize = 7 * MAX_DEPTH;
 
-/// A traversal item: an inner node (`leaf == 0`; `idx` = node index) or a leaf (`idx` = first
-/// primitive, `leaf` = 8 | its primitive count in unary (1, 3 or 7; 0 for an empty slot)),
-/// with its entry distance.
-#[derive(Clone, Copy)]
-struct Item {
-    idx: u32,
-    leaf: u32,
-    dist: f32,
+/// A traversal stack entry: an inner node, packed into a `u64` as its entry distance's bits
+/// (high half) and its node index (low half). Entry distances are non-negative, so their bits
+/// order as integers, and entries order by distance with integer compares.
+type Key = u64;
+
+/// The key of an inner node entered at distance `dist` (≥ 0). The sign bit is cleared, so that
+/// a −0 (which `f32::max(−0, 0)` may return) orders as +0.
+#[inline(always)]
+fn node_key(dist: f32, idx: u32) -> Key {
+    (((dist.to_bits() & 0x7fff_ffff) as u64) << 32) | idx as u64
 }
 
-/// The item for child slot `k` of `node`, entered at distance `dist` (branch-free decode of
-/// the slot's meta byte).
+/// The largest key whose entry distance does not exceed `t` (> 0): entries above it cannot
+/// hold a hit closer than `t`.
 #[inline(always)]
-fn child_item(node: &CwBvhNode, k: u32, dist: f32) -> Item {
-    let meta = node.child_meta[k as usize] as u32;
-    let imask = node.imask as u32;
-    let inner = (imask >> k) & 1 != 0;
-    // Inner children are stored in slot order from child_base_idx.
-    let node_idx = node.child_base_idx + (imask & ((1u32 << k) - 1)).count_ones();
-    let prim_idx = node.primitive_base_idx + (meta & 0x1f);
-    Item {
-        idx: if inner { node_idx } else { prim_idx },
-        leaf: if inner { 0 } else { (meta >> 5) | 8 },
-        dist,
+fn cull_key(t: f32) -> Key {
+    node_key(t, u32::MAX)
+}
+
+/// The slots whose entry distance `tmin` does not exceed `t` (a mask as from [`node_test`]).
+#[inline(always)]
+fn le_mask(tmin: &[f32; 8], t: f32) -> u32 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    // SAFETY: AVX is enabled at compile time; the load reads the 8 floats of `tmin`.
+    unsafe {
+        use std::arch::x86_64::*;
+        let v = _mm256_loadu_ps(tmin.as_ptr());
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(v, _mm256_set1_ps(t))) as u32
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+    {
+        let mut m = 0;
+        for (k, &d) in tmin.iter().enumerate() {
+            if d <= t {
+                m |= 1 << k;
+            }
+        }
+        m
     }
 }
 
-/// Prefetches the node or the leaf triangles an item refers to.
+/// The primitive tests of a traversal: `leaf(first, unary, t_max)` tests the leaf's primitives
+/// `first..` (`unary` = their count in unary: 1, 3 or 7, or 0 for none) and returns the new
+/// t_max (smaller on a closer hit), or `None` to stop the traversal (any hit).
+trait LeafTest {
+    fn leaf(&mut self, first: u32, unary: u32, t_max: f32) -> Option<f32>;
+    /// Prefetches the data of primitive `first` (any value; nothing is read).
+    fn prefetch(&self, first: u32);
+}
+
+/// Prefetches the two cache lines at `p` (any address: prefetching never faults).
 #[inline(always)]
-fn prefetch(nodes: &[CwBvhNode], tris: &[[Vec3; 3]], it: &Item) {
+fn prefetch(p: *const u8) {
     #[cfg(target_arch = "x86_64")]
-    {
+    // SAFETY: prefetching has no effect on memory and never faults.
+    unsafe {
         use std::arch::x86_64::*;
-        // Prefetching never faults and has no effect on memory; the addresses are computed
-        // with wrapping arithmetic, so no pointer leaves its allocation.
-        let (p, len) = if it.leaf == 0 {
-            (
-                nodes.as_ptr().wrapping_add(it.idx as usize) as *const i8,
-                80,
-            )
-        } else {
-            let n = (it.leaf & 7).count_ones() as usize;
-            (
-                tris.as_ptr().wrapping_add(it.idx as usize) as *const i8,
-                n * 36,
-            )
-        };
-        // SAFETY: see above.
-        unsafe {
-            _mm_prefetch::<_MM_HINT_T0>(p);
-            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
-            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(len.max(1) - 1));
-        }
+        _mm_prefetch::<_MM_HINT_T0>(p as *const i8);
+        _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64) as *const i8);
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = (nodes, tris, it);
+    let _ = p;
 }
 
-/// CWBVH traversal with a CPU-style stack of (child, entry distance). With `ORDERED`
-/// (closest hit) the hit children of a node are visited nearest first and stack entries that
-/// start beyond the current `t_max` are skipped; without it (any hit) the order is arbitrary.
-/// `leaf_fn(first, count, t_max)` tests the primitives `first..first + count` and returns the
-/// new t_max (smaller on a closer hit) or `None` to stop traversal (any-hit).
+/// CWBVH traversal with a CPU-style stack of inner nodes ([`Key`]s). The leaf children of a
+/// node are tested as soon as the node test finds them, before its inner children. With
+/// `ORDERED` (closest hit) the inner children that still start before the (possibly reduced)
+/// `t_max` are visited nearest first, and stack entries that start beyond the current `t_max`
+/// are skipped; without it (any hit) the order is arbitrary.
 #[inline(always)]
 fn traverse<const ORDERED: bool>(
-    bvh: &CwBvh,
-    tris: &[[Vec3; 3]],
+    nodes: &[CwBvhNode],
     origin: Vec3,
     dir: Vec3,
     mut t_max: f32,
-    mut leaf_fn: impl FnMut(u32, u32, f32) -> Option<f32>,
+    leaves: &mut impl LeafTest,
 ) {
-    let nodes = &bvh.nodes[..];
     if nodes.is_empty() {
         return;
     }
     let r = NodeRay::new(origin, dir);
-    let mut stack = [const { MaybeUninit::<Item>::uninit() }; STACK_SIZE];
+    let mut stack = [const { MaybeUninit::<Key>::uninit() }; STACK_SIZE];
     let mut sp = 0usize;
-    let mut cur = Item {
-        idx: 0,
-        leaf: 0,
-        dist: 0.0,
-    };
+    let mut cull = cull_key(t_max);
+    let mut cur = 0u32; // the root
     let mut tmin = [0.0f32; 8];
     macro_rules! push {
-        ($it:expr) => {{
+        ($k:expr) => {{
             debug_assert!(sp < STACK_SIZE);
             // SAFETY: at most 7 entries are pushed per level and the build rejects BVHs
             // deeper than MAX_DEPTH.
-            unsafe { stack.get_unchecked_mut(sp).write($it) };
+            unsafe { stack.get_unchecked_mut(sp).write($k) };
             sp += 1;
         }};
     }
-    loop {
-        if cur.leaf == 0 {
-            // SAFETY: inner child indices are valid node indices (node 0 exists).
-            let node = unsafe { nodes.get_unchecked(cur.idx as usize) };
-            let mut mask = node_test(node, &r, t_max, &mut tmin);
-            if mask != 0 {
-                let c0 = {
-                    let k = mask.trailing_zeros();
-                    child_item(node, k, tmin[k as usize])
-                };
+    'nodes: loop {
+        // SAFETY: inner child indices are valid node indices (node 0 exists).
+        let node = unsafe { nodes.get_unchecked(cur as usize) };
+        prefetch(nodes.as_ptr().wrapping_add(node.child_base_idx as usize) as *const u8);
+        leaves.prefetch(node.primitive_base_idx);
+        let mut mask = node_test(node, &r, t_max, &mut tmin);
+        let imask = node.imask as u32;
+        // The leaf children (an empty slot would decode as a leaf without primitives).
+        let mut leaf_mask = mask & !imask;
+        if leaf_mask != 0 {
+            let t0 = t_max;
+            while leaf_mask != 0 {
+                let k = leaf_mask.trailing_zeros();
+                let meta = node.child_meta[k as usize] as u32;
+                let first = node.primitive_base_idx + (meta & 0x1f);
+                match leaves.leaf(first, meta >> 5, t_max) {
+                    Some(t) => t_max = t,
+                    None => return,
+                }
+                leaf_mask &= leaf_mask - 1;
+            }
+            if ORDERED && t_max != t0 {
+                cull = cull_key(t_max);
+                mask &= le_mask(&tmin, t_max);
+            }
+        }
+        // The inner children, stored in slot order from child_base_idx.
+        let mut mask = mask & imask;
+        if mask != 0 {
+            let idx = |k: u32| node.child_base_idx + (imask & ((1u32 << k) - 1)).count_ones();
+            let key = |k: u32| node_key(tmin[k as usize], idx(k));
+            if !ORDERED {
+                cur = idx(mask.trailing_zeros());
                 mask &= mask - 1;
-                if mask == 0 {
-                    cur = c0;
-                    continue;
-                }
-                let c1 = {
-                    let k = mask.trailing_zeros();
-                    child_item(node, k, tmin[k as usize])
-                };
-                mask &= mask - 1;
-                if !ORDERED {
-                    prefetch(nodes, tris, &c1);
-                    push!(c1);
-                    while mask != 0 {
-                        let k = mask.trailing_zeros();
-                        let c = child_item(node, k, tmin[k as usize]);
-                        prefetch(nodes, tris, &c);
-                        push!(c);
-                        mask &= mask - 1;
-                    }
-                    cur = c0;
-                    continue;
-                }
-                if mask == 0 {
-                    let (near, far) = if c1.dist < c0.dist {
-                        (c1, c0)
-                    } else {
-                        (c0, c1)
-                    };
-                    prefetch(nodes, tris, &far);
-                    push!(far);
-                    cur = near;
-                    continue;
-                }
-                // Three or more: push all, sort the new entries by decreasing distance (the
-                // nearest on top) and continue with the nearest.
-                let first = sp;
-                push!(c0);
-                push!(c1);
                 while mask != 0 {
-                    push!({
-                        let k = mask.trailing_zeros();
-                        child_item(node, k, tmin[k as usize])
-                    });
+                    push!(idx(mask.trailing_zeros()) as Key);
                     mask &= mask - 1;
-                }
-                // SAFETY: entries first..sp were just written.
-                unsafe {
-                    for i in first + 1..sp {
-                        let x = stack.get_unchecked(i).assume_init();
-                        let mut j = i;
-                        while j > first
-                            && stack.get_unchecked(j - 1).assume_init_ref().dist < x.dist
-                        {
-                            let y = stack.get_unchecked(j - 1).assume_init();
-                            stack.get_unchecked_mut(j).write(y);
-                            j -= 1;
-                        }
-                        stack.get_unchecked_mut(j).write(x);
-                    }
-                    for i in first..sp - 1 {
-                        prefetch(nodes, tris, stack.get_unchecked(i).assume_init_ref());
-                    }
-                    sp -= 1;
-                    cur = stack.get_unchecked(sp).assume_init();
                 }
                 continue;
             }
-        } else {
-            match leaf_fn(cur.idx, (cur.leaf & 7).count_ones(), t_max) {
-                Some(t) => t_max = t,
-                None => return,
+            let c0 = key(mask.trailing_zeros());
+            mask &= mask - 1;
+            if mask == 0 {
+                cur = c0 as u32;
+                continue;
             }
-        }
-        // Pop the nearest entry that can still hold a hit.
-        loop {
-            if sp == 0 {
-                return;
+            let c1 = key(mask.trailing_zeros());
+            mask &= mask - 1;
+            let (near, far) = (c0.min(c1), c0.max(c1));
+            if mask == 0 {
+                push!(far);
+                cur = near as u32;
+                continue;
+            }
+            // Three or more: push all, sorted by decreasing key (the nearest on top), and
+            // continue with the nearest.
+            let first = sp;
+            push!(far);
+            push!(near);
+            while mask != 0 {
+                let x = key(mask.trailing_zeros());
+                mask &= mask - 1;
+                debug_assert!(sp < STACK_SIZE);
+                // SAFETY: entries first..sp were just written; j stays in first..=sp, and sp
+                // is below STACK_SIZE as in `push!`.
+                unsafe {
+                    let mut j = sp;
+                    while j > first && stack.get_unchecked(j - 1).assume_init() < x {
+                        let y = stack.get_unchecked(j - 1).assume_init();
+                        stack.get_unchecked_mut(j).write(y);
+                        j -= 1;
+                    }
+                    stack.get_unchecked_mut(j).write(x);
+                }
+                sp += 1;
             }
             sp -= 1;
+            // SAFETY: entry sp was written.
+            cur = unsafe { stack.get_unchecked(sp).assume_init() } as u32;
+            continue;
+        }
+        // Pop the nearest entry that can still hold a hit.
+        while sp != 0 {
+            sp -= 1;
             // SAFETY: entries below sp were written.
-            let it = unsafe { stack.get_unchecked(sp).assume_init() };
-            if !ORDERED || it.dist <= t_max {
-                cur = it;
-                break;
+            let k = unsafe { stack.get_unchecked(sp).assume_init() };
+            if !ORDERED || k <= cull {
+                cur = k as u32;
+                continue 'nodes;
             }
         }
+        return;
     }
 }
 
 /// [`super::prim::intersect_triangle`] with the vertex transform and the edge functions in SIMD (the
 /// three vertices in three lanes); every operation and its rounding is the same as in the
-/// scalar test, so the results are bit-identical.
+/// scalar test, so the results are bit-identical. `v` may also be the marker of a non-triangle
+/// primitive (NaN first vertex), which is then tested from `others`.
 #[cfg(all(
     target_arch = "x86_64",
     target_feature = "avx2",
@@ -441,6 +442,7 @@ fn intersect_triangle_simd<const KZ: usize>(
     r: &RayPre,
     t_max: f32,
     v: &[Vec3; 3],
+    others: &[Prim],
 ) -> Option<PrimT> {
     use std::arch::x86_64::*;
     let kx = (KZ + 1) % 3;
@@ -488,6 +490,11 @@ fn intersect_triangle_simd<const KZ: usize>(
         let pos = _mm_movemask_ps(_mm_cmpgt_ps(e, zero)) & 7;
         if neg != 0 && pos != 0 {
             return None;
+        }
+        // A marker for a non-triangle primitive (see `SceneGeometry::tris`) gets here: its first
+        // vertex is NaN, so two of its edge functions are NaN and the sign test cannot reject it.
+        if v[0].x.is_nan() {
+            return others[v[1].x.to_bits() as usize].intersect::<KZ>(r, t_max);
         }
         let mut xa = [0.0f32; 4];
         let mut ya = [0.0f32; 4];
@@ -815,48 +822,97 @@ impl SceneGeometry {
         })
     }
 
-    #[inline]
+    #[inline(always)]
     fn ray_ok(origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO && t_max > 0.0
+        let (o, d) = (Vec3A::from(origin), Vec3A::from(dir));
+        let inf = Vec3A::splat(f32::INFINITY);
+        // NaN compares false, so this also rejects NaN components.
+        (o.abs().cmplt(inf) & d.abs().cmplt(inf)).all() && d.cmpne(Vec3A::ZERO).any() && t_max > 0.0
     }
 
     /// Closest hit with `t` in `(0, t_max)` (`t_max` may be `f32::INFINITY`). `dir` need not be
     /// normalized (any finite non-zero vector); `t` is in units of `|dir|`. Returns `None` for
     /// a miss or an invalid ray (non-finite, zero direction).
+    ///
+    /// This is [`SceneGeometry::intersect_basic`]'s traversal followed by the full hit record
+    /// (point, unit normals, shading normal, error bounds).
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
         if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
             return None;
         }
         let pre = RayPre::new(origin, dir);
+        let (prim, t, a, b) = self.closest_dyn(&pre, t_max)?;
+        Some(self.make_hit(prim, &pre, t, a, b))
+    }
+
+    /// The closest hit as Embree's `rtcIntersect1` reports it: `t`, the surface parameters,
+    /// the unnormalized geometric normal, and the primitive and object ids. Same hits and
+    /// conventions as [`SceneGeometry::intersect`], without building the full [`Hit`].
+    pub fn intersect_basic(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<RayHit> {
+        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+            return None;
+        }
+        let pre = RayPre::new(origin, dir);
+        let (prim, t, u, v) = self.closest_dyn(&pre, t_max)?;
+        let tri = &self.tris[prim as usize];
+        let ng = if tri[0].x.is_nan() {
+            self.prim(prim).normal_at(origin + t * dir)
+        } else {
+            (tri[1] - tri[0]).cross(tri[2] - tri[0])
+        };
+        Some(RayHit {
+            t,
+            u,
+            v,
+            ng,
+            prim,
+            object: self.prim_object[prim as usize],
+        })
+    }
+
+    /// Closest-hit traversal: (primitive, t, a, b) of the closest hit.
+    #[inline(always)]
+    fn closest_dyn(&self, pre: &RayPre, t_max: f32) -> Option<(u32, f32, f32, f32)> {
         match pre.kz {
-            0 => self.closest::<0>(&pre, t_max),
-            1 => self.closest::<1>(&pre, t_max),
-            _ => self.closest::<2>(&pre, t_max),
+            0 => self.closest::<0>(pre, t_max),
+            1 => self.closest::<1>(pre, t_max),
+            _ => self.closest::<2>(pre, t_max),
         }
     }
 
     #[inline(always)]
-    fn closest<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> Option<Hit> {
-        let mut best = u32::MAX;
-        let (mut tbest, mut ba, mut bb) = (t_max, 0.0f32, 0.0f32);
-        traverse::<true>(
-            &self.bvh,
-            &self.tris,
-            pre.o,
-            pre.d,
-            t_max,
-            |first, count, mut tmax| {
-                for id in first..first + count {
-                    if let Some((t, a, b)) = self.prim_intersect::<KZ>(id, pre, tmax) {
-                        best = id;
-                        (tbest, ba, bb) = (t, a, b);
-                        tmax = t;
+    fn closest<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> Option<(u32, f32, f32, f32)> {
+        struct Closest<'a, const KZ: usize> {
+            geo: &'a SceneGeometry,
+            pre: &'a RayPre,
+            best: (u32, f32, f32, f32),
+        }
+        impl<const KZ: usize> LeafTest for Closest<'_, KZ> {
+            #[inline(always)]
+            fn leaf(&mut self, first: u32, unary: u32, mut t_max: f32) -> Option<f32> {
+                let (mut id, mut u) = (first, unary);
+                while u != 0 {
+                    if let Some((t, a, b)) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max) {
+                        self.best = (id, t, a, b);
+                        t_max = t;
                     }
+                    id += 1;
+                    u >>= 1;
                 }
-                Some(tmax)
-            },
-        );
-        (best != u32::MAX).then(|| self.make_hit(best, pre, tbest, ba, bb))
+                Some(t_max)
+            }
+            #[inline(always)]
+            fn prefetch(&self, first: u32) {
+                prefetch(self.geo.tris.as_ptr().wrapping_add(first as usize) as *const u8);
+            }
+        }
+        let mut c = Closest::<KZ> {
+            geo: self,
+            pre,
+            best: (u32::MAX, t_max, 0.0, 0.0),
+        };
+        traverse::<true>(&self.bvh.nodes, pre.o, pre.d, t_max, &mut c);
+        (c.best.0 != u32::MAX).then_some(c.best)
     }
 
     /// Ray test of primitive `id` (a leaf primitive id from the traversal).
@@ -865,20 +921,20 @@ impl SceneGeometry {
         debug_assert!((id as usize) < self.tris.len());
         // SAFETY: leaf primitive ids index `tris` (same length as the builder's input).
         let v = unsafe { self.tris.get_unchecked(id as usize) };
+        #[cfg(all(
+            target_arch = "x86_64",
+            target_feature = "avx2",
+            target_feature = "fma"
+        ))]
+        return intersect_triangle_simd::<KZ>(pre, t_max, v, &self.others);
+        #[cfg(not(all(
+            target_arch = "x86_64",
+            target_feature = "avx2",
+            target_feature = "fma"
+        )))]
         if v[0].x.is_nan() {
             self.others[v[1].x.to_bits() as usize].intersect::<KZ>(pre, t_max)
         } else {
-            #[cfg(all(
-                target_arch = "x86_64",
-                target_feature = "avx2",
-                target_feature = "fma"
-            ))]
-            return intersect_triangle_simd::<KZ>(pre, t_max, v);
-            #[cfg(not(all(
-                target_arch = "x86_64",
-                target_feature = "avx2",
-                target_feature = "fma"
-            )))]
             super::prim::intersect_triangle::<KZ>(pre, t_max, v)
         }
     }
@@ -897,8 +953,12 @@ impl SceneGeometry {
     /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
     /// brute-force tests).
     fn make_hit(&self, prim: u32, pre: &RayPre, t: f32, a: f32, b: f32) -> Hit {
-        let p = self.prim(prim);
-        let g = p.hit_geom(pre, t, a, b);
+        let v = &self.tris[prim as usize];
+        let g = if v[0].x.is_nan() {
+            self.others[v[1].x.to_bits() as usize].hit_geom(pre, t, a, b)
+        } else {
+            super::prim::triangle_hit_geom(v, a, b)
+        };
         let mut ns = g.ng;
         if let Some(idx) = self.prim_normals.get(prim as usize) {
             if idx[0] != u32::MAX {
@@ -940,24 +1000,37 @@ impl SceneGeometry {
 
     #[inline(always)]
     fn any_hit<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> bool {
-        let mut hit = false;
-        traverse::<false>(
-            &self.bvh,
-            &self.tris,
-            pre.o,
-            pre.d,
-            t_max,
-            |first, count, tmax| {
-                for id in first..first + count {
-                    if self.prim_intersect::<KZ>(id, pre, tmax).is_some() {
-                        hit = true;
+        struct AnyHit<'a, const KZ: usize> {
+            geo: &'a SceneGeometry,
+            pre: &'a RayPre,
+            hit: bool,
+        }
+        impl<const KZ: usize> LeafTest for AnyHit<'_, KZ> {
+            #[inline(always)]
+            fn leaf(&mut self, first: u32, unary: u32, t_max: f32) -> Option<f32> {
+                let (mut id, mut u) = (first, unary);
+                while u != 0 {
+                    if self.geo.prim_intersect::<KZ>(id, self.pre, t_max).is_some() {
+                        self.hit = true;
                         return None;
                     }
+                    id += 1;
+                    u >>= 1;
                 }
-                Some(tmax)
-            },
-        );
-        hit
+                Some(t_max)
+            }
+            #[inline(always)]
+            fn prefetch(&self, first: u32) {
+                prefetch(self.geo.tris.as_ptr().wrapping_add(first as usize) as *const u8);
+            }
+        }
+        let mut a = AnyHit::<KZ> {
+            geo: self,
+            pre,
+            hit: false,
+        };
+        traverse::<false>(&self.bvh.nodes, pre.o, pre.d, t_max, &mut a);
+        a.hit
     }
 
     /// Brute force closest hit over all primitives (no BVH) — for tests and debugging.
