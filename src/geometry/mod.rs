@@ -45,7 +45,7 @@ pub use robust::{
     gamma, next_float_down, next_float_up, offset_ray_origin, point_error_bound, shadow_ray,
     shadow_ray_between, MACHINE_EPSILON, SHADOW_EPSILON,
 };
-pub use scene::SceneGeometry;
+pub use scene::{RayHit, SceneGeometry};
 
 use glam::{Affine3A, Mat3, Quat, Vec2, Vec3};
 use std::path::PathBuf;
