@@ -596,7 +596,7 @@ fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()
     }
     let (p0, first) = &loaded[0];
     let mut film = first.film.clone();
-    let mut seeds = vec![first.seed];
+    let mut seeds = first.seeds();
     for (p, s) in &loaded[1..] {
         if s.scene_hash != first.scene_hash
             || s.film.width != film.width
@@ -609,14 +609,13 @@ fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()
                 p.display()
             );
         }
-        if seeds.contains(&s.seed) {
+        if let Some(seed) = s.seeds().into_iter().find(|x| seeds.contains(x)) {
             bail!(
-                "{} repeats seed {} of another input: renders with the same seed take the same samples, so merging them would not add information; render with different --seed values",
-                p.display(),
-                s.seed
+                "{} repeats seed {seed} of another input (directly or inside a merged state): renders with the same seed take the same samples, so merging them would count those samples twice; render with different --seed values",
+                p.display()
             );
         }
-        seeds.push(s.seed);
+        seeds.extend(s.seeds());
         film.merge(&s.film);
     }
     let stem = match out.extension().and_then(|e| e.to_str()) {
@@ -646,6 +645,7 @@ fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()
     write_png(&film, &with_suffix(&stem, ".png"), exposure)?;
     let merged = candela::state::RenderState {
         seed: seeds[0],
+        merged_seeds: seeds[1..].to_vec(),
         film,
         ..first.clone()
     };

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &str = "candela-render-state";
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RenderState {
@@ -26,6 +26,16 @@ pub struct RenderState {
     pub max_depth: u32,
     pub illuminance: bool,
     pub film: Film,
+    /// The other seeds a merged state contains (`candela merge`; empty for one render), so a
+    /// later merge can refuse a seed that is already in it.
+    pub merged_seeds: Vec<u64>,
+}
+
+/// The leading fields of every version, read first so an old file gets a clear message.
+#[derive(Deserialize)]
+struct Header {
+    magic: String,
+    version: u32,
 }
 
 /// Hash of the scene text, the contents of every file it refers to ([`World::sources`]) and the
@@ -71,7 +81,15 @@ impl RenderState {
             max_depth: world.settings.max_depth,
             illuminance: world.settings.illuminance,
             film,
+            merged_seeds: Vec::new(),
         }
+    }
+
+    /// Every seed whose samples this state holds.
+    pub fn seeds(&self) -> Vec<u64> {
+        std::iter::once(self.seed)
+            .chain(self.merged_seeds.iter().copied())
+            .collect()
     }
 
     pub fn save(&self, path: &Path) -> anyhow::Result<()> {
@@ -83,6 +101,14 @@ impl RenderState {
     pub fn load(path: &Path) -> anyhow::Result<Self> {
         let bytes = std::fs::read(path)
             .map_err(|e| anyhow::anyhow!("cannot read state file {}: {e}", path.display()))?;
+        if let Ok((h, _)) = postcard::take_from_bytes::<Header>(&bytes) {
+            anyhow::ensure!(
+                h.magic != MAGIC || h.version == VERSION,
+                "{} is a candela render state of format version {}; this candela reads version {VERSION} (finish or merge it with the candela that wrote it, or render again)",
+                path.display(),
+                h.version
+            );
+        }
         let s: RenderState = postcard::from_bytes(&bytes).map_err(|e| {
             anyhow::anyhow!(
                 "{} is not a candela render state (or is corrupt or truncated): {e}",

@@ -201,9 +201,12 @@ fn merge_combines_two_seeds() {
     for i in 0..m.len() {
         assert!((m[i] - 0.5 * (a[i] + b[i])).abs() <= 1e-5 * m[i].abs().max(1.0));
     }
-    // The same seed twice is refused.
+    // The same seed twice is refused, also when one input is itself a merge containing it.
     let o = candela(dir.path(), &["merge", "r1.state", "r1.state", "-o", "m2"]);
     assert_eq!(o.status.code(), Some(1));
+    let o = candela(dir.path(), &["merge", "m.state", "r2.state", "-o", "m3"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("repeats seed 2"));
 }
 
 #[test]

@@ -138,6 +138,31 @@ fn corrupt_state_file_is_an_error() {
 }
 
 #[test]
+fn state_of_an_older_format_version_is_refused_by_name() {
+    // A version-2 file: the current fields minus the merged-seed list, so postcard alone would
+    // only report a truncated file.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("old.state");
+    let mut st = candela::state::RenderState::new(
+        std::path::Path::new("s.ron"),
+        7,
+        &world(FURNACE),
+        Film::new(2, 2),
+    );
+    st.version = 2;
+    let mut bytes = postcard::to_stdvec(&st).unwrap();
+    bytes.pop(); // the empty merged-seed list's length byte
+    std::fs::write(&path, bytes).unwrap();
+    let e = candela::state::RenderState::load(&path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("old.state") && e.contains("format version 2"),
+        "{e}"
+    );
+}
+
+#[test]
 fn adaptive_buffers_have_independent_illuminance_samples() {
     // The decision buffer decides when a pixel stops; if its illuminance samples repeated the
     // image's, the stopping time would depend on the image's own estimate (biased). A floor
