@@ -5,7 +5,7 @@ mod common;
 use candela::bxdf::{Frame, Material};
 use candela::scene::{load_world, Overrides};
 use candela::spectrum::SampledWavelengths;
-use common::{assert_every_pixel, image_mean, render, world};
+use common::{assert_every_pixel, image_mean, pixel_footprint_mean, render, world};
 use glam::{Vec2, Vec3};
 use std::path::Path;
 
@@ -109,19 +109,7 @@ fn glass_sphere_truncated_furnace() {
         let (mut sum_d, mut var_d, mut sum_e) = (0.0, 0.0, 0.0);
         for y in 0..res {
             for x in 0..res {
-                let n = 16;
-                let mut e = 0.0;
-                for j in 0..n {
-                    for i in 0..n {
-                        let r = w.camera.generate_ray(
-                            x as f32 + (i as f32 + 0.5) / n as f32,
-                            y as f32 + (j as f32 + 0.5) / n as f32,
-                            Vec2::ZERO,
-                        );
-                        e += expected_ray(r.origin, r.dir);
-                    }
-                }
-                e /= (n * n) as f64;
+                let e = pixel_footprint_mean(&w, x, y, expected_ray);
                 let p = &film.pixels[y * res + x];
                 let (v, se) = (p.mean_xyz()[1], p.y_standard_error());
                 sum_d += v - e;

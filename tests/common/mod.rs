@@ -53,9 +53,14 @@ pub fn assert_every_pixel(film: &Film, expected: f64, k: f64) {
     );
 }
 
-/// The box-filter mean of `f` over pixel (x, y)'s footprint on the plane y = 0: a 16×16
-/// midpoint quadrature over the pixel square of points where the camera rays meet the plane.
-pub fn floor_footprint_mean(w: &World, x: usize, y: usize, f: impl Fn(glam::Vec3) -> f64) -> f64 {
+/// The box-filter mean of `f(origin, direction)` over the camera rays of pixel (x, y): a 16×16
+/// midpoint quadrature over the pixel square.
+pub fn pixel_footprint_mean(
+    w: &World,
+    x: usize,
+    y: usize,
+    f: impl Fn(glam::Vec3, glam::Vec3) -> f64,
+) -> f64 {
     let n = 16;
     let mut sum = 0.0;
     for j in 0..n {
@@ -65,8 +70,14 @@ pub fn floor_footprint_mean(w: &World, x: usize, y: usize, f: impl Fn(glam::Vec3
                 y as f32 + (j as f32 + 0.5) / n as f32,
                 glam::Vec2::ZERO,
             );
-            sum += f(r.origin + r.dir * (-r.origin.y / r.dir.y));
+            sum += f(r.origin, r.dir);
         }
     }
     sum / (n * n) as f64
+}
+
+/// The box-filter mean of `f` over pixel (x, y)'s footprint on the plane y = 0: the points
+/// where the pixel's camera rays meet the plane (see [`pixel_footprint_mean`]).
+pub fn floor_footprint_mean(w: &World, x: usize, y: usize, f: impl Fn(glam::Vec3) -> f64) -> f64 {
+    pixel_footprint_mean(w, x, y, |o, d| f(o + d * (-o.y / d.y)))
 }
