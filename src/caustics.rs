@@ -52,7 +52,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// The lights light tracing starts paths from (all at a finite position), chosen in
+/// The lights light tracing starts paths from (all but environments), chosen in
 /// proportion to their luminous power, and where their paths are aimed.
 #[derive(Clone, Debug)]
 pub struct CausticLights {
@@ -114,7 +114,7 @@ fn sphere_of_box(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
 
 impl CausticLights {
     /// `targets`: bounding spheres of the objects whose material has a delta lobe. None when
-    /// light tracing has nothing to do: no such object, or no light at a finite position with
+    /// light tracing has nothing to do: no such object, or no light other than an environment with
     /// power.
     pub fn new(
         lights: &[Light],
@@ -139,9 +139,7 @@ impl CausticLights {
         let mut powers = Vec::new();
         for (i, l) in lights.iter().enumerate() {
             let p = l.power_lm(geom, scene_radius);
-            // Distant lights (the sun) too: their paths start on the targets' shadow disks.
-            let emits = l.can_emit_paths() || matches!(l, Light::Distant { .. });
-            if emits && p > 0.0 && p.is_finite() {
+            if l.can_emit_paths() && p > 0.0 && p.is_finite() {
                 chosen.push(i as u32);
                 powers.push(p);
             }
@@ -176,19 +174,15 @@ impl CausticLights {
     /// disks containing the point) / (sum of the disks' areas).
     fn sample_parallel(&self, dir: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32)> {
         use std::f32::consts::PI;
-        let total: f32 = self.targets.iter().map(|(_, r)| PI * r * r).sum();
+        let area = |&(_, r): &(Vec3, f32)| PI * r * r;
+        let total: f32 = self.targets.iter().map(area).sum();
         if total.is_nan() || total <= 0.0 {
             return None;
         }
-        let mut x = uc * total;
-        let mut chosen = self.targets.len() - 1;
-        for (k, (_, r)) in self.targets.iter().enumerate() {
-            if x < PI * r * r {
-                chosen = k;
-                break;
-            }
-            x -= PI * r * r;
-        }
+        let chosen = choose_by_weight(
+            self.targets.iter().map(|t| area(t) as f64),
+            (uc * total) as f64,
+        );
         let (c, r) = self.targets[chosen];
         let (t, b) = dir.any_orthonormal_pair();
         let (rad, phi) = (r * u.x.sqrt(), 2.0 * PI * u.y);
@@ -250,16 +244,7 @@ impl CausticLights {
             ));
         }
         // Choose a cone in proportion to its solid angle.
-        let mut x = uc as f64 * total;
-        let mut chosen = cones.len() - 1;
-        for (k, c) in cones.iter().enumerate() {
-            let omega = 2.0 * PI * c.2;
-            if x < omega {
-                chosen = k;
-                break;
-            }
-            x -= omega;
-        }
+        let chosen = choose_by_weight(cones.iter().map(|c| 2.0 * PI * c.2), uc as f64 * total);
         let (axis, _, omc) = cones[chosen];
         // Uniform within the cone: 1 − cos θ uniform in [0, 1 − cos θmax].
         let omc_t = u.x as f64 * omc;
@@ -287,6 +272,18 @@ impl CausticLights {
     pub fn handles(&self, light: usize) -> bool {
         self.handled.get(light).copied().unwrap_or(false)
     }
+}
+
+/// The index k whose interval [Σ_{j<k} w_j, Σ_{j≤k} w_j) contains `x` (the last on round-off).
+fn choose_by_weight(weights: impl ExactSizeIterator<Item = f64>, mut x: f64) -> usize {
+    let last = weights.len().saturating_sub(1);
+    for (k, w) in weights.enumerate() {
+        if x < w {
+            return k;
+        }
+        x -= w;
+    }
+    last
 }
 
 /// One camera connection of a light path: its film position and its contribution (absolute

@@ -43,7 +43,7 @@ pub const DEFAULT_LIGHT_PATHS_PER_SAMPLE: f32 = 0.0625;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Caustics {
     /// Traced from the lights and connected to the camera (see [`crate::caustics`]); used
-    /// when the scene has a delta-lobe material and a light at a finite position.
+    /// when the scene has a delta-lobe material and a light other than an environment.
     #[default]
     LightTracing,
     /// Left to the camera paths' BSDF sampling (misses point-light caustics entirely).

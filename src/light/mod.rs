@@ -102,9 +102,11 @@ pub struct EmissionPoint {
 
 impl Light {
     /// Whether light tracing can start paths at this light: sources at a finite position
-    /// (area, point, spot, goniometric). Lights at infinity cannot.
+    /// (area, point, spot, goniometric; from [`Light::sample_emission_point`]) and distant
+    /// lights (parallel beams, started across the scene by [`crate::caustics`]). An
+    /// environment cannot.
     pub fn can_emit_paths(&self) -> bool {
-        !matches!(self, Light::Distant { .. } | Light::Environment { .. })
+        !matches!(self, Light::Environment { .. })
     }
 
     /// Sample the point light leaves from (light tracing): uniform by area on an area light
