@@ -5,7 +5,9 @@ mod common;
 use candela::bxdf::{Frame, Material};
 use candela::scene::{load_world, Overrides};
 use candela::spectrum::SampledWavelengths;
-use common::{assert_every_pixel, image_mean, pixel_footprint_mean, render, world};
+use common::{
+    assert_every_pixel, fresnel_unpolarised, image_mean, pixel_footprint_mean, render, world,
+};
 use glam::{Vec2, Vec3};
 use std::path::Path;
 
@@ -59,16 +61,6 @@ fn white_furnace_rough_materials_gain_nothing() {
         );
         assert!(mean[1] > 0.5, "{m}: {} implausibly dark", mean[1]);
     }
-}
-
-/// Unpolarised Fresnel reflectance of a smooth dielectric (relative index `eta`) at incidence
-/// cosine `cos_i` (from outside), written out here independently of the renderer's.
-fn fresnel_unpolarised(cos_i: f64, eta: f64) -> f64 {
-    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
-    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    0.5 * (rs * rs + rp * rp)
 }
 
 #[test]

@@ -370,11 +370,7 @@ fn sunlight_through_a_window_pane_is_light_traced() {
     let film = render(&w, 2);
     let to_sun = -sun.normalize();
     let cos = to_sun.y as f64;
-    let (eta, c) = (1.5f64, cos);
-    let cos_t = (1.0 - (1.0 - c * c) / (eta * eta)).sqrt();
-    let rs = (c - eta * cos_t) / (c + eta * cos_t);
-    let rp = (eta * c - cos_t) / (eta * c + cos_t);
-    let r = 0.5 * (rs * rs + rp * rp);
+    let r = fresnel_unpolarised(cos, 1.5);
     let t = (1.0 - r) / (1.0 + r);
     let e_floor = |p: Vec3| {
         let q = p + to_sun * ((1.0 - p.y) / to_sun.y);

@@ -81,3 +81,13 @@ pub fn pixel_footprint_mean(
 pub fn floor_footprint_mean(w: &World, x: usize, y: usize, f: impl Fn(glam::Vec3) -> f64) -> f64 {
     pixel_footprint_mean(w, x, y, |o, d| f(o + d * (-o.y / d.y)))
 }
+
+/// Unpolarised Fresnel reflectance of a smooth dielectric (relative index `eta`) at incidence
+/// cosine `cos_i` (from outside), written out here independently of the renderer's.
+pub fn fresnel_unpolarised(cos_i: f64, eta: f64) -> f64 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
