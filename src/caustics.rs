@@ -22,6 +22,11 @@
 //! non-specular vertex to the light, so it keeps all of its own). Each estimator is unbiased on
 //! its part, so the sum is unbiased, without MIS weights. Paths the camera sees through glass
 //! (camera-side vertex specular) stay with the camera paths. The same max depth applies.
+//! Passing straight through a window pane ([`crate::bxdf::Material::passes_straight`]) is a
+//! null event on both sides, not a scattering: it neither counts as a vertex nor decides the
+//! split, and next-event estimation and the camera connections cross panes with their
+//! transmittance ([`crate::integrator::transmittance`]). Sunlight through a window is thus the
+//! camera paths' (light sampling) part; the pane's mirror reflection stays light tracing's.
 //!
 //! **Estimator.** A light path starts at a point on a light and leaves toward the bounding
 //! sphere of one of the objects that can scatter specularly (the other directions cannot start
@@ -43,10 +48,10 @@
 use crate::bxdf::Frame;
 use crate::film::radiance_to_xyz;
 use crate::geometry::SceneGeometry;
-use crate::integrator::RayStats;
+use crate::integrator::{transmittance, RayStats, MAX_STRAIGHT_THROUGH};
 use crate::light::{pick_from_cdf, Light};
 use crate::sampler::Sampler;
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -472,6 +477,8 @@ pub fn trace_light_path(
     let camera = &world.camera;
     // Scattering events so far, counting the surface being processed.
     let mut depth = 0u32;
+    // Null events (straight through window panes) so far.
+    let mut straight_through = 0u32;
     loop {
         stats.light_rays += 1;
         let Some(hit) = world.geometry.intersect(ray_o, ray_d, f32::INFINITY) else {
@@ -499,36 +506,68 @@ pub fn trace_light_path(
         if depth >= 2 && (want_l || want_e) {
             if let Some(c) = camera.connect(hit.p, Vec2::new(lx, ly), filter.radius()) {
                 let cos_cam = c.wi.dot(hit.ng).abs();
-                let mut xyz = [0.0f64; 3];
+                let mut l = SampledSpectrum::ZERO;
                 if want_l {
                     let wi = frame.to_local(c.wi);
                     // Radiance convention: out toward the camera, in from the light.
                     let f = material.eval(wi, wo, &wl);
                     let g = cos_cam * wo_world.dot(hit.ns).abs() / wo_world.dot(hit.ng).abs();
                     if !f.is_black() && g > 0.0 && g.is_finite() {
-                        xyz = radiance_to_xyz(&(beta * f * (g * c.importance)), &wl);
+                        l = beta * f * (g * c.importance);
                     }
                 }
-                let mut e = 0.0f64;
+                let mut e = SampledSpectrum::ZERO;
                 if want_e && c.wi.dot(hit.ng) * wo_world.dot(hit.ng) > 0.0 {
-                    e = radiance_to_xyz(&(beta * (cos_cam * c.importance)), &wl)[1];
+                    e = beta * (cos_cam * c.importance);
                 }
-                if !(xyz.iter().all(|v| v.is_finite()) && e.is_finite()) {
-                    stats.non_finite += 1;
-                } else if xyz[1] != 0.0 || xyz[0] != 0.0 || xyz[2] != 0.0 || e != 0.0 {
+                if !(l.is_black() && e.is_black()) {
                     stats.shadow_rays += 1;
                     let origin = hit.spawn_origin(c.wi);
                     let t_max = (c.lens_point - origin).length();
-                    if !world.geometry.occluded(origin, c.wi, t_max) {
-                        splats.push(Splat {
-                            path: index,
-                            film: c.film,
-                            xyz,
-                            e,
-                        });
+                    // Through window panes with their transmittance, as the camera paths
+                    // see through them (a pane's straight transmission is a null event).
+                    if let Some(tr) = transmittance(world, origin, c.wi, t_max, &wl) {
+                        let xyz = radiance_to_xyz(&(l * tr), &wl);
+                        let e = radiance_to_xyz(&(e * tr), &wl)[1];
+                        if !(xyz.iter().all(|v| v.is_finite()) && e.is_finite()) {
+                            stats.non_finite += 1;
+                        } else if xyz.iter().any(|&v| v != 0.0) || e != 0.0 {
+                            splats.push(Splat {
+                                path: index,
+                                film: c.film,
+                                xyz,
+                                e,
+                            });
+                        }
                     }
                 }
             }
+        }
+
+        // A window pane: passing straight through is a null event, as for the camera paths
+        // (not a scattering: the depth and the "first scattering is specular" rule are those
+        // of the path without it). The illuminance on the pane itself was recorded above, on
+        // arrival, whichever lobe is then chosen.
+        let mut chosen = None;
+        if material.passes_straight() {
+            let [ux, uy, uc, _] = sampler.get4();
+            let Some(bs) = material.sample(wo, uc, Vec2::new(ux, uy), &mut wl) else {
+                return;
+            };
+            if bs.pdf.is_nan() || bs.pdf <= 0.0 {
+                return;
+            }
+            if material.is_straight_through(wo, bs.wi) {
+                beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+                depth -= 1;
+                straight_through += 1;
+                if beta.is_black() || straight_through > MAX_STRAIGHT_THROUGH {
+                    return;
+                }
+                ray_o = hit.spawn_origin(ray_d);
+                continue;
+            }
+            chosen = Some(bs);
         }
 
         // Continue while a further surface is within the depth limit; the first scattering
@@ -538,7 +577,8 @@ pub fn trace_light_path(
             return;
         }
         let [ux, uy, uc, u_rr] = sampler.get4();
-        let Some(bs) = material.sample(wo, uc, Vec2::new(ux, uy), &mut wl) else {
+        let Some(bs) = chosen.or_else(|| material.sample(wo, uc, Vec2::new(ux, uy), &mut wl))
+        else {
             return;
         };
         if (depth == 1 && !bs.specular) || bs.pdf.is_nan() || bs.pdf <= 0.0 {

@@ -120,6 +120,8 @@ pub fn trace(
     // specular scattering are light tracing's part (see `crate::caustics`).
     // (A receiver's path, started at depth 1, begins at that non-specular receiver.)
     let mut first_non_specular = start.depth >= 1;
+    // Null events (straight through window panes) on the path so far.
+    let mut straight_through = 0u32;
 
     loop {
         let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
@@ -164,21 +166,47 @@ pub fn trace(
             }
         }
 
-        if depth >= settings.max_depth {
-            break;
-        }
         let material = &world.materials[object.material as usize];
         if material.is_black() {
             break;
         }
-
-        material.prepare(wl);
         let frame = Frame::from_normal(hit.ns);
         let wo_world = -ray_d;
         let wo = frame.to_local(wo_world);
         if wo.z == 0.0 {
             break;
         }
+
+        // A window pane: its lobe is chosen first. Passing straight through is a null event
+        // (no scattering vertex: depth, MIS state and the caustic partition stay those of the
+        // last real vertex), which matches next-event estimation, whose shadow rays pass
+        // through the pane with its transmittance (see `transmittance`).
+        let mut chosen = None;
+        if material.passes_straight() {
+            let [ux, uy, uc, _] = sampler.get4();
+            let Some(bs) = material.sample(wo, uc, glam::Vec2::new(ux, uy), wl) else {
+                break;
+            };
+            if bs.pdf.is_nan() || bs.pdf <= 0.0 {
+                break;
+            }
+            if material.is_straight_through(wo, bs.wi) {
+                beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+                straight_through += 1;
+                if beta.is_black() || straight_through > MAX_STRAIGHT_THROUGH {
+                    break;
+                }
+                ray_o = hit.spawn_origin(ray_d);
+                stats.bounce_rays += 1;
+                continue;
+            }
+            chosen = Some(bs);
+        }
+
+        if depth >= settings.max_depth {
+            break;
+        }
+        material.prepare(wl);
 
         // Next-event estimation. Each bounce takes two sets of four dimensions, each led by its
         // 2-D pair (see `Sampler`): the point on the light, then the BSDF direction.
@@ -197,14 +225,16 @@ pub fn trace(
                     let f = material.eval(wo, wi, wl) * wi.z.abs();
                     if !f.is_black() {
                         stats.shadow_rays += 1;
-                        if unoccluded(world, &RayStart::surface(&hit), &ls) {
+                        if let Some(tr) =
+                            shadow_transmittance(world, &RayStart::surface(&hit), &ls, wl)
+                        {
                             let pdf = p_select * ls.pdf;
                             let w = if ls.delta {
                                 1.0
                             } else {
                                 power_heuristic(pdf, material.pdf(wo, wi, wl))
                             };
-                            l += beta * f * ls.li * (w / pdf);
+                            l += beta * f * tr * ls.li * (w / pdf);
                         }
                     }
                 }
@@ -214,7 +244,7 @@ pub fn trace(
         // Continue the path by sampling the BSDF.
         let [ux, uy, uc, u_rr] = sampler.get4();
         let u = glam::Vec2::new(ux, uy);
-        let Some(bs) = material.sample(wo, uc, u, wl) else {
+        let Some(bs) = chosen.or_else(|| material.sample(wo, uc, u, wl)) else {
             break;
         };
         if bs.pdf.is_nan() || bs.pdf <= 0.0 {
@@ -278,8 +308,13 @@ impl RayStart {
     }
 }
 
-/// Shadow test between a point and a light sample.
-fn unoccluded(world: &World, from: &RayStart, ls: &crate::light::LightSample) -> bool {
+/// Transmittance of the shadow ray between a point and a light sample (None when blocked).
+fn shadow_transmittance(
+    world: &World,
+    from: &RayStart,
+    ls: &crate::light::LightSample,
+    wl: &SampledWavelengths,
+) -> Option<SampledSpectrum> {
     let (origin, dir, t_max) = match ls.point {
         Some((p, n)) => shadow_ray_between(from.p, from.error, from.ng, p, point_error_bound(p), n),
         None => {
@@ -292,7 +327,53 @@ fn unoccluded(world: &World, from: &RayStart, ls: &crate::light::LightSample) ->
             (origin, ls.wi, t_max)
         }
     };
-    t_max <= 0.0 || !world.geometry.occluded(origin, dir, t_max)
+    if t_max <= 0.0 {
+        return Some(SampledSpectrum::ONE);
+    }
+    transmittance(world, origin, dir, t_max, wl)
+}
+
+/// Most surfaces a ray passes straight through before it is given up (a guard against
+/// pathological stacks of panes; each costs a ray).
+pub const MAX_STRAIGHT_THROUGH: u32 = 64;
+
+/// Spectral transmittance of the segment from `origin` along unit `dir` up to `t_max`: `None`
+/// when an opaque surface blocks it, else the product of the straight-through transmittances
+/// ([`crate::bxdf::Material::straight_transmittance`]) of the window panes it crosses (one
+/// when it crosses none). Without see-through materials in the world this is one any-hit
+/// query.
+pub fn transmittance(
+    world: &World,
+    origin: Vec3,
+    dir: Vec3,
+    t_max: f32,
+    wl: &SampledWavelengths,
+) -> Option<SampledSpectrum> {
+    if !world.see_through {
+        return (!world.geometry.occluded(origin, dir, t_max)).then_some(SampledSpectrum::ONE);
+    }
+    let end = origin + dir * t_max;
+    let (mut o, mut t) = (origin, t_max);
+    let mut tr = SampledSpectrum::ONE;
+    for _ in 0..MAX_STRAIGHT_THROUGH {
+        let Some(hit) = world.geometry.intersect(o, dir, t) else {
+            return Some(tr);
+        };
+        let object = world.objects[hit.object as usize];
+        let material = &world.materials[object.material as usize];
+        tr *= material.straight_transmittance(dir.dot(hit.ns), wl)?;
+        if tr.is_black() {
+            return None;
+        }
+        o = hit.spawn_origin(dir);
+        if t.is_finite() {
+            t = (end - o).dot(dir);
+            if t.is_nan() || t <= 0.0 {
+                return Some(tr);
+            }
+        }
+    }
+    None
 }
 
 /// Spectral irradiance (W·m⁻²·nm⁻¹) on the hemisphere around unit normal `n` at `at`: light
@@ -324,14 +405,14 @@ pub fn irradiance(
             let cos = ls.wi.dot(n);
             if cos > 0.0 && ls.pdf > 0.0 && !ls.li.is_black() {
                 stats.shadow_rays += 1;
-                if unoccluded(world, at, &ls) {
+                if let Some(tr) = shadow_transmittance(world, at, &ls, wl) {
                     let pdf = p_select * ls.pdf;
                     let w = if ls.delta {
                         1.0
                     } else {
                         power_heuristic(pdf, cos * FRAC_1_PI)
                     };
-                    e += ls.li * (cos * w / pdf);
+                    e += tr * ls.li * (cos * w / pdf);
                 }
             }
         }

@@ -67,6 +67,10 @@ impl Default for RenderSettings {
 
 pub struct World {
     pub geometry: SceneGeometry,
+    /// Whether some object's material passes light straight through (a window pane, see
+    /// [`crate::bxdf::Material::passes_straight`]): shadow rays then carry a transmittance
+    /// ([`crate::integrator::transmittance`]) instead of a plain occlusion test.
+    pub see_through: bool,
     pub objects: Vec<Object>,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,

@@ -164,6 +164,36 @@ impl Material {
             _ => 1.0,
         }
     }
+    /// Whether the material can pass light *straight through* (transmission that keeps the
+    /// direction: a thin slab). The integrators treat such a transmission as a null event: it
+    /// is not a scattering vertex (no depth, no MIS state, no caustic), and shadow rays pass
+    /// through the surface weighted by [`Material::straight_transmittance`], so that light
+    /// sampling sees the sun or a lamp through a window pane.
+    #[inline]
+    pub fn passes_straight(&self) -> bool {
+        matches!(self, Material::ThinDielectric(_))
+    }
+    /// Whether sampled scattering `wo` → `wi` (local frame) is the straight-through
+    /// transmission of a material that [`passes_straight`](Material::passes_straight).
+    #[inline]
+    pub fn is_straight_through(&self, wo: Vec3, wi: Vec3) -> bool {
+        self.passes_straight() && wo.z * wi.z < 0.0
+    }
+    /// Fraction of radiance that passes straight through the surface at |cos θ| = `cos`
+    /// (against the shading normal, as `sample` measures it), per wavelength; `None` for a
+    /// material that blocks shadow rays. It equals the expected weight of the straight-through
+    /// lobe of `sample`, so light sampling through the surface and BSDF sampling through it
+    /// estimate the same light.
+    pub fn straight_transmittance(
+        &self,
+        cos: f32,
+        wl: &SampledWavelengths,
+    ) -> Option<SampledSpectrum> {
+        match self {
+            Material::ThinDielectric(m) => Some(m.transmittance(cos, wl)),
+            _ => None,
+        }
+    }
     /// True if the material scatters nothing, so paths can stop at it.
     pub fn is_black(&self) -> bool {
         matches!(self, Material::Black)

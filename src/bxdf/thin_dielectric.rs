@@ -24,6 +24,19 @@ pub fn thin_slab_reflectance(cos: f32, eta: f32) -> f32 {
 }
 
 impl ThinDielectric {
+    /// Straight-through transmittance 1 − R' at |cos θ| = `cos`, per wavelength (zero at
+    /// grazing incidence).
+    pub fn transmittance(&self, cos: f32, wl: &SampledWavelengths) -> SampledSpectrum {
+        let c = cos.abs().min(1.0);
+        let mut t = SampledSpectrum::ZERO;
+        if c > 0.0 {
+            for i in 0..N_LAMBDA {
+                t[i] = 1.0 - thin_slab_reflectance(c, self.ior.at(wl.lambda[i]));
+            }
+        }
+        t
+    }
+
     pub fn sample(&self, wo: Vec3, uc: f32, wl: &SampledWavelengths) -> Option<BsdfSample> {
         let c = wo.z.abs();
         if c == 0.0 {

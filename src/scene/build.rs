@@ -636,8 +636,12 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         crate::world::Caustics::PathTracing => None,
     };
 
+    let see_through = objects
+        .iter()
+        .any(|o| materials[o.material as usize].passes_straight());
     Ok(World {
         geometry,
+        see_through,
         objects,
         materials,
         lights,

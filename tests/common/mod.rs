@@ -91,3 +91,49 @@ pub fn fresnel_unpolarised(cos_i: f64, eta: f64) -> f64 {
     let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     0.5 * (rs * rs + rp * rp)
 }
+
+/// Every pixel's value (mean, standard error) within 5σ of `expected(x, y)`, and the image
+/// mean within 4σ with a standard error below 1 %.
+pub fn check_pixels(
+    film: &Film,
+    label: &str,
+    value: impl Fn(&candela::film::PixelSums) -> (f64, f64),
+    expected: impl Fn(usize, usize) -> f64,
+) {
+    let (mut sum, mut sum_exp, mut var) = (0.0, 0.0, 0.0);
+    for y in 0..film.height {
+        for x in 0..film.width {
+            let (v, se) = value(&film.pixels[y * film.width + x]);
+            let e = expected(x, y);
+            assert!(
+                (v - e).abs() <= 5.0 * se,
+                "{label}, pixel ({x}, {y}): {v} ± {se}, expected {e}"
+            );
+            sum += v;
+            sum_exp += e;
+            var += se * se;
+        }
+    }
+    let n = film.pixels.len() as f64;
+    let (m, e, se) = (sum / n, sum_exp / n, var.sqrt() / n);
+    assert!(
+        (m - e).abs() <= 4.0 * se && se < 0.01 * e,
+        "{label}: mean {m} ± {se}, expected {e}"
+    );
+}
+
+pub fn luminance(p: &candela::film::PixelSums) -> (f64, f64) {
+    (p.mean_xyz()[1], p.y_standard_error())
+}
+
+/// Straight-through transmittance of a thin non-absorbing slab (relative index `eta`) at
+/// incidence cosine `cos_i`: T = (1 − R)/(1 + R) for each polarisation (both faces and all
+/// their incoherent inter-reflections), then averaged over s and p; written out here
+/// independently of the renderer's.
+pub fn thin_slab_transmittance(cos_i: f64, eta: f64) -> f64 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    let rs = ((cos_i - eta * cos_t) / (cos_i + eta * cos_t)).powi(2);
+    let rp = ((eta * cos_i - cos_t) / (eta * cos_i + cos_t)).powi(2);
+    0.5 * ((1.0 - rs) / (1.0 + rs) + (1.0 - rp) / (1.0 + rp))
+}
