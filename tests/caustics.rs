@@ -57,20 +57,9 @@ fn e_from(p: Vec3, h: f64, i: f64) -> f64 {
     i * (d.y as f64 / d2.sqrt()) / d2
 }
 
-/// Reflectance of a conductor of complex index N + iK at incidence angle θ (cos θ = `c`),
-/// unpolarised: the average of |r_s|² and |r_p|² (Born & Wolf §14.2).
+/// The mirror's reflectance at incidence cosine `c`.
 fn r_conductor(c: f64) -> f64 {
-    let s2 = 1.0 - c * c;
-    // n̂² − sin²θ = a + ib; its square root u + iv.
-    let (a, b) = (N * N - K * K - s2, 2.0 * N * K);
-    let m = (a * a + b * b).sqrt();
-    let (u, v) = (((m + a) / 2.0).sqrt(), ((m - a) / 2.0).sqrt());
-    let rs = ((c - u).powi(2) + v * v) / ((c + u).powi(2) + v * v);
-    // r_p = (n̂² cos θ − w) / (n̂² cos θ + w), w = u + iv.
-    let (pr, pi) = (a + s2, b); // n̂² = (N² − K²) + i·2NK
-    let (xr, xi) = (pr * c, pi * c);
-    let rp = ((xr - u).powi(2) + (xi - v).powi(2)) / ((xr + u).powi(2) + (xi + v).powi(2));
-    0.5 * (rs + rp)
+    conductor_reflectance(c, N, K)
 }
 
 /// Luminance of the floor seen through pixel (x, y): ρ/π · E averaged over the pixel's

@@ -218,3 +218,61 @@ fn a_pane_in_a_uniform_sky_is_invisible() {
     ));
     assert_every_pixel(&render(&w, 2), l, 5.0);
 }
+
+#[test]
+fn caustics_and_direct_light_seen_through_a_pane() {
+    // A point light (100 cd, 0.4 m up) between a Lambertian floor and a horizontal pane at
+    // 0.7 m, a smooth metal ceiling (facing down) at 1 m, and the camera at 0.9 m looking down
+    // through the pane. With max_depth 2 the floor receives
+    // - the direct light (below the pane: untouched);
+    // - the pane's mirror image of the lamp (height 2·0.7 − 0.4 = 1.0), of intensity scaled by
+    //   the slab's reflectance R′ = 1 − T: a light-traced caustic;
+    // - the metal's mirror image (height 2·1 − 0.4 = 1.6), scaled by the metal's reflectance
+    //   and by T² (up and down through the pane at the same angle): a light-traced caustic
+    //   whose light path crosses the pane twice;
+    // and the camera sees it through the pane, scaled by T at the camera ray's angle: the
+    // light-traced connections and the camera paths both look through the pane.
+    let (i_cd, h_light, h_pane, h_metal, n, k) = (100.0, 0.4, 0.7, 1.0, 0.2, 3.0);
+    let text = format!(
+        r#"(
+        camera: (position: (0.1, 0.9, 0.0), look_at: (0.1, 0, 0), up: (0, 0, 1), vfov_deg: 60, resolution: (16, 16)),
+        render: (spp: 256, max_depth: 2, light_paths_per_sample: 4),
+        materials: {{
+            "floor": Diffuse(reflectance: Constant({RHO})),
+            "pane": ThinDielectric(ior: Constant({ETA})),
+            "metal": Conductor(n: Constant({n}), k: Constant({k})),
+        }},
+        objects: [
+            (shape: Quad(origin: (-50, 0, -50), edge_u: (0, 0, 100), edge_v: (100, 0, 0)), material: "floor"),
+            (shape: Quad(origin: (-50, {h_pane}, -50), edge_u: (0, 0, 100), edge_v: (100, 0, 0)), material: "pane"),
+            (shape: Quad(origin: (-50, {h_metal}, -50), edge_u: (100, 0, 0), edge_v: (0, 0, 100)), material: "metal"),
+        ],
+        lights: [Point(position: (0, {h_light}, 0), spectrum: Named("D65"), amount: Intensity({i_cd}))],
+    )"#
+    );
+    let w = world_with(&text, Caustics::LightTracing);
+    let film = render(&w, 2);
+    // Illuminance at floor point p from a source of intensity i at height h above the origin,
+    // and the cosine of its incidence.
+    let from = |p: Vec3, h: f64, i: f64| {
+        let d = Vec3::new(0.0, h as f32, 0.0) - p;
+        let d2 = d.length_squared() as f64;
+        let cos = d.y as f64 / d2.sqrt();
+        (i * cos / d2, cos)
+    };
+    let e_floor = |p: Vec3| {
+        let (direct, _) = from(p, h_light, i_cd);
+        let (e1, c1) = from(p, 2.0 * h_pane - h_light, i_cd);
+        let (e2, c2) = from(p, 2.0 * h_metal - h_light, i_cd);
+        direct
+            + e1 * (1.0 - thin_slab_transmittance(c1, ETA))
+            + e2 * conductor_reflectance(c2, n, k) * thin_slab_transmittance(c2, ETA).powi(2)
+    };
+    check_pixels(&film, "through the pane", luminance, |x, y| {
+        pixel_footprint_mean(&w, x, y, |o, d| {
+            let p = o + d * (-o.y / d.y);
+            let cos_cam = (d.y / d.length()).abs() as f64;
+            thin_slab_transmittance(cos_cam, ETA) * RHO / PI * e_floor(p)
+        })
+    });
+}

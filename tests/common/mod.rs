@@ -137,3 +137,19 @@ pub fn thin_slab_transmittance(cos_i: f64, eta: f64) -> f64 {
     let rp = ((eta * cos_i - cos_t) / (eta * cos_i + cos_t)).powi(2);
     0.5 * ((1.0 - rs) / (1.0 + rs) + (1.0 - rp) / (1.0 + rp))
 }
+
+/// Reflectance of a conductor of complex index n + ik (`n_re`, `k`) at incidence angle θ (cos θ = `c`),
+/// unpolarised: the average of |r_s|² and |r_p|² (Born & Wolf §14.2).
+pub fn conductor_reflectance(c: f64, n_re: f64, k: f64) -> f64 {
+    let s2 = 1.0 - c * c;
+    // n̂² − sin²θ = a + ib; its square root u + iv.
+    let (a, b) = (n_re * n_re - k * k - s2, 2.0 * n_re * k);
+    let m = (a * a + b * b).sqrt();
+    let (u, v) = (((m + a) / 2.0).sqrt(), ((m - a) / 2.0).sqrt());
+    let rs = ((c - u).powi(2) + v * v) / ((c + u).powi(2) + v * v);
+    // r_p = (n̂² cos θ − w) / (n̂² cos θ + w), w = u + iv.
+    let (pr, pi) = (a + s2, b); // n̂² = (n² − k²) + i·2nk
+    let (xr, xi) = (pr * c, pi * c);
+    let rp = ((xr - u).powi(2) + (xi - v).powi(2)) / ((xr + u).powi(2) + (xi + v).powi(2));
+    0.5 * (rs + rp)
+}
