@@ -2,22 +2,10 @@
 //! tracer, with tolerances from the estimated standard errors.
 
 mod common;
-use candela::scene::{self, Overrides};
 use candela::world::{Caustics, World};
 use common::*;
 use glam::Vec3;
 use std::f64::consts::PI;
-use std::path::Path;
-
-fn world_with(text: &str, caustics: Caustics) -> World {
-    let path = Path::new("test-scene.ron");
-    let s = scene::parse(text, path).unwrap_or_else(|e| panic!("{e}"));
-    let o = Overrides {
-        caustics: Some(caustics),
-        ..Default::default()
-    };
-    scene::build(&s, path, &o).unwrap_or_else(|e| panic!("{e}"))
-}
 
 const I_CD: f64 = 100.0;
 /// Height of the point light above the floor, and of the mirror (facing down).

@@ -6,25 +6,13 @@
 
 mod common;
 use candela::meter::{measure_all, Estimate};
-use candela::scene::{self, Overrides};
-use candela::world::{Caustics, World};
+use candela::world::Caustics;
 use common::*;
 use glam::Vec3;
 use std::f64::consts::PI;
-use std::path::Path;
 
 const RHO: f64 = 0.5;
 const ETA: f64 = 1.5;
-
-fn world_with(text: &str, caustics: Caustics) -> World {
-    let path = Path::new("test-scene.ron");
-    let s = scene::parse(text, path).unwrap_or_else(|e| panic!("{e}"));
-    let o = Overrides {
-        caustics: Some(caustics),
-        ..Default::default()
-    };
-    scene::build(&s, path, &o).unwrap_or_else(|e| panic!("{e}"))
-}
 
 #[test]
 fn sunlight_through_a_window_pane_in_both_caustics_modes() {

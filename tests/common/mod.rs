@@ -12,6 +12,17 @@ pub fn world(text: &str) -> World {
     scene::build(&s, path, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// [`world`] with the caustics mode overridden (as `--caustics` does).
+pub fn world_with(text: &str, caustics: candela::world::Caustics) -> World {
+    let path = Path::new("test-scene.ron");
+    let s = scene::parse(text, path).unwrap_or_else(|e| panic!("{e}"));
+    let o = Overrides {
+        caustics: Some(caustics),
+        ..Default::default()
+    };
+    scene::build(&s, path, &o).unwrap_or_else(|e| panic!("{e}"))
+}
+
 pub fn render(world: &World, threads: usize) -> Film {
     candela::render::render(world, Some(threads), &|_, _| {})
         .expect("render")
