@@ -48,7 +48,7 @@
 use crate::bxdf::Frame;
 use crate::film::radiance_to_xyz;
 use crate::geometry::SceneGeometry;
-use crate::integrator::{transmittance, RayStats, MAX_STRAIGHT_THROUGH};
+use crate::integrator::{transmittance_counted, RayStats, MAX_STRAIGHT_THROUGH};
 use crate::light::{pick_from_cdf, Light};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -525,10 +525,19 @@ pub fn trace_light_path(
                     let origin = hit.spawn_origin(c.wi);
                     let t_max = (c.lens_point - origin).length();
                     // Through window panes with their transmittance, as the camera paths
-                    // see through them (a pane's straight transmission is a null event).
-                    if let Some(tr) = transmittance(world, origin, c.wi, t_max, &wl) {
+                    // see through them (a pane's straight transmission is a null event). The
+                    // illuminance channel is the illuminance on the first surface the camera
+                    // ray meets, so a surface behind a pane gives it nothing (the pane itself
+                    // receives its own splats on arrival).
+                    if let Some((tr, panes)) =
+                        transmittance_counted(world, origin, c.wi, t_max, &wl)
+                    {
                         let xyz = radiance_to_xyz(&(l * tr), &wl);
-                        let e = radiance_to_xyz(&(e * tr), &wl)[1];
+                        let e = if panes == 0 {
+                            radiance_to_xyz(&e, &wl)[1]
+                        } else {
+                            0.0
+                        };
                         if !(xyz.iter().all(|v| v.is_finite()) && e.is_finite()) {
                             stats.non_finite += 1;
                         } else if xyz.iter().any(|&v| v != 0.0) || e != 0.0 {

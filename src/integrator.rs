@@ -349,15 +349,26 @@ pub fn transmittance(
     t_max: f32,
     wl: &SampledWavelengths,
 ) -> Option<SampledSpectrum> {
+    transmittance_counted(world, origin, dir, t_max, wl).map(|(tr, _)| tr)
+}
+
+/// [`transmittance`], and the number of panes the segment crosses.
+pub fn transmittance_counted(
+    world: &World,
+    origin: Vec3,
+    dir: Vec3,
+    t_max: f32,
+    wl: &SampledWavelengths,
+) -> Option<(SampledSpectrum, u32)> {
     if !world.see_through {
-        return (!world.geometry.occluded(origin, dir, t_max)).then_some(SampledSpectrum::ONE);
+        return (!world.geometry.occluded(origin, dir, t_max)).then_some((SampledSpectrum::ONE, 0));
     }
     let end = origin + dir * t_max;
     let (mut o, mut t) = (origin, t_max);
     let mut tr = SampledSpectrum::ONE;
-    for _ in 0..MAX_STRAIGHT_THROUGH {
+    for crossed in 0..MAX_STRAIGHT_THROUGH {
         let Some(hit) = world.geometry.intersect(o, dir, t) else {
-            return Some(tr);
+            return Some((tr, crossed));
         };
         let object = world.objects[hit.object as usize];
         let material = &world.materials[object.material as usize];
@@ -369,7 +380,7 @@ pub fn transmittance(
         if t.is_finite() {
             t = (end - o).dot(dir);
             if t.is_nan() || t <= 0.0 {
-                return Some(tr);
+                return Some((tr, crossed + 1));
             }
         }
     }

@@ -220,11 +220,13 @@ fn caustics_and_direct_light_seen_through_a_pane() {
     //   whose light path crosses the pane twice;
     // and the camera sees it through the pane, scaled by T at the camera ray's angle: the
     // light-traced connections and the camera paths both look through the pane.
+    // Many light paths per sample: the pane's own illuminance (checked last) is light tracing's
+    // alone.
     let (i_cd, h_light, h_pane, h_metal, n, k) = (100.0, 0.4, 0.7, 1.0, 0.2, 3.0);
     let text = format!(
         r#"(
         camera: (position: (0.1, 0.9, 0.0), look_at: (0.1, 0, 0), up: (0, 0, 1), vfov_deg: 60, resolution: (16, 16)),
-        render: (spp: 256, max_depth: 2, light_paths_per_sample: 4),
+        render: (spp: 256, max_depth: 2, light_paths_per_sample: 64, illuminance: true),
         materials: {{
             "floor": Diffuse(reflectance: Constant({RHO})),
             "pane": ThinDielectric(ior: Constant({ETA})),
@@ -263,4 +265,20 @@ fn caustics_and_direct_light_seen_through_a_pane() {
             thin_slab_transmittance(cos_cam, ETA) * RHO / PI * e_floor(p)
         })
     });
+    // The illuminance channel is the illuminance on the first surface the camera ray meets:
+    // the pane's top. Only the metal's image of the lamp lights it from above (through the
+    // pane once); the lamp itself and its image in the pane are below. None of the light on
+    // the floor behind the pane may leak into it through the light-traced connections.
+    check_pixels(
+        &film,
+        "illuminance on the pane",
+        |p| (p.mean_e().unwrap(), p.e_standard_error()),
+        |x, y| {
+            pixel_footprint_mean(&w, x, y, |o, d| {
+                let p = o + d * ((h_pane as f32 - o.y) / d.y);
+                let (e, c) = from(p, 2.0 * h_metal - h_light, i_cd);
+                e * conductor_reflectance(c, n, k) * thin_slab_transmittance(c, ETA)
+            })
+        },
+    );
 }
