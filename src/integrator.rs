@@ -226,7 +226,7 @@ pub fn trace(
                     if !f.is_black() {
                         stats.shadow_rays += 1;
                         if let Some(tr) =
-                            shadow_transmittance(world, &RayStart::surface(&hit), &ls, wl)
+                            shadow_transmittance(world, &RayStart::surface(&hit), &ls, wl, stats)
                         {
                             let pdf = p_select * ls.pdf;
                             let w = if ls.delta {
@@ -314,6 +314,7 @@ fn shadow_transmittance(
     from: &RayStart,
     ls: &crate::light::LightSample,
     wl: &SampledWavelengths,
+    stats: &mut RayStats,
 ) -> Option<SampledSpectrum> {
     let (origin, dir, t_max) = match ls.point {
         Some((p, n)) => shadow_ray_between(from.p, from.error, from.ng, p, point_error_bound(p), n),
@@ -330,7 +331,7 @@ fn shadow_transmittance(
     if t_max <= 0.0 {
         return Some(SampledSpectrum::ONE);
     }
-    transmittance(world, origin, dir, t_max, wl)
+    transmittance(world, origin, dir, t_max, wl, stats)
 }
 
 /// Most surfaces a ray passes straight through before it is given up (a guard against
@@ -341,15 +342,17 @@ pub const MAX_STRAIGHT_THROUGH: u32 = 64;
 /// when an opaque surface blocks it, else the product of the straight-through transmittances
 /// ([`crate::bxdf::Material::straight_transmittance`]) of the window panes it crosses (one
 /// when it crosses none). Without see-through materials in the world this is one any-hit
-/// query.
+/// query. The caller counts the segment as one shadow ray; the rays continued past panes are
+/// added to `stats` here.
 pub fn transmittance(
     world: &World,
     origin: Vec3,
     dir: Vec3,
     t_max: f32,
     wl: &SampledWavelengths,
+    stats: &mut RayStats,
 ) -> Option<SampledSpectrum> {
-    transmittance_counted(world, origin, dir, t_max, wl).map(|(tr, _)| tr)
+    transmittance_counted(world, origin, dir, t_max, wl, stats).map(|(tr, _)| tr)
 }
 
 /// [`transmittance`], and the number of panes the segment crosses.
@@ -359,6 +362,7 @@ pub fn transmittance_counted(
     dir: Vec3,
     t_max: f32,
     wl: &SampledWavelengths,
+    stats: &mut RayStats,
 ) -> Option<(SampledSpectrum, u32)> {
     if !world.see_through {
         return (!world.geometry.occluded(origin, dir, t_max)).then_some((SampledSpectrum::ONE, 0));
@@ -367,6 +371,9 @@ pub fn transmittance_counted(
     let (mut o, mut t) = (origin, t_max);
     let mut tr = SampledSpectrum::ONE;
     for crossed in 0..MAX_STRAIGHT_THROUGH {
+        if crossed > 0 {
+            stats.shadow_rays += 1;
+        }
         let Some(hit) = world.geometry.intersect(o, dir, t) else {
             return Some((tr, crossed));
         };
@@ -416,7 +423,7 @@ pub fn irradiance(
             let cos = ls.wi.dot(n);
             if cos > 0.0 && ls.pdf > 0.0 && !ls.li.is_black() {
                 stats.shadow_rays += 1;
-                if let Some(tr) = shadow_transmittance(world, at, &ls, wl) {
+                if let Some(tr) = shadow_transmittance(world, at, &ls, wl, stats) {
                     let pdf = p_select * ls.pdf;
                     let w = if ls.delta {
                         1.0
