@@ -23,6 +23,8 @@ pub struct RayStats {
     /// connections count as shadow rays).
     pub light_paths: u64,
     pub light_rays: u64,
+    /// Window panes crossed by shadow rays (see [`transmittance`]).
+    pub pane_crossings: u64,
 }
 
 impl RayStats {
@@ -36,6 +38,7 @@ impl RayStats {
         self.non_finite += o.non_finite;
         self.light_paths += o.light_paths;
         self.light_rays += o.light_rays;
+        self.pane_crossings += o.pane_crossings;
     }
 }
 
@@ -335,15 +338,15 @@ fn shadow_transmittance(
 }
 
 /// Most surfaces a ray passes straight through before it is given up (a guard against
-/// pathological stacks of panes; each costs a ray).
+/// pathological stacks of panes).
 pub const MAX_STRAIGHT_THROUGH: u32 = 64;
 
 /// Spectral transmittance of the segment from `origin` along unit `dir` up to `t_max`: `None`
 /// when an opaque surface blocks it, else the product of the straight-through transmittances
 /// ([`crate::bxdf::Material::straight_transmittance`]) of the window panes it crosses (one
 /// when it crosses none). Without see-through materials in the world this is one any-hit
-/// query. The caller counts the segment as one shadow ray; the rays continued past panes are
-/// added to `stats` here.
+/// query; with panes, one any-hit query that passes through them (their crossings are counted
+/// in `stats`).
 pub fn transmittance(
     world: &World,
     origin: Vec3,
@@ -364,34 +367,28 @@ pub fn transmittance_counted(
     wl: &SampledWavelengths,
     stats: &mut RayStats,
 ) -> Option<(SampledSpectrum, u32)> {
-    if !world.see_through {
+    if world.see_through.is_empty() {
         return (!world.geometry.occluded(origin, dir, t_max)).then_some((SampledSpectrum::ONE, 0));
     }
-    let end = origin + dir * t_max;
-    let (mut o, mut t) = (origin, t_max);
+    // One any-hit traversal that passes through the panes' primitives: the transmittance is a
+    // product, so the order in which they are found does not matter.
     let mut tr = SampledSpectrum::ONE;
-    for crossed in 0..MAX_STRAIGHT_THROUGH {
-        if crossed > 0 {
-            stats.shadow_rays += 1;
-        }
-        let Some(hit) = world.geometry.intersect(o, dir, t) else {
-            return Some((tr, crossed));
-        };
-        let object = world.objects[hit.object as usize];
-        let material = &world.materials[object.material as usize];
-        tr *= material.straight_transmittance(dir.dot(hit.ns), wl)?;
-        if tr.is_black() {
-            return None;
-        }
-        o = hit.spawn_origin(dir);
-        if t.is_finite() {
-            t = (end - o).dot(dir);
-            if t.is_nan() || t <= 0.0 {
-                return Some((tr, crossed + 1));
+    let mut crossed = 0u32;
+    let blocked = world
+        .geometry
+        .occluded_except(origin, dir, t_max, &world.see_through, |hit| {
+            crossed += 1;
+            let material = &world.materials[world.objects[hit.object as usize].material as usize];
+            match material.straight_transmittance(dir.dot(hit.ns), wl) {
+                Some(t) => {
+                    tr *= t;
+                    crossed <= MAX_STRAIGHT_THROUGH && !tr.is_black()
+                }
+                None => false,
             }
-        }
-    }
-    None
+        });
+    stats.pane_crossings += crossed as u64;
+    (!blocked).then_some((tr, crossed))
 }
 
 /// Spectral irradiance (W·m⁻²·nm⁻¹) on the hemisphere around unit normal `n` at `at`: light

@@ -67,10 +67,11 @@ impl Default for RenderSettings {
 
 pub struct World {
     pub geometry: SceneGeometry,
-    /// Whether some object's material passes light straight through (a window pane, see
-    /// [`crate::bxdf::Material::passes_straight`]): shadow rays then carry a transmittance
-    /// ([`crate::integrator::transmittance`]) instead of a plain occlusion test.
-    pub see_through: bool,
+    /// Per object: whether its material passes light straight through (a window pane, see
+    /// [`crate::bxdf::Material::passes_straight`]). Empty when no object does. Shadow rays
+    /// pass through those objects with their transmittance
+    /// ([`crate::integrator::transmittance`]).
+    pub see_through: Vec<bool>,
     pub objects: Vec<Object>,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,

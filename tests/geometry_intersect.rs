@@ -564,3 +564,85 @@ fn scene_geometry_is_send_and_sync() {
     check::<candela::geometry::Hit>();
     check::<candela::geometry::GeometryError>();
 }
+
+/// `occluded_except` against a walk of closest hits (each continued from just past the last):
+/// the same verdict, and the same crossings of the passing objects (spheres, which are crossed
+/// in and out, and quads), on the random scene at three scales.
+#[test]
+fn occluded_except_matches_a_walk_of_closest_hits() {
+    for (scale, offset, seed) in [
+        (1.0, Vec3::ZERO, 11),
+        (1e-3, Vec3::splat(0.5), 12),
+        (1e3, Vec3::new(-2e3, 0.0, 1e3), 13),
+    ] {
+        let mut rng = Rng::new(seed);
+        let shapes = random_scene(&mut rng, scale, offset);
+        let g = SceneGeometry::build(&shapes).unwrap();
+        // Spheres (objects 1–60) and quads (100–129) pass; the mesh (0) and disks block.
+        let passes: Vec<bool> = (0..230)
+            .map(|o| (1..=60).contains(&o) || (100..130).contains(&o))
+            .collect();
+        let (mut crossings, mut sphere_twice) = (0, 0);
+        for i in 0..12000 {
+            let o = rng.in_box(Vec3::splat(-1.5), Vec3::splat(1.5)) * scale + offset;
+            let d = rng.unit_vector();
+            let t_max = if i % 3 == 0 {
+                f32::INFINITY
+            } else {
+                rng.range(0.0, 3.0) * scale
+            };
+            // Reference: walk the closest hits.
+            let end = o + d * t_max;
+            let (mut p, mut t) = (o, t_max);
+            let mut expected = Vec::new();
+            let expected_blocked = loop {
+                let Some(h) = g.intersect(p, d, t) else {
+                    break false;
+                };
+                if !passes[h.object as usize] {
+                    break true;
+                }
+                expected.push((h.object, h.p));
+                p = h.spawn_origin(d);
+                if t.is_finite() {
+                    t = (end - p).dot(d);
+                    if t <= 0.0 {
+                        break false;
+                    }
+                }
+            };
+            let mut got = Vec::new();
+            let blocked = g.occluded_except(o, d, t_max, &passes, |h| {
+                got.push((h.object, h.p));
+                true
+            });
+            assert_eq!(
+                blocked, expected_blocked,
+                "ray {i} (scale {scale}): verdict"
+            );
+            if !blocked {
+                assert_eq!(
+                    got.len(),
+                    expected.len(),
+                    "ray {i} (scale {scale}): {got:?} vs {expected:?}"
+                );
+                for (obj, q) in &expected {
+                    assert!(
+                        got.iter()
+                            .any(|(o2, q2)| o2 == obj && close3(*q, *q2, 1e-4)),
+                        "ray {i} (scale {scale}): crossing of {obj} at {q} missing from {got:?}"
+                    );
+                }
+                crossings += got.len();
+                if (1..=60).any(|s| got.iter().filter(|(o, _)| *o == s).count() == 2) {
+                    sphere_twice += 1;
+                }
+            }
+            assert_eq!(g.occluded(o, d, t_max), g.intersect(o, d, t_max).is_some());
+        }
+        assert!(
+            crossings > 200 && sphere_twice > 50,
+            "{crossings} crossings, {sphere_twice} rays through a whole sphere"
+        );
+    }
+}

@@ -991,28 +991,86 @@ impl SceneGeometry {
             return false;
         }
         let pre = RayPre::new(origin, dir);
+        let block = |_: u32, _: &RayPre, _: PrimT| false;
         match pre.kz {
-            0 => self.any_hit::<0>(&pre, t_max),
-            1 => self.any_hit::<1>(&pre, t_max),
-            _ => self.any_hit::<2>(&pre, t_max),
+            0 => self.any_hit::<0>(&pre, t_max, block),
+            1 => self.any_hit::<1>(&pre, t_max, block),
+            _ => self.any_hit::<2>(&pre, t_max, block),
         }
     }
 
+    /// Any-hit query that lets some objects through: true if a primitive of an object whose
+    /// `passes[object]` is false (or out of range) is hit with `t` in `(0, t_max)`. Every
+    /// crossing of a primitive of a passing object (a window pane) is handed to `crossed` as a
+    /// full [`Hit`], in no particular order, and the traversal goes on; `crossed` returns false
+    /// to stop it (the query then reports the ray as blocked). A sphere the ray enters is
+    /// crossed twice (in and out, when both are within `t_max`). Same ray conventions as
+    /// [`SceneGeometry::occluded`], and as cheap when nothing passing is hit.
+    pub fn occluded_except(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        passes: &[bool],
+        mut crossed: impl FnMut(&Hit) -> bool,
+    ) -> bool {
+        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+            return false;
+        }
+        let pre = RayPre::new(origin, dir);
+        let mut pass = |prim: u32, pre: &RayPre, (t, a, b): PrimT| {
+            let object = self.prim_object[prim as usize] as usize;
+            if !passes.get(object).copied().unwrap_or(false) {
+                return false;
+            }
+            let hit = self.make_hit(prim, pre, t, a, b);
+            if !crossed(&hit) {
+                return false;
+            }
+            // Entering a sphere (its near root): the way out is a second crossing.
+            if let (Prim::Sphere { center, radius }, true) = (self.prim(prim), hit.front_face) {
+                let o = hit.spawn_origin(dir);
+                let pre = RayPre::new(o, dir);
+                let t_left = t_max - (o - origin).dot(dir) / dir.length_squared();
+                if let Some((t, _, _)) = super::prim::intersect_sphere(&pre, t_left, center, radius)
+                {
+                    return crossed(&self.make_hit(prim, &pre, t, 0.0, 0.0));
+                }
+            }
+            true
+        };
+        match pre.kz {
+            0 => self.any_hit::<0>(&pre, t_max, &mut pass),
+            1 => self.any_hit::<1>(&pre, t_max, &mut pass),
+            _ => self.any_hit::<2>(&pre, t_max, &mut pass),
+        }
+    }
+
+    /// Any-hit traversal; a hit primitive for which `pass(prim, ray, (t, a, b))` is true does
+    /// not end it.
     #[inline(always)]
-    fn any_hit<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> bool {
-        struct AnyHit<'a, const KZ: usize> {
+    fn any_hit<const KZ: usize>(
+        &self,
+        pre: &RayPre,
+        t_max: f32,
+        pass: impl FnMut(u32, &RayPre, PrimT) -> bool,
+    ) -> bool {
+        struct AnyHit<'a, F, const KZ: usize> {
             geo: &'a SceneGeometry,
             pre: &'a RayPre,
+            pass: F,
             hit: bool,
         }
-        impl<const KZ: usize> LeafTest for AnyHit<'_, KZ> {
+        impl<F: FnMut(u32, &RayPre, PrimT) -> bool, const KZ: usize> LeafTest for AnyHit<'_, F, KZ> {
             #[inline(always)]
             fn leaf(&mut self, first: u32, unary: u32, t_max: f32) -> Option<f32> {
                 let (mut id, mut u) = (first, unary);
                 while u != 0 {
-                    if self.geo.prim_intersect::<KZ>(id, self.pre, t_max).is_some() {
-                        self.hit = true;
-                        return None;
+                    if let Some(h) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max) {
+                        if !(self.pass)(id, self.pre, h) {
+                            self.hit = true;
+                            return None;
+                        }
                     }
                     id += 1;
                     u >>= 1;
@@ -1024,9 +1082,10 @@ impl SceneGeometry {
                 prefetch(self.geo.tris.as_ptr().wrapping_add(first as usize) as *const u8);
             }
         }
-        let mut a = AnyHit::<KZ> {
+        let mut a = AnyHit::<_, KZ> {
             geo: self,
             pre,
+            pass,
             hit: false,
         };
         traverse::<false>(&self.bvh.nodes, pre.o, pre.d, t_max, &mut a);

@@ -636,9 +636,13 @@ pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<Wo
         crate::world::Caustics::PathTracing => None,
     };
 
-    let see_through = objects
+    let mut see_through: Vec<bool> = objects
         .iter()
-        .any(|o| materials[o.material as usize].passes_straight());
+        .map(|o| materials[o.material as usize].passes_straight())
+        .collect();
+    if !see_through.contains(&true) {
+        see_through.clear();
+    }
     Ok(World {
         geometry,
         see_through,
