@@ -133,6 +133,7 @@ pub fn mesh_scene(mesh: crate::geometry::TriangleMesh, spp: u32, resolution: u32
             LightDesc::Environment {
                 spectrum: SpectrumDesc::Named("D65".into()),
                 amount: Amount::Luminance(5000.0),
+                portals: Vec::new(),
             },
             LightDesc::Distant {
                 direction: [0.3, -1.0, 0.5],

@@ -138,7 +138,8 @@ pub fn trace(
                 if prev_specular {
                     l += beta * le;
                 } else {
-                    let p_light = world.light_sampler.pmf(li as usize) * light.pdf_li_escape();
+                    let p_light =
+                        world.light_sampler.pmf(li as usize) * light.pdf_li_escape(prev_p, ray_d);
                     l += beta * le * power_heuristic(prev_pdf, p_light);
                 }
             }

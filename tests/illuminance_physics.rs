@@ -255,3 +255,64 @@ fn pixels_seeing_the_sky_or_an_emitter_have_no_illuminance() {
         .all(|&v| v == candela::output::ILLUMINANCE_SENTINEL));
     assert!(se.iter().all(|&v| v == 0.0) && mask.iter().all(|&v| v == 0.0));
 }
+
+/// A uniform sky (L = 4000 cd/m²) seen through a 1 m × 2 m skylight in an opaque black
+/// ceiling 3 m up, from a meter under one corner of the opening: E = π L F with the same
+/// parallel-rectangle form factor as `rectangle_source_below_a_corner` (F = 0.0522678). The
+/// ceiling reaches 10 km in every direction, so the sky beyond it (below 0.02° of elevation)
+/// adds less than 10⁻⁷ of the result. With the opening declared as a portal of the sky,
+/// light sampling aims through it; without, the sky is sampled over the whole sphere. Both
+/// are unbiased; the portal must cut the standard error severalfold.
+#[test]
+fn skylight_through_an_opening_with_and_without_a_portal() {
+    let l = 4000.0;
+    let meter = |portals: &str| {
+        let w = world(&format!(
+            r#"(
+            camera: (position: (0, -5, 0), look_at: (0, 0, 0), up: (0, 0, 1), vfov_deg: 10, resolution: (1, 1)),
+            render: (spp: 1, max_depth: 4),
+            objects: [
+                (shape: Quad(origin: (-1e4, 3, -1e4), edge_u: (1e4, 0, 0), edge_v: (0, 0, 2e4)), material: "black"),
+                (shape: Quad(origin: (1, 3, -1e4), edge_u: (9999, 0, 0), edge_v: (0, 0, 2e4)), material: "black"),
+                (shape: Quad(origin: (0, 3, -1e4), edge_u: (1, 0, 0), edge_v: (0, 0, 1e4)), material: "black"),
+                (shape: Quad(origin: (0, 3, 2), edge_u: (1, 0, 0), edge_v: (0, 0, 9998)), material: "black"),
+            ],
+            lights: [Environment(spectrum: Named("D65"), amount: Luminance({l}), portals: [{portals}])],
+            meters: [
+                Illuminance(name: "m", position: (0, 0, 0), normal: (0, 1, 0)),
+                Illuminance(name: "roof", position: (0.5, 4, 1), normal: (0, 1, 0)),
+            ],
+            measure: (samples: 262144),
+        )"#
+        ));
+        let m = measure_all(&w).meters;
+        (m[0], m[1])
+    };
+    let expected = PI * l * 0.0522678;
+    let (with, roof) = meter("(origin: (0, 3, 0), edge_u: (1, 0, 0), edge_v: (0, 0, 2))");
+    let (without, _) = meter("");
+    // Above the roof the portal lies behind the meter: light sampling through it finds
+    // nothing, and the open sky comes from the cosine-sampled paths alone (their MIS weight
+    // is 1 where the portals' density is 0): E = π L.
+    assert!(
+        (roof.mean - PI * l).abs() <= 5.0 * roof.stderr && roof.stderr < 0.01 * PI * l,
+        "roof: E = {} ± {}, expected {}",
+        roof.mean,
+        roof.stderr,
+        PI * l
+    );
+    for (e, label) in [(&with, "portal"), (&without, "no portal")] {
+        assert!(
+            (e.mean - expected).abs() <= 5.0 * e.stderr && e.stderr < 0.01 * expected,
+            "{label}: E = {} ± {}, expected {expected}",
+            e.mean,
+            e.stderr
+        );
+    }
+    assert!(
+        with.stderr * 4.0 < without.stderr,
+        "portal {} vs none {}",
+        with.stderr,
+        without.stderr
+    );
+}

@@ -56,8 +56,12 @@ pub enum Light {
         to_light: Vec3,
         irradiance: DenseSpectrum,
     },
-    /// Uniform radiance from every direction at infinity.
-    Environment { radiance: DenseSpectrum },
+    /// Uniform radiance from every direction at infinity, light-sampled uniformly over the
+    /// sphere or, with portals, through them.
+    Environment {
+        radiance: DenseSpectrum,
+        portals: Portals,
+    },
     /// Emission from the primitives of one scene object.
     Area {
         object: u32,
@@ -70,6 +74,120 @@ pub enum Light {
     },
     /// A luminaire measured by a photometric file (IES/EULUMDAT): see [`goniometric`].
     Goniometric(Box<goniometric::Goniometric>),
+}
+
+/// A window or skylight opening through which an environment light reaches an interior: the
+/// parallelogram `origin + s·eu + t·ev`, s, t ∈ [0, 1] (pbrt-v4's portal lights and Bitterli et
+/// al. 2015 sample the environment through such openings; here simply uniformly by area).
+#[derive(Clone, Copy, Debug)]
+pub struct Portal {
+    origin: Vec3,
+    eu: Vec3,
+    ev: Vec3,
+    /// Unit normal.
+    n: Vec3,
+    area: f32,
+}
+
+impl Portal {
+    /// None for a degenerate parallelogram (zero or non-finite area).
+    pub fn new(origin: Vec3, eu: Vec3, ev: Vec3) -> Option<Self> {
+        let c = eu.cross(ev);
+        let area = c.length();
+        (area > 0.0 && area.is_finite()).then(|| Self {
+            origin,
+            eu,
+            ev,
+            n: c / area,
+            area,
+        })
+    }
+
+    /// Distance along unit `wi` from `p` at which the ray crosses the portal, if it does.
+    fn crossing(&self, p: Vec3, wi: Vec3) -> Option<f32> {
+        let denom = wi.dot(self.n);
+        if denom == 0.0 {
+            return None;
+        }
+        let t = (self.origin - p).dot(self.n) / denom;
+        if !(t > 0.0 && t.is_finite()) {
+            return None;
+        }
+        // Coordinates of the crossing in the (eu, ev) basis.
+        let q = p + wi * t - self.origin;
+        let (uu, uv, vv) = (
+            self.eu.dot(self.eu),
+            self.eu.dot(self.ev),
+            self.ev.dot(self.ev),
+        );
+        let (qu, qv) = (q.dot(self.eu), q.dot(self.ev));
+        let det = uu * vv - uv * uv;
+        let s = (qu * vv - qv * uv) / det;
+        let r = (qv * uu - qu * uv) / det;
+        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then_some(t)
+    }
+}
+
+/// The portals of an environment light, chosen in proportion to their areas.
+#[derive(Clone, Debug, Default)]
+pub struct Portals {
+    portals: Vec<Portal>,
+    cdf: Vec<f32>,
+    total_area: f32,
+}
+
+impl Portals {
+    pub fn new(portals: Vec<Portal>) -> Self {
+        let areas: Vec<f64> = portals.iter().map(|p| p.area as f64).collect();
+        let total_area = areas.iter().sum::<f64>() as f32;
+        let cdf = if portals.is_empty() {
+            Vec::new()
+        } else {
+            cdf_from_weights(&areas)
+        };
+        Self {
+            portals,
+            cdf,
+            total_area,
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.portals.is_empty()
+    }
+
+    /// A direction from `p` through a point chosen uniformly on all the portals' area, and its
+    /// density ([`Portals::pdf`]: the sum over every portal the direction crosses).
+    fn sample(&self, p: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32)> {
+        let (k, _) = pick_from_cdf(&self.cdf, uc);
+        let portal = &self.portals[k];
+        let d = portal.origin + portal.eu * u.x + portal.ev * u.y - p;
+        let len = d.length();
+        if !(len > 0.0 && len.is_finite()) {
+            return None;
+        }
+        let wi = d / len;
+        let pdf = self.pdf(p, wi);
+        (pdf > 0.0 && pdf.is_finite()).then_some((wi, pdf))
+    }
+
+    /// Solid-angle density of [`Portals::sample`] producing unit direction `wi` from `p`:
+    /// Σ over the portals the ray crosses of t² / (|cos θ| · total area), θ the angle to the
+    /// portal's normal at the crossing t.
+    fn pdf(&self, p: Vec3, wi: Vec3) -> f32 {
+        let mut pdf = 0.0;
+        for portal in &self.portals {
+            if let Some(t) = portal.crossing(p, wi) {
+                let cos = wi.dot(portal.n).abs();
+                pdf += t * t / (cos * self.total_area);
+            }
+        }
+        if pdf.is_finite() {
+            pdf
+        } else {
+            0.0
+        }
+    }
 }
 
 /// A sampled direction toward a light.
@@ -222,7 +340,7 @@ impl Light {
                     * (1.0 - 0.5 * (*cos_inner as f64 + *cos_outer as f64))
             }
             Light::Distant { irradiance, .. } => luminous_integral(irradiance) * pi * r2,
-            Light::Environment { radiance } => luminous_integral(radiance) * pi * pi * r2,
+            Light::Environment { radiance, .. } => luminous_integral(radiance) * pi * pi * r2,
             Light::Area {
                 prims,
                 radiance,
@@ -262,12 +380,16 @@ impl Light {
                 point: None,
                 delta: true,
             }),
-            Light::Environment { radiance } => {
-                let wi = sample_uniform_sphere(u);
+            Light::Environment { radiance, portals } => {
+                let (wi, pdf) = if portals.is_empty() {
+                    (sample_uniform_sphere(u), 1.0 / (4.0 * PI))
+                } else {
+                    portals.sample(p, uc, u)?
+                };
                 Some(LightSample {
                     wi,
                     li: radiance.sample(wl),
-                    pdf: 1.0 / (4.0 * PI),
+                    pdf,
                     dist: f32::INFINITY,
                     point: None,
                     delta: false,
@@ -351,10 +473,12 @@ impl Light {
         }
     }
 
-    /// Density of direction `wi` for an environment light (solid angle).
-    pub fn pdf_li_escape(&self) -> f32 {
+    /// Density (solid angle) with which [`Light::sample_li`] at `p` picks unit direction `wi`,
+    /// for an environment light (zero for the others).
+    pub fn pdf_li_escape(&self, p: Vec3, wi: Vec3) -> f32 {
         match self {
-            Light::Environment { .. } => 1.0 / (4.0 * PI),
+            Light::Environment { portals, .. } if portals.is_empty() => 1.0 / (4.0 * PI),
+            Light::Environment { portals, .. } => portals.pdf(p, wi),
             _ => 0.0,
         }
     }
@@ -374,7 +498,7 @@ impl Light {
     /// Radiance arriving along an escaped ray.
     pub fn escaped(&self, wl: &SampledWavelengths) -> SampledSpectrum {
         match self {
-            Light::Environment { radiance } => radiance.sample(wl),
+            Light::Environment { radiance, .. } => radiance.sample(wl),
             _ => SampledSpectrum::ZERO,
         }
     }
@@ -435,6 +559,67 @@ pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two portals whose projections from `p` overlap (a skylight above a window-sized
+    /// opening): the density of the directions they sample integrates to 1 over the sphere
+    /// (Monte Carlo with uniform directions), and every sampled direction's density is the
+    /// sum over the portals it crosses, which `pdf` reports for any direction.
+    #[test]
+    fn portal_density_is_normalised_and_matches_sampling() {
+        let portals = Portals::new(vec![
+            Portal::new(
+                Vec3::new(-0.5, 2.0, -0.5),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, 1.5),
+            )
+            .unwrap(),
+            Portal::new(
+                Vec3::new(-0.2, 3.0, -0.3),
+                Vec3::new(0.0, 0.0, 0.8),
+                Vec3::new(0.9, 0.3, 0.0),
+            )
+            .unwrap(),
+        ]);
+        let p = Vec3::new(0.1, 0.0, 0.2);
+        let n = 400_000;
+        let mut rng = 0x9e3779b97f4a7c15u64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+        for _ in 0..n {
+            let w = sample_uniform_sphere(Vec2::new(next(), next()));
+            let f = (portals.pdf(p, w) * 4.0 * PI) as f64;
+            sum += f;
+            sum2 += f * f;
+        }
+        let mean = sum / n as f64;
+        let se = ((sum2 / n as f64 - mean * mean) / n as f64).sqrt();
+        assert!(
+            (mean - 1.0).abs() < 5.0 * se && se < 0.02,
+            "∫pdf = {mean} ± {se}"
+        );
+        let mut both = 0;
+        for _ in 0..10_000 {
+            let (wi, pdf) = portals
+                .sample(p, next(), Vec2::new(next(), next()))
+                .unwrap();
+            assert_eq!(pdf, portals.pdf(p, wi));
+            let crossed = portals
+                .portals
+                .iter()
+                .filter(|q| q.crossing(p, wi).is_some())
+                .count();
+            assert!(crossed >= 1);
+            if crossed == 2 {
+                both += 1;
+            }
+        }
+        assert!(both > 100, "{both} samples through both portals");
+    }
 
     #[test]
     fn cdf_pick() {

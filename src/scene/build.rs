@@ -903,13 +903,31 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
                 irradiance: scaled(spectrum, lux)?,
             }
         }
-        LightDesc::Environment { spectrum, amount } => {
+        LightDesc::Environment {
+            spectrum,
+            amount,
+            portals,
+        } => {
             let lum = match amount {
                 Amount::Luminance(l) => nonneg(ctx, &afield, *l)?,
                 a => return Err(wrong(a, "Luminance(cd/m²)")),
             };
+            let mut built = Vec::with_capacity(portals.len());
+            for (k, d) in portals.iter().enumerate() {
+                let pf = format!("{field}.portals[{k}]");
+                let origin = ctx.vec3(&format!("{pf}.origin"), d.origin)?;
+                let eu = ctx.vec3(&format!("{pf}.edge_u"), d.edge_u)?;
+                let ev = ctx.vec3(&format!("{pf}.edge_v"), d.edge_v)?;
+                built.push(crate::light::Portal::new(origin, eu, ev).ok_or_else(|| {
+                    ctx.err(
+                        &pf,
+                        "the portal has zero area (its edges are zero or parallel)",
+                    )
+                })?);
+            }
             Light::Environment {
                 radiance: scaled(spectrum, lum)?,
+                portals: crate::light::Portals::new(built),
             }
         }
         LightDesc::Goniometric {

@@ -420,6 +420,16 @@ pub struct EmissionDesc {
     pub two_sided: bool,
 }
 
+/// A window or skylight opening of an environment light: the parallelogram
+/// `origin + s·edge_u + t·edge_v`, s, t ∈ [0, 1].
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PortalDesc {
+    pub origin: V3,
+    pub edge_u: V3,
+    pub edge_v: V3,
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum LightDesc {
@@ -447,10 +457,14 @@ pub enum LightDesc {
         spectrum: SpectrumDesc,
         amount: Amount,
     },
-    /// Uniform light from every direction; amount `Luminance(cd/m²)`.
+    /// Uniform light from every direction; amount `Luminance(cd/m²)`. `portals`: the
+    /// openings (windows, skylights) through which it reaches an interior, as parallelograms;
+    /// light sampling then aims through them (see docs/scene-format.md → lights).
     Environment {
         spectrum: SpectrumDesc,
         amount: Amount,
+        #[serde(default)]
+        portals: Vec<PortalDesc>,
     },
     /// A luminaire from a photometric file (docs/luminaires.md): candela from the file,
     /// colour from `spectrum`.
