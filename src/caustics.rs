@@ -530,7 +530,7 @@ pub fn trace_light_path(
                     // ray meets, so a surface behind a pane gives it nothing (the pane itself
                     // receives its own splats on arrival).
                     if let Some((tr, panes)) =
-                        transmittance_counted(world, origin, c.wi, t_max, &wl, stats)
+                        transmittance_counted(world, origin, c.wi, t_max, &wl)
                     {
                         let xyz = radiance_to_xyz(&(l * tr), &wl);
                         let e = if panes == 0 {

@@ -23,8 +23,6 @@ pub struct RayStats {
     /// connections count as shadow rays).
     pub light_paths: u64,
     pub light_rays: u64,
-    /// Window panes crossed by shadow rays (see [`transmittance`]).
-    pub pane_crossings: u64,
 }
 
 impl RayStats {
@@ -38,7 +36,6 @@ impl RayStats {
         self.non_finite += o.non_finite;
         self.light_paths += o.light_paths;
         self.light_rays += o.light_rays;
-        self.pane_crossings += o.pane_crossings;
     }
 }
 
@@ -123,7 +120,7 @@ pub fn trace(
     // specular scattering are light tracing's part (see `crate::caustics`).
     // (A receiver's path, started at depth 1, begins at that non-specular receiver.)
     let mut first_non_specular = start.depth >= 1;
-    // Null events (straight through window panes) on the path so far.
+    // Null events (straight through window panes) since the last scattering.
     let mut straight_through = 0u32;
 
     loop {
@@ -230,7 +227,7 @@ pub fn trace(
                     if !f.is_black() {
                         stats.shadow_rays += 1;
                         if let Some(tr) =
-                            shadow_transmittance(world, &RayStart::surface(&hit), &ls, wl, stats)
+                            shadow_transmittance(world, &RayStart::surface(&hit), &ls, wl)
                         {
                             let pdf = p_select * ls.pdf;
                             let w = if ls.delta {
@@ -263,6 +260,7 @@ pub fn trace(
             first_non_specular = !bs.specular;
         }
         prev_specular = bs.specular;
+        straight_through = 0;
         prev_pdf = bs.pdf;
         prev_p = hit.p;
         let wi_world = frame.to_world(bs.wi);
@@ -318,7 +316,6 @@ fn shadow_transmittance(
     from: &RayStart,
     ls: &crate::light::LightSample,
     wl: &SampledWavelengths,
-    stats: &mut RayStats,
 ) -> Option<SampledSpectrum> {
     let (origin, dir, t_max) = match ls.point {
         Some((p, n)) => shadow_ray_between(from.p, from.error, from.ng, p, point_error_bound(p), n),
@@ -335,7 +332,7 @@ fn shadow_transmittance(
     if t_max <= 0.0 {
         return Some(SampledSpectrum::ONE);
     }
-    transmittance(world, origin, dir, t_max, wl, stats)
+    transmittance(world, origin, dir, t_max, wl)
 }
 
 /// Most surfaces a ray passes straight through before it is given up (a guard against
@@ -346,17 +343,15 @@ pub const MAX_STRAIGHT_THROUGH: u32 = 64;
 /// when an opaque surface blocks it, else the product of the straight-through transmittances
 /// ([`crate::bxdf::Material::straight_transmittance`]) of the window panes it crosses (one
 /// when it crosses none). Without see-through materials in the world this is one any-hit
-/// query; with panes, one any-hit query that passes through them (their crossings are counted
-/// in `stats`).
+/// query; with panes, one any-hit query that passes through them.
 pub fn transmittance(
     world: &World,
     origin: Vec3,
     dir: Vec3,
     t_max: f32,
     wl: &SampledWavelengths,
-    stats: &mut RayStats,
 ) -> Option<SampledSpectrum> {
-    transmittance_counted(world, origin, dir, t_max, wl, stats).map(|(tr, _)| tr)
+    transmittance_counted(world, origin, dir, t_max, wl).map(|(tr, _)| tr)
 }
 
 /// [`transmittance`], and the number of panes the segment crosses.
@@ -366,30 +361,40 @@ pub fn transmittance_counted(
     dir: Vec3,
     t_max: f32,
     wl: &SampledWavelengths,
-    stats: &mut RayStats,
 ) -> Option<(SampledSpectrum, u32)> {
     if world.see_through.is_empty() {
         return (!world.geometry.occluded(origin, dir, t_max)).then_some((SampledSpectrum::ONE, 0));
     }
     // One any-hit traversal that passes through the panes' primitives: the transmittance is a
-    // product, so the order in which they are found does not matter.
+    // product, so the order in which they are found does not matter. A ray exactly through the
+    // seam of two pieces of a pane (two triangles, two touching quads) hits both at the same
+    // point: that is one crossing, recognised by points that agree within their error bounds.
     let mut tr = SampledSpectrum::ONE;
-    let mut crossed = 0u32;
+    let mut seen = [(Vec3::ZERO, Vec3::ZERO); MAX_STRAIGHT_THROUGH as usize];
+    let mut crossed = 0usize;
     let blocked = world
         .geometry
         .occluded_except(origin, dir, t_max, &world.see_through, |hit| {
+            let same =
+                |&(p, e): &(Vec3, Vec3)| ((hit.p - p).abs() - (hit.error + e)).max_element() <= 0.0;
+            if seen[..crossed].iter().any(same) {
+                return true;
+            }
+            if crossed == seen.len() {
+                return false;
+            }
+            seen[crossed] = (hit.p, hit.error);
             crossed += 1;
             let material = &world.materials[world.objects[hit.object as usize].material as usize];
             match material.straight_transmittance(dir.dot(hit.ns), wl) {
                 Some(t) => {
                     tr *= t;
-                    crossed <= MAX_STRAIGHT_THROUGH && !tr.is_black()
+                    !tr.is_black()
                 }
                 None => false,
             }
         });
-    stats.pane_crossings += crossed as u64;
-    (!blocked).then_some((tr, crossed))
+    (!blocked).then_some((tr, crossed as u32))
 }
 
 /// Spectral irradiance (W·m⁻²·nm⁻¹) on the hemisphere around unit normal `n` at `at`: light
@@ -421,7 +426,7 @@ pub fn irradiance(
             let cos = ls.wi.dot(n);
             if cos > 0.0 && ls.pdf > 0.0 && !ls.li.is_black() {
                 stats.shadow_rays += 1;
-                if let Some(tr) = shadow_transmittance(world, at, &ls, wl, stats) {
+                if let Some(tr) = shadow_transmittance(world, at, &ls, wl) {
                     let pdf = p_select * ls.pdf;
                     let w = if ls.delta {
                         1.0

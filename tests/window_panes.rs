@@ -309,3 +309,56 @@ fn a_meter_reads_the_sun_through_both_walls_of_a_glass_bubble() {
         );
     }
 }
+
+#[test]
+fn a_seam_between_pane_pieces_is_one_crossing() {
+    // A 1000 cd lamp 2 m above meters on the floor, and a pane at 1 m made of two pieces:
+    // two triangles (seam along the diagonal x = z), or two quads meeting at x = 0. Meters
+    // whose shadow ray runs exactly through the seam hit both pieces at one point; that is one
+    // crossing, E = I cos θ T(θ) / d², not T².
+    for (pane, meters) in [
+        (
+            r#"(shape: Triangles(positions: [(-2, 1, -2), (2, 1, -2), (2, 1, 2), (-2, 1, 2)], indices: [(0, 1, 2), (0, 2, 3)]), material: "pane")"#,
+            [[0.0, 0.0, 0.0], [1.0, 0.0, 1.0], [0.1, 0.0, 0.0]],
+        ),
+        (
+            r#"(shape: Quad(origin: (-2, 1, -2), edge_u: (2, 0, 0), edge_v: (0, 0, 4)), material: "pane"),
+               (shape: Quad(origin: (0, 1, -2), edge_u: (2, 0, 0), edge_v: (0, 0, 4)), material: "pane")"#,
+            [[0.0, 0.0, 0.0], [0.0, 0.0, 0.7], [0.01, 0.0, 0.0]],
+        ),
+    ] {
+        let list: Vec<String> = meters
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                format!(
+                    r#"Illuminance(name: "m{i}", position: ({}, {}, {}), normal: (0, 1, 0))"#,
+                    m[0], m[1], m[2]
+                )
+            })
+            .collect();
+        let w = world(&format!(
+            r#"(
+            camera: (position: (0, -5, 0), look_at: (0, 0, 0), up: (0, 0, 1), vfov_deg: 10, resolution: (1, 1)),
+            render: (spp: 1, max_depth: 1),
+            materials: {{ "pane": ThinDielectric(ior: Constant({ETA})) }},
+            objects: [{pane}],
+            lights: [Point(position: (0, 2, 0), spectrum: Named("D65"), amount: Intensity(1000.0))],
+            meters: [{}],
+            measure: (samples: 16),
+        )"#,
+            list.join(", ")
+        ));
+        let results = measure_all(&w).meters;
+        for (m, e) in meters.iter().zip(&results) {
+            let d = Vec3::new(-m[0] as f32, 2.0, -m[2] as f32);
+            let d2 = d.length_squared() as f64;
+            let cos = 2.0 / d2.sqrt();
+            assert_estimate(
+                e,
+                1000.0 * cos * thin_slab_transmittance(cos, ETA) / d2,
+                &format!("meter at {m:?}"),
+            );
+        }
+    }
+}

@@ -92,39 +92,39 @@ pub struct Portal {
 impl Portal {
     /// None for a degenerate parallelogram (zero or non-finite area).
     pub fn new(origin: Vec3, eu: Vec3, ev: Vec3) -> Option<Self> {
-        let c = eu.cross(ev);
+        let c = eu.as_dvec3().cross(ev.as_dvec3());
         let area = c.length();
-        (area > 0.0 && area.is_finite()).then(|| Self {
+        let ok = area > 0.0 && area.is_finite() && (area as f32) > 0.0 && (area as f32).is_finite();
+        ok.then(|| Self {
             origin,
             eu,
             ev,
-            n: c / area,
-            area,
+            n: (c / area).as_vec3(),
+            area: area as f32,
         })
     }
 
-    /// Distance along unit `wi` from `p` at which the ray crosses the portal, if it does.
+    /// Distance along unit `wi` from `p` at which the ray crosses the portal, if it does. In
+    /// f64, with the coordinates from cross products (as for quads in the geometry), so that
+    /// slivers, skewed and far portals keep their exact footprint.
     fn crossing(&self, p: Vec3, wi: Vec3) -> Option<f32> {
-        let denom = wi.dot(self.n);
+        let (eu, ev, w) = (self.eu.as_dvec3(), self.ev.as_dvec3(), wi.as_dvec3());
+        let n = eu.cross(ev);
+        let denom = w.dot(n);
         if denom == 0.0 {
             return None;
         }
-        let t = (self.origin - p).dot(self.n) / denom;
+        let op = self.origin.as_dvec3() - p.as_dvec3();
+        let t = op.dot(n) / denom;
         if !(t > 0.0 && t.is_finite()) {
             return None;
         }
-        // Coordinates of the crossing in the (eu, ev) basis.
-        let q = p + wi * t - self.origin;
-        let (uu, uv, vv) = (
-            self.eu.dot(self.eu),
-            self.eu.dot(self.ev),
-            self.ev.dot(self.ev),
-        );
-        let (qu, qv) = (q.dot(self.eu), q.dot(self.ev));
-        let det = uu * vv - uv * uv;
-        let s = (qu * vv - qv * uv) / det;
-        let r = (qv * uu - qu * uv) / det;
-        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then_some(t)
+        // q = s·eu + r·ev: (q × ev)·n = s|n|², (eu × q)·n = r|n|².
+        let q = w * t - op;
+        let nn = n.length_squared();
+        let s = q.cross(ev).dot(n) / nn;
+        let r = eu.cross(q).dot(n) / nn;
+        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then_some(t as f32)
     }
 }
 
@@ -161,12 +161,15 @@ impl Portals {
     fn sample(&self, p: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32)> {
         let (k, _) = pick_from_cdf(&self.cdf, uc);
         let portal = &self.portals[k];
-        let d = portal.origin + portal.eu * u.x + portal.ev * u.y - p;
+        // In f64 relative to p, so that a far portal's sample point keeps its place.
+        let d = (portal.origin.as_dvec3() - p.as_dvec3())
+            + portal.eu.as_dvec3() * u.x as f64
+            + portal.ev.as_dvec3() * u.y as f64;
         let len = d.length();
         if !(len > 0.0 && len.is_finite()) {
             return None;
         }
-        let wi = d / len;
+        let wi = (d / len).as_vec3();
         let pdf = self.pdf(p, wi);
         (pdf > 0.0 && pdf.is_finite()).then_some((wi, pdf))
     }
@@ -619,6 +622,31 @@ mod tests {
             }
         }
         assert!(both > 100, "{both} samples through both portals");
+        // A sliver (1 m × 0.1 mm, skewed) and a portal 10 km away keep their footprint: every
+        // direction sampled through them is found crossing them again.
+        for (o, eu, ev, p) in [
+            (
+                Vec3::new(0.0, 2.0, 0.0),
+                Vec3::X,
+                Vec3::new(1.0, 0.0, 1e-4),
+                Vec3::ZERO,
+            ),
+            (
+                Vec3::new(1e4, 2.0, 1e4),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(0.3, 0.0, 1.0),
+                Vec3::new(1e4 + 0.5, 0.0, 1e4 - 1.0),
+            ),
+        ] {
+            let portals = Portals::new(vec![Portal::new(o, eu, ev).unwrap()]);
+            for _ in 0..10_000 {
+                let s = portals.sample(p, next(), Vec2::new(next(), next()));
+                assert!(
+                    s.is_some_and(|(_, pdf)| pdf > 0.0),
+                    "{o} {eu} {ev}: lost sample"
+                );
+            }
+        }
     }
 
     #[test]
