@@ -294,20 +294,9 @@ fn skylight_through_an_opening_with_and_without_a_portal() {
     // Above the roof the portal lies behind the meter: light sampling through it finds
     // nothing, and the open sky comes from the cosine-sampled paths alone (their MIS weight
     // is 1 where the portals' density is 0): E = π L.
-    assert!(
-        (roof.mean - PI * l).abs() <= 5.0 * roof.stderr && roof.stderr < 0.01 * PI * l,
-        "roof: E = {} ± {}, expected {}",
-        roof.mean,
-        roof.stderr,
-        PI * l
-    );
+    assert_estimate_near(roof.mean, roof.stderr, PI * l, 0.01, "roof");
     for (e, label) in [(&with, "portal"), (&without, "no portal")] {
-        assert!(
-            (e.mean - expected).abs() <= 5.0 * e.stderr && e.stderr < 0.01 * expected,
-            "{label}: E = {} ± {}, expected {expected}",
-            e.mean,
-            e.stderr
-        );
+        assert_estimate_near(e.mean, e.stderr, expected, 0.01, label);
     }
     assert!(
         with.stderr * 4.0 < without.stderr,

@@ -585,13 +585,8 @@ mod tests {
         ]);
         let p = Vec3::new(0.1, 0.0, 0.2);
         let n = 400_000;
-        let mut rng = 0x9e3779b97f4a7c15u64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = crate::geometry::generate::Rng::new(7);
+        let mut next = || rng.f32();
         let (mut sum, mut sum2) = (0.0f64, 0.0f64);
         for _ in 0..n {
             let w = sample_uniform_sphere(Vec2::new(next(), next()));

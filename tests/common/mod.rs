@@ -164,3 +164,12 @@ pub fn conductor_reflectance(c: f64, n_re: f64, k: f64) -> f64 {
     let rp = ((xr - u).powi(2) + (xi - v).powi(2)) / ((xr + u).powi(2) + (xi + v).powi(2));
     0.5 * (rs + rp)
 }
+
+/// An estimate (mean ± standard error) within 5 standard errors of `expected`, with a standard
+/// error below `max_rel_se` of it (so that the check has power).
+pub fn assert_estimate_near(mean: f64, stderr: f64, expected: f64, max_rel_se: f64, label: &str) {
+    assert!(
+        (mean - expected).abs() <= 5.0 * stderr && stderr < max_rel_se * expected,
+        "{label}: {mean} ± {stderr}, expected {expected}"
+    );
+}
