@@ -48,7 +48,9 @@
 use crate::bxdf::Frame;
 use crate::film::radiance_to_xyz;
 use crate::geometry::SceneGeometry;
-use crate::integrator::{transmittance_counted, RayStats, MAX_STRAIGHT_THROUGH};
+use crate::integrator::{
+    choose_pane_lobe, transmittance_counted, PaneLobe, RayStats, MAX_STRAIGHT_THROUGH,
+};
 use crate::light::{pick_from_cdf, Light};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -477,7 +479,7 @@ pub fn trace_light_path(
     let camera = &world.camera;
     // Scattering events so far, counting the surface being processed.
     let mut depth = 0u32;
-    // Null events (straight through window panes) so far.
+    // Null events (straight through window panes) since the last scattering.
     let mut straight_through = 0u32;
     loop {
         stats.light_rays += 1;
@@ -559,24 +561,20 @@ pub fn trace_light_path(
         // arrival, whichever lobe is then chosen.
         let mut chosen = None;
         if material.passes_straight() {
-            let [ux, uy, uc, _] = sampler.get4();
-            let Some(bs) = material.sample(wo, uc, Vec2::new(ux, uy), &mut wl) else {
-                return;
-            };
-            if bs.pdf.is_nan() || bs.pdf <= 0.0 {
-                return;
-            }
-            if material.is_straight_through(wo, bs.wi) {
-                beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-                depth -= 1;
-                straight_through += 1;
-                if beta.is_black() || straight_through > MAX_STRAIGHT_THROUGH {
-                    return;
+            match choose_pane_lobe(material, wo, &mut sampler, &mut wl) {
+                None => return,
+                Some(PaneLobe::Straight(weight)) => {
+                    beta *= weight;
+                    depth -= 1;
+                    straight_through += 1;
+                    if beta.is_black() || straight_through > MAX_STRAIGHT_THROUGH {
+                        return;
+                    }
+                    ray_o = hit.spawn_origin(ray_d);
+                    continue;
                 }
-                ray_o = hit.spawn_origin(ray_d);
-                continue;
+                Some(PaneLobe::Scatter(bs)) => chosen = Some(bs),
             }
-            chosen = Some(bs);
         }
 
         // Continue while a further surface is within the depth limit; the first scattering
@@ -612,6 +610,7 @@ pub fn trace_light_path(
             beta = beta / (1.0 - q);
             throughput /= 1.0 - q;
         }
+        straight_through = 0;
         ray_o = hit.spawn_origin(wi_world);
         ray_d = wi_world.normalize();
     }

@@ -184,24 +184,20 @@ pub fn trace(
         // through the pane with its transmittance (see `transmittance`).
         let mut chosen = None;
         if material.passes_straight() {
-            let [ux, uy, uc, _] = sampler.get4();
-            let Some(bs) = material.sample(wo, uc, glam::Vec2::new(ux, uy), wl) else {
-                break;
-            };
-            if bs.pdf.is_nan() || bs.pdf <= 0.0 {
-                break;
-            }
-            if material.is_straight_through(wo, bs.wi) {
-                beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-                straight_through += 1;
-                if beta.is_black() || straight_through > MAX_STRAIGHT_THROUGH {
-                    break;
+            match choose_pane_lobe(material, wo, sampler, wl) {
+                None => break,
+                Some(PaneLobe::Straight(weight)) => {
+                    beta *= weight;
+                    straight_through += 1;
+                    if beta.is_black() || straight_through > MAX_STRAIGHT_THROUGH {
+                        break;
+                    }
+                    ray_o = hit.spawn_origin(ray_d);
+                    stats.bounce_rays += 1;
+                    continue;
                 }
-                ray_o = hit.spawn_origin(ray_d);
-                stats.bounce_rays += 1;
-                continue;
+                Some(PaneLobe::Scatter(bs)) => chosen = Some(bs),
             }
-            chosen = Some(bs);
         }
 
         if depth >= settings.max_depth {
@@ -338,6 +334,36 @@ fn shadow_transmittance(
 /// Most surfaces a ray passes straight through before it is given up (a guard against
 /// pathological stacks of panes).
 pub const MAX_STRAIGHT_THROUGH: u32 = 64;
+
+/// The lobe a window pane ([`crate::bxdf::Material::passes_straight`]) chose for a path.
+pub enum PaneLobe {
+    /// Straight through: a null event, with this weight f·|cos|/pdf on the throughput.
+    Straight(SampledSpectrum),
+    /// A real scattering (the mirror lobe), to be handled like any other.
+    Scatter(crate::bxdf::BsdfSample),
+}
+
+/// At a surface that passes light straight through, choose its lobe before anything else (one
+/// set of four sampler dimensions), so that passing through can be a null event; the camera
+/// paths and the light paths both do this. None when the surface scatters nothing (the path
+/// ends).
+pub fn choose_pane_lobe(
+    material: &crate::bxdf::Material,
+    wo: Vec3,
+    sampler: &mut Sampler,
+    wl: &mut SampledWavelengths,
+) -> Option<PaneLobe> {
+    let [ux, uy, uc, _] = sampler.get4();
+    let bs = material.sample(wo, uc, glam::Vec2::new(ux, uy), wl)?;
+    if bs.pdf.is_nan() || bs.pdf <= 0.0 {
+        return None;
+    }
+    Some(if material.is_straight_through(wo, bs.wi) {
+        PaneLobe::Straight(bs.f * (bs.wi.z.abs() / bs.pdf))
+    } else {
+        PaneLobe::Scatter(bs)
+    })
+}
 
 /// Spectral transmittance of the segment from `origin` along unit `dir` up to `t_max`: `None`
 /// when an opaque surface blocks it, else the product of the straight-through transmittances
