@@ -84,32 +84,37 @@ pub struct Portal {
     origin: Vec3,
     eu: Vec3,
     ev: Vec3,
-    /// Unit normal.
-    n: Vec3,
-    area: f32,
+    /// eu × ev (f64): the normal, of length `area`.
+    n: glam::DVec3,
+    area: f64,
 }
 
 impl Portal {
     /// None for a degenerate parallelogram (zero or non-finite area).
     pub fn new(origin: Vec3, eu: Vec3, ev: Vec3) -> Option<Self> {
-        let c = eu.as_dvec3().cross(ev.as_dvec3());
-        let area = c.length();
+        let n = eu.as_dvec3().cross(ev.as_dvec3());
+        let area = n.length();
         let ok = area > 0.0 && area.is_finite() && (area as f32) > 0.0 && (area as f32).is_finite();
-        ok.then(|| Self {
+        ok.then_some(Self {
             origin,
             eu,
             ev,
-            n: (c / area).as_vec3(),
-            area: area as f32,
+            n,
+            area,
         })
     }
 
-    /// Distance along unit `wi` from `p` at which the ray crosses the portal, if it does. In
-    /// f64, with the coordinates from cross products (as for quads in the geometry), so that
-    /// slivers, skewed and far portals keep their exact footprint.
-    fn crossing(&self, p: Vec3, wi: Vec3) -> Option<f32> {
-        let (eu, ev, w) = (self.eu.as_dvec3(), self.ev.as_dvec3(), wi.as_dvec3());
-        let n = eu.cross(ev);
+    /// Distance along unit `wi` from `p` at which the ray crosses the portal, if it does, and
+    /// |cos θ| to its normal there. In f64, with the coordinates from cross products (as for
+    /// quads in the geometry), so that slivers, skewed and far portals keep their exact
+    /// footprint.
+    fn crossing(&self, p: Vec3, wi: Vec3) -> Option<(f64, f64)> {
+        let (eu, ev, w, n) = (
+            self.eu.as_dvec3(),
+            self.ev.as_dvec3(),
+            wi.as_dvec3(),
+            self.n,
+        );
         let denom = w.dot(n);
         if denom == 0.0 {
             return None;
@@ -124,7 +129,7 @@ impl Portal {
         let nn = n.length_squared();
         let s = q.cross(ev).dot(n) / nn;
         let r = eu.cross(q).dot(n) / nn;
-        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then_some(t as f32)
+        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then(|| (t, denom.abs() / self.area))
     }
 }
 
@@ -133,13 +138,13 @@ impl Portal {
 pub struct Portals {
     portals: Vec<Portal>,
     cdf: Vec<f32>,
-    total_area: f32,
+    total_area: f64,
 }
 
 impl Portals {
     pub fn new(portals: Vec<Portal>) -> Self {
-        let areas: Vec<f64> = portals.iter().map(|p| p.area as f64).collect();
-        let total_area = areas.iter().sum::<f64>() as f32;
+        let areas: Vec<f64> = portals.iter().map(|p| p.area).collect();
+        let total_area = areas.iter().sum::<f64>();
         let cdf = if portals.is_empty() {
             Vec::new()
         } else {
@@ -178,13 +183,13 @@ impl Portals {
     /// Σ over the portals the ray crosses of t² / (|cos θ| · total area), θ the angle to the
     /// portal's normal at the crossing t.
     fn pdf(&self, p: Vec3, wi: Vec3) -> f32 {
-        let mut pdf = 0.0;
+        let mut pdf = 0.0f64;
         for portal in &self.portals {
-            if let Some(t) = portal.crossing(p, wi) {
-                let cos = wi.dot(portal.n).abs();
+            if let Some((t, cos)) = portal.crossing(p, wi) {
                 pdf += t * t / (cos * self.total_area);
             }
         }
+        let pdf = pdf as f32;
         if pdf.is_finite() {
             pdf
         } else {
