@@ -12,8 +12,8 @@
  *   embree_trace RAYS [--quality low|medium|high] [--build-reps N] [--robust]
  *                     [--threads 1,2] [--reps N] [--hits OUT] [--serve]
  *
- * --robust sets RTC_SCENE_FLAG_ROBUST (watertight traversal; for checking hit mismatches,
- * not used by the benchmark).
+ * --robust sets RTC_SCENE_FLAG_ROBUST (Embree's watertight mode, which candela's kernel always
+ * matches; the benchmark's `medium-robust` column).
  *
  * Without --serve it traces every batch --reps times for each thread count and prints one
  * `trace ...` line per run. With --serve (used by `candela bench traversal --embree`) it reads

@@ -37,7 +37,9 @@ pub struct TraversalArgs {
     /// Also time Embree: the embree_trace program built by bench/embree/build.sh. Needs --rays.
     #[arg(long, value_name = "PROGRAM", requires = "rays")]
     pub embree: Option<PathBuf>,
-    /// Embree build qualities to compare against (low, medium, high).
+    /// Embree configurations to compare against: a build quality (low, medium, high),
+    /// optionally with `-robust` (e.g. `medium-robust`: RTC_SCENE_FLAG_ROBUST, Embree's
+    /// watertight mode, the guarantee candela's kernel always gives).
     #[arg(long, value_delimiter = ',', default_value = "medium,high")]
     pub embree_quality: Vec<String>,
     /// Thread counts to time (comma separated).
@@ -323,9 +325,15 @@ fn field<T: std::str::FromStr>(line: &str, key: &str) -> Result<T> {
 
 impl Embree {
     fn spawn(program: &Path, rays: &Path, quality: &str, build_reps: usize) -> Result<Embree> {
+        let (build_quality, robust) = match quality.strip_suffix("-robust") {
+            Some(q) => (q, true),
+            None => (quality, false),
+        };
         let mut child = Command::new(program)
             .arg(rays)
-            .args(["--quality", quality, "--build-reps"])
+            .args(["--quality", build_quality])
+            .args(robust.then_some("--robust"))
+            .arg("--build-reps")
             .arg(build_reps.max(1).to_string())
             .arg("--serve")
             .stdin(Stdio::piped())

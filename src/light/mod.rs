@@ -13,7 +13,7 @@ pub mod sampler;
 use crate::bxdf::Frame;
 use crate::geometry::{Hit, SceneGeometry};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use std::f32::consts::PI;
 
 pub use sampler::LightSampler;
@@ -78,16 +78,22 @@ pub enum Light {
 
 /// A window or skylight opening through which an environment light reaches an interior: the
 /// parallelogram `origin + s·eu + t·ev`, s, t ∈ [0, 1] (pbrt-v4's portal lights and Bitterli et
-/// al. 2015 sample the environment through such openings; here simply uniformly by area).
+/// al. 2015 sample the environment through such openings). [`Portals`] samples it uniformly in
+/// the solid angle it subtends.
 #[derive(Clone, Copy, Debug)]
 pub struct Portal {
     origin: Vec3,
     eu: Vec3,
     ev: Vec3,
     /// eu × ev (f64): the normal, of length `area`.
-    n: glam::DVec3,
+    n: DVec3,
     area: f64,
 }
+
+/// Below this solid angle (sr) a portal is sampled uniformly by area instead of by solid angle:
+/// the two densities then differ by less than its angular size squared, and the spherical
+/// triangle construction would lose digits. A 1 m² window 1 km away subtends 10⁻⁶ sr.
+const PORTAL_AREA_SAMPLING_BELOW: f64 = 1e-6;
 
 impl Portal {
     /// None for a degenerate parallelogram (zero or non-finite area).
@@ -102,6 +108,24 @@ impl Portal {
             n,
             area,
         })
+    }
+
+    /// The corners relative to `p`, in f64 (so that a far portal keeps its shape): o, o + eu,
+    /// o + eu + ev, o + ev. The two triangles are corners (0, 1, 2) and (0, 2, 3).
+    fn corners(&self, p: Vec3) -> [DVec3; 4] {
+        let o = self.origin.as_dvec3() - p.as_dvec3();
+        let (eu, ev) = (self.eu.as_dvec3(), self.ev.as_dvec3());
+        [o, o + eu, o + eu + ev, o + ev]
+    }
+
+    /// Solid angles (sr) of the portal's two triangles seen from `p`.
+    fn solid_angles(&self, p: Vec3) -> (f64, f64) {
+        let c = self.corners(p);
+        // For both triangles (b − a) × (c − a) = eu × ev.
+        (
+            triangle_solid_angle(c[0], c[1], c[2], self.n),
+            triangle_solid_angle(c[0], c[2], c[3], self.n),
+        )
     }
 
     /// Distance along unit `wi` from `p` at which the ray crosses the portal, if it does, and
@@ -133,60 +157,177 @@ impl Portal {
     }
 }
 
-/// The portals of an environment light, chosen in proportion to their areas.
+/// Solid angle of the triangle with vertices `a`, `b`, `c` (relative to the viewpoint, not
+/// normalized), given `n` = (b − a) × (c − a): Van Oosterom & Strackee (1983),
+/// tan(Ω/2) = |a·(b × c)| / (|a||b||c| + (a·b)|c| + (a·c)|b| + (b·c)|a|). The triple product
+/// a·(b × c) equals a·n, which is taken from the exact edges rather than from the cross product
+/// of nearly parallel far vertices.
+fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3, n: DVec3) -> f64 {
+    let triple = a.dot(n);
+    let (la, lb, lc) = (a.length(), b.length(), c.length());
+    let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+    let omega = 2.0 * triple.abs().atan2(den);
+    if omega.is_finite() {
+        omega
+    } else {
+        0.0
+    }
+}
+
+/// The angle between unit vectors, accurate also near 0 and π (pbrt-v4 `AngleBetween`).
+fn angle_between(v1: DVec3, v2: DVec3) -> f64 {
+    if v1.dot(v2) < 0.0 {
+        std::f64::consts::PI - 2.0 * ((v1 + v2).length() / 2.0).min(1.0).asin()
+    } else {
+        2.0 * ((v2 - v1).length() / 2.0).min(1.0).asin()
+    }
+}
+
+/// A unit direction distributed uniformly in the solid angle of the triangle with vertices
+/// `a`, `b`, `c` (relative to the viewpoint, not normalized), from `u` ∈ [0, 1)²: Arvo (1995),
+/// "Stratified sampling of spherical triangles", in the form of pbrt-v4's
+/// `SampleSphericalTriangle` (f64 here). None for a degenerate triangle.
+fn sample_spherical_triangle(a: DVec3, b: DVec3, c: DVec3, u: Vec2) -> Option<DVec3> {
+    let (a, b, c) = (a.try_normalize()?, b.try_normalize()?, c.try_normalize()?);
+    let n_ab = a.cross(b).try_normalize()?;
+    let n_bc = b.cross(c).try_normalize()?;
+    let n_ca = c.cross(a).try_normalize()?;
+    // The triangle's angles at a and the sum of all three (its area is the sum − π).
+    let alpha = angle_between(n_ab, -n_ca);
+    let beta = angle_between(n_bc, -n_ab);
+    let gamma = angle_between(n_ca, -n_bc);
+    let pi = std::f64::consts::PI;
+    // The sub-triangle a b c' of area u.x · A.
+    let ap_pi = pi + u.x as f64 * (alpha + beta + gamma - pi);
+    let (sin_alpha, cos_alpha) = alpha.sin_cos();
+    let (sin_ap, cos_ap) = ap_pi.sin_cos();
+    let sin_phi = sin_ap * cos_alpha - cos_ap * sin_alpha;
+    let cos_phi = cos_ap * cos_alpha + sin_ap * sin_alpha;
+    let k1 = cos_phi + cos_alpha;
+    let k2 = sin_phi - sin_alpha * a.dot(b);
+    let cos_bp = (k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha)
+        / ((k2 * sin_phi + k1 * cos_phi) * sin_alpha);
+    if cos_bp.is_nan() {
+        return None;
+    }
+    let cos_bp = cos_bp.clamp(-1.0, 1.0);
+    let sin_bp = (1.0 - cos_bp * cos_bp).max(0.0).sqrt();
+    let cp = cos_bp * a + sin_bp * (c - c.dot(a) * a).try_normalize()?;
+    // Then along the arc from b to c'.
+    let cos_t = 1.0 - u.y as f64 * (1.0 - cp.dot(b));
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    let w = cos_t * b + sin_t * (cp - cp.dot(b) * b).try_normalize()?;
+    w.try_normalize()
+}
+
+/// The portals of an environment light. Seen from a point, each is chosen in proportion to
+/// the solid angle it subtends there and sampled uniformly within it (so the density is 1/Ω
+/// over all their solid angle Ω, summed where portals overlap); a portal smaller than
+/// [`PORTAL_AREA_SAMPLING_BELOW`] is sampled uniformly by area.
 #[derive(Clone, Debug, Default)]
 pub struct Portals {
     portals: Vec<Portal>,
-    cdf: Vec<f32>,
-    total_area: f64,
 }
 
 impl Portals {
     pub fn new(portals: Vec<Portal>) -> Self {
-        let areas: Vec<f64> = portals.iter().map(|p| p.area).collect();
-        let total_area = areas.iter().sum::<f64>();
-        let cdf = if portals.is_empty() {
-            Vec::new()
-        } else {
-            cdf_from_weights(&areas)
-        };
-        Self {
-            portals,
-            cdf,
-            total_area,
-        }
+        Self { portals }
     }
 
     pub fn is_empty(&self) -> bool {
         self.portals.is_empty()
     }
 
-    /// A direction from `p` through a point chosen uniformly on all the portals' area, and its
-    /// density ([`Portals::pdf`]: the sum over every portal the direction crosses).
-    fn sample(&self, p: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32)> {
-        let (k, _) = pick_from_cdf(&self.cdf, uc);
-        let portal = &self.portals[k];
-        // In f64 relative to p, so that a far portal's sample point keeps its place.
-        let d = (portal.origin.as_dvec3() - p.as_dvec3())
-            + portal.eu.as_dvec3() * u.x as f64
-            + portal.ev.as_dvec3() * u.y as f64;
-        let len = d.length();
-        if !(len > 0.0 && len.is_finite()) {
-            return None;
+    /// Calls `f` with the solid angles of every portal's two triangles seen from `p` (on the
+    /// stack for up to 8 portals).
+    fn with_solid_angles<R>(&self, p: Vec3, f: impl FnOnce(&[(f64, f64)]) -> R) -> R {
+        const N: usize = 8;
+        if self.portals.len() <= N {
+            let mut buf = [(0.0, 0.0); N];
+            for (b, q) in buf.iter_mut().zip(&self.portals) {
+                *b = q.solid_angles(p);
+            }
+            f(&buf[..self.portals.len()])
+        } else {
+            let v: Vec<_> = self.portals.iter().map(|q| q.solid_angles(p)).collect();
+            f(&v)
         }
-        let wi = (d / len).as_vec3();
-        let pdf = self.pdf(p, wi);
-        (pdf > 0.0 && pdf.is_finite()).then_some((wi, pdf))
+    }
+
+    /// Σ over the portals of the solid angle they subtend from `p`.
+    #[cfg(test)]
+    fn total_solid_angle(&self, p: Vec3) -> f64 {
+        self.with_solid_angles(p, |om| om.iter().map(|(a, b)| a + b).sum())
+    }
+
+    /// A direction from `p` through one of the portals and its density ([`Portals::pdf`]).
+    fn sample(&self, p: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32)> {
+        self.with_solid_angles(p, |om| {
+            let total: f64 = om.iter().map(|(a, b)| a + b).sum();
+            if !(total > 0.0 && total.is_finite()) {
+                return None;
+            }
+            // The portal whose cumulative solid-angle interval holds uc·total, and uc
+            // remapped to [0, 1) within it (to pick one of its triangles).
+            let target = uc as f64 * total;
+            let mut acc = 0.0;
+            let mut chosen = None;
+            for (k, &(a, b)) in om.iter().enumerate() {
+                if a + b > 0.0 {
+                    chosen = Some((k, a, b, (target - acc) / (a + b)));
+                    if target < acc + a + b {
+                        break;
+                    }
+                }
+                acc += a + b;
+            }
+            let (k, om0, om1, v) = chosen?;
+            let portal = &self.portals[k];
+            let c = portal.corners(p);
+            let d = if om0 + om1 < PORTAL_AREA_SAMPLING_BELOW {
+                // In f64 relative to p, so that a far portal's sample point keeps its place.
+                c[0] + portal.eu.as_dvec3() * u.x as f64 + portal.ev.as_dvec3() * u.y as f64
+            } else if v * (om0 + om1) < om0 {
+                sample_spherical_triangle(c[0], c[1], c[2], u)?
+            } else {
+                sample_spherical_triangle(c[0], c[2], c[3], u)?
+            };
+            let len = d.length();
+            if !(len > 0.0 && len.is_finite()) {
+                return None;
+            }
+            let wi = (d / len).as_vec3();
+            let pdf = self.pdf_with(p, wi, om);
+            (pdf > 0.0 && pdf.is_finite()).then_some((wi, pdf))
+        })
     }
 
     /// Solid-angle density of [`Portals::sample`] producing unit direction `wi` from `p`:
-    /// Σ over the portals the ray crosses of t² / (|cos θ| · total area), θ the angle to the
-    /// portal's normal at the crossing t.
+    /// Σ over the portals the ray crosses of (Ω_k / Ω) · p_k, with Ω_k the portal's solid angle,
+    /// Ω their sum, and p_k = 1 / Ω_k, or t² / (|cos θ| · area) for a portal sampled by area
+    /// (θ the angle to the portal's normal at the crossing t).
     fn pdf(&self, p: Vec3, wi: Vec3) -> f32 {
+        if self.portals.iter().all(|q| q.crossing(p, wi).is_none()) {
+            return 0.0;
+        }
+        self.with_solid_angles(p, |om| self.pdf_with(p, wi, om))
+    }
+
+    /// [`Portals::pdf`] given the portals' solid angles `om` from `p`.
+    fn pdf_with(&self, p: Vec3, wi: Vec3, om: &[(f64, f64)]) -> f32 {
+        let total: f64 = om.iter().map(|(a, b)| a + b).sum();
         let mut pdf = 0.0f64;
-        for portal in &self.portals {
+        for (portal, &(a, b)) in self.portals.iter().zip(om) {
+            let omega = a + b;
+            if !(omega > 0.0) {
+                continue;
+            }
             if let Some((t, cos)) = portal.crossing(p, wi) {
-                pdf += t * t / (cos * self.total_area);
+                pdf += if omega < PORTAL_AREA_SAMPLING_BELOW {
+                    omega / total * t * t / (cos * portal.area)
+                } else {
+                    1.0 / total
+                };
             }
         }
         let pdf = pdf as f32;
@@ -647,6 +788,70 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Samples are uniform in solid angle within a portal (both of its triangles), for a near,
+    /// oblique view, a point 1 mm in front of the opening and a far portal sampled by area: the
+    /// fraction of samples through a sub-rectangle equals its share of the solid angle (its
+    /// share of the area for the far one), within 5 binomial standard errors.
+    #[test]
+    fn portal_samples_are_uniform_in_solid_angle() {
+        let (o, eu, ev) = (
+            Vec3::new(-1.0, 2.0, -0.5),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.5, 1.5),
+        );
+        let portal = Portal::new(o, eu, ev).unwrap();
+        let portals = Portals::new(vec![portal]);
+        // The sub-rectangle s ∈ [0.1, 0.6], r ∈ [0.3, 1.0] crosses the diagonal of the split.
+        let sub = Portal::new(o + 0.1 * eu + 0.3 * ev, 0.5 * eu, 0.7 * ev).unwrap();
+        let mid = o + 0.5 * (eu + ev);
+        let normal = eu.cross(ev).normalize();
+        let mut rng = crate::geometry::generate::Rng::new(11);
+        let mut next = || rng.f32();
+        for p in [
+            Vec3::new(0.3, 0.0, 0.2),
+            Vec3::new(2.5, 1.8, -1.0),
+            mid - 1e-3 * normal,
+        ] {
+            let (a, b) = sub.solid_angles(p);
+            let expected = (a + b) / portals.total_solid_angle(p);
+            let n = 100_000;
+            let mut inside = 0;
+            for _ in 0..n {
+                let (wi, pdf) = portals
+                    .sample(p, next(), Vec2::new(next(), next()))
+                    .expect("sample");
+                assert!((pdf as f64 * portals.total_solid_angle(p) - 1.0).abs() < 1e-5);
+                if sub.crossing(p, wi).is_some() {
+                    inside += 1;
+                }
+            }
+            let f = inside as f64 / n as f64;
+            let se = (expected * (1.0 - expected) / n as f64).sqrt();
+            assert!(
+                (f - expected).abs() < 5.0 * se,
+                "from {p}: {f} of the samples in the sub-rectangle, expected {expected} ± {se}"
+            );
+        }
+        // 1 m² seen from 3 km subtends ~10⁻⁷ sr: sampled by area, so the sub-rectangle gets its
+        // share of the area (0.35), and the density is that of area sampling.
+        let p = Vec3::new(0.0, -3000.0, 0.0);
+        assert!(portals.total_solid_angle(p) < PORTAL_AREA_SAMPLING_BELOW);
+        let n = 100_000;
+        let mut inside = 0;
+        for _ in 0..n {
+            let (wi, _) = portals
+                .sample(p, next(), Vec2::new(next(), next()))
+                .expect("sample");
+            inside += sub.crossing(p, wi).is_some() as usize;
+        }
+        let f = inside as f64 / n as f64;
+        let se = (0.35f64 * 0.65 / n as f64).sqrt();
+        assert!(
+            (f - 0.35).abs() < 5.0 * se,
+            "far portal: {f} in the sub-rectangle"
+        );
     }
 
     #[test]
