@@ -319,7 +319,7 @@ impl Portals {
         let mut pdf = 0.0f64;
         for (portal, &(a, b)) in self.portals.iter().zip(om) {
             let omega = a + b;
-            if !(omega > 0.0) {
+            if omega <= 0.0 {
                 continue;
             }
             if let Some((t, cos)) = portal.crossing(p, wi) {
