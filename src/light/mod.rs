@@ -174,33 +174,22 @@ fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3, n: DVec3) -> f64 {
     }
 }
 
-/// The angle between unit vectors, accurate also near 0 and π (pbrt-v4 `AngleBetween`).
-fn angle_between(v1: DVec3, v2: DVec3) -> f64 {
-    if v1.dot(v2) < 0.0 {
-        std::f64::consts::PI - 2.0 * ((v1 + v2).length() / 2.0).min(1.0).asin()
-    } else {
-        2.0 * ((v2 - v1).length() / 2.0).min(1.0).asin()
-    }
-}
-
 /// A unit direction distributed uniformly in the solid angle of the triangle with vertices
-/// `a`, `b`, `c` (relative to the viewpoint, not normalized), from `u` ∈ [0, 1)²: Arvo (1995),
-/// "Stratified sampling of spherical triangles", in the form of pbrt-v4's
-/// `SampleSphericalTriangle` (f64 here). None for a degenerate triangle.
-fn sample_spherical_triangle(a: DVec3, b: DVec3, c: DVec3, u: Vec2) -> Option<DVec3> {
+/// `a`, `b`, `c` (relative to the viewpoint, not normalized) whose solid angle is `area`, from
+/// `u` ∈ [0, 1)²: Arvo (1995), "Stratified sampling of spherical triangles", in the form of
+/// pbrt-v4's `SampleSphericalTriangle` (f64 here). The angle α at `a` enters only through its
+/// sine and cosine, taken from the normals of the two sides at `a`, and the sub-triangle's
+/// area u.x·A from the given solid angle, so no inverse trigonometry is needed. None for a
+/// degenerate triangle.
+fn sample_spherical_triangle(a: DVec3, b: DVec3, c: DVec3, area: f64, u: Vec2) -> Option<DVec3> {
     let (a, b, c) = (a.try_normalize()?, b.try_normalize()?, c.try_normalize()?);
     let n_ab = a.cross(b).try_normalize()?;
-    let n_bc = b.cross(c).try_normalize()?;
-    let n_ca = c.cross(a).try_normalize()?;
-    // The triangle's angles at a and the sum of all three (its area is the sum − π).
-    let alpha = angle_between(n_ab, -n_ca);
-    let beta = angle_between(n_bc, -n_ab);
-    let gamma = angle_between(n_ca, -n_bc);
-    let pi = std::f64::consts::PI;
-    // The sub-triangle a b c' of area u.x · A.
-    let ap_pi = pi + u.x as f64 * (alpha + beta + gamma - pi);
-    let (sin_alpha, cos_alpha) = alpha.sin_cos();
-    let (sin_ap, cos_ap) = ap_pi.sin_cos();
+    let n_ac = a.cross(c).try_normalize()?;
+    let (cos_alpha, sin_alpha) = (n_ab.dot(n_ac), n_ab.cross(n_ac).length());
+    // The sub-triangle a b c' of area u.x·A: its angle sum A' + π has sin = −sin(u.x·A) and
+    // cos = −cos(u.x·A).
+    let (sin_x, cos_x) = (u.x as f64 * area).sin_cos();
+    let (sin_ap, cos_ap) = (-sin_x, -cos_x);
     let sin_phi = sin_ap * cos_alpha - cos_ap * sin_alpha;
     let cos_phi = cos_ap * cos_alpha + sin_ap * sin_alpha;
     let k1 = cos_phi + cos_alpha;
@@ -288,9 +277,9 @@ impl Portals {
                 // In f64 relative to p, so that a far portal's sample point keeps its place.
                 c[0] + portal.eu.as_dvec3() * u.x as f64 + portal.ev.as_dvec3() * u.y as f64
             } else if v * (om0 + om1) < om0 {
-                sample_spherical_triangle(c[0], c[1], c[2], u)?
+                sample_spherical_triangle(c[0], c[1], c[2], om0, u)?
             } else {
-                sample_spherical_triangle(c[0], c[2], c[3], u)?
+                sample_spherical_triangle(c[0], c[2], c[3], om1, u)?
             };
             let len = d.length();
             if !(len > 0.0 && len.is_finite()) {
