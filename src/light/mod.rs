@@ -121,10 +121,13 @@ impl Portal {
     /// Solid angles (sr) of the portal's two triangles seen from `p`.
     fn solid_angles(&self, p: Vec3) -> (f64, f64) {
         let c = self.corners(p);
-        // For both triangles (b − a) × (c − a) = eu × ev.
+        let l = c.map(|v| v.length());
+        // For both triangles (b − a) × (c − a) = eu × ev and a = c[0], so the triple product
+        // a·(b × c) is the same.
+        let triple = c[0].dot(self.n);
         (
-            triangle_solid_angle(c[0], c[1], c[2], self.n),
-            triangle_solid_angle(c[0], c[2], c[3], self.n),
+            triangle_solid_angle(triple, [c[0], c[1], c[2]], [l[0], l[1], l[2]]),
+            triangle_solid_angle(triple, [c[0], c[2], c[3]], [l[0], l[2], l[3]]),
         )
     }
 
@@ -157,14 +160,14 @@ impl Portal {
     }
 }
 
-/// Solid angle of the triangle with vertices `a`, `b`, `c` (relative to the viewpoint, not
-/// normalized), given `n` = (b − a) × (c − a): Van Oosterom & Strackee (1983),
-/// tan(Ω/2) = |a·(b × c)| / (|a||b||c| + (a·b)|c| + (a·c)|b| + (b·c)|a|). The triple product
-/// a·(b × c) equals a·n, which is taken from the exact edges rather than from the cross product
-/// of nearly parallel far vertices.
-fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3, n: DVec3) -> f64 {
-    let triple = a.dot(n);
-    let (la, lb, lc) = (a.length(), b.length(), c.length());
+/// Solid angle of the triangle with vertices `v` = (a, b, c) relative to the viewpoint (not
+/// normalized), of lengths `l`, given their triple product a·(b × c): Van Oosterom & Strackee
+/// (1983), tan(Ω/2) = |a·(b × c)| / (|a||b||c| + (a·b)|c| + (a·c)|b| + (b·c)|a|). The caller
+/// takes the triple product as a·((b − a) × (c − a)), from the exact edges rather than from the
+/// cross product of nearly parallel far vertices.
+fn triangle_solid_angle(triple: f64, v: [DVec3; 3], l: [f64; 3]) -> f64 {
+    let [a, b, c] = v;
+    let [la, lb, lc] = l;
     let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
     let omega = 2.0 * triple.abs().atan2(den);
     if omega.is_finite() {
@@ -182,9 +185,10 @@ fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3, n: DVec3) -> f64 {
 /// area u.x·A from the given solid angle, so no inverse trigonometry is needed. None for a
 /// degenerate triangle.
 fn sample_spherical_triangle(a: DVec3, b: DVec3, c: DVec3, area: f64, u: Vec2) -> Option<DVec3> {
-    let (a, b, c) = (a.try_normalize()?, b.try_normalize()?, c.try_normalize()?);
-    let n_ab = a.cross(b).try_normalize()?;
-    let n_ac = a.cross(c).try_normalize()?;
+    // Plain normalizations: a degenerate triangle gives NaN, caught at the end.
+    let unit = |v: DVec3| v * (1.0 / v.length());
+    let (a, b, c) = (unit(a), unit(b), unit(c));
+    let (n_ab, n_ac) = (unit(a.cross(b)), unit(a.cross(c)));
     let (cos_alpha, sin_alpha) = (n_ab.dot(n_ac), n_ab.cross(n_ac).length());
     // The sub-triangle a b c' of area u.x·A: its angle sum A' + π has sin = −sin(u.x·A) and
     // cos = −cos(u.x·A).
@@ -196,17 +200,20 @@ fn sample_spherical_triangle(a: DVec3, b: DVec3, c: DVec3, area: f64, u: Vec2) -
     let k2 = sin_phi - sin_alpha * a.dot(b);
     let cos_bp = (k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha)
         / ((k2 * sin_phi + k1 * cos_phi) * sin_alpha);
-    if cos_bp.is_nan() {
-        return None;
-    }
     let cos_bp = cos_bp.clamp(-1.0, 1.0);
     let sin_bp = (1.0 - cos_bp * cos_bp).max(0.0).sqrt();
-    let cp = cos_bp * a + sin_bp * (c - c.dot(a) * a).try_normalize()?;
+    let cp = cos_bp * a + sin_bp * unit(c - c.dot(a) * a);
     // Then along the arc from b to c'.
     let cos_t = 1.0 - u.y as f64 * (1.0 - cp.dot(b));
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-    let w = cos_t * b + sin_t * (cp - cp.dot(b) * b).try_normalize()?;
-    w.try_normalize()
+    // Unit length up to rounding (the caller normalizes). At u.x = 0, c' = b and the arc is a
+    // point.
+    let w = if sin_t > 0.0 {
+        cos_t * b + sin_t * unit(cp - cp.dot(b) * b)
+    } else {
+        b
+    };
+    w.is_finite().then_some(w)
 }
 
 /// The portals of an environment light. Seen from a point, each is chosen in proportion to
