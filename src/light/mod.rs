@@ -121,19 +121,7 @@ impl Portal {
 
     /// Solid angles (sr) of the portal's two triangles seen from `p`.
     fn solid_angles(&self, p: Vec3) -> (f64, f64) {
-        let c = self.corners(p);
-        let l = c.map(|v| v.length());
-        // For both triangles (b − a) × (c − a) = eu × ev and a = c[0], so the triple product
-        // a·(b × c) is the same.
-        let triple = c[0].dot(self.n);
-        if triple == 0.0 {
-            // p lies in the portal's plane: no ray from it crosses the portal.
-            return (0.0, 0.0);
-        }
-        (
-            triangle_solid_angle(triple, [c[0], c[1], c[2]], [l[0], l[1], l[2]]),
-            triangle_solid_angle(triple, [c[0], c[2], c[3]], [l[0], l[2], l[3]]),
-        )
+        parallelogram_solid_angles(self.corners(p), self.n)
     }
 
     /// Distance along unit `wi` from `p` at which the ray crosses the portal, if it does, and
@@ -141,6 +129,13 @@ impl Portal {
     /// quads in the geometry), so that slivers, skewed and far portals keep their exact
     /// footprint.
     fn crossing(&self, p: Vec3, wi: Vec3) -> Option<(f64, f64)> {
+        let (t, cos, s, r) = self.plane_crossing(p, wi)?;
+        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then_some((t, cos))
+    }
+
+    /// Where the ray from `p` along unit `wi` meets the portal's plane (t > 0): t, |cos θ| to the
+    /// normal, and the parallelogram coordinates (s, r) of the point, inside for s, r ∈ [0, 1].
+    fn plane_crossing(&self, p: Vec3, wi: Vec3) -> Option<(f64, f64, f64, f64)> {
         let (eu, ev, w, n) = (
             self.eu.as_dvec3(),
             self.ev.as_dvec3(),
@@ -161,8 +156,25 @@ impl Portal {
         let nn = n.length_squared();
         let s = q.cross(ev).dot(n) / nn;
         let r = eu.cross(q).dot(n) / nn;
-        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then(|| (t, denom.abs() / self.area))
+        Some((t, denom.abs() / self.area, s, r))
     }
+}
+
+/// Solid angles (sr) of the two triangles (c0, c1, c2) and (c0, c2, c3) of the parallelogram
+/// with corners `c` relative to the viewpoint and normal `n` = (c1 − c0) × (c3 − c0); both zero
+/// when the viewpoint lies in its plane (no ray from there crosses it).
+fn parallelogram_solid_angles(c: [DVec3; 4], n: DVec3) -> (f64, f64) {
+    let l = c.map(|v| v.length());
+    // For both triangles (b − a) × (c − a) = n and a = c[0], so the triple product a·(b × c) is
+    // the same.
+    let triple = c[0].dot(n);
+    if triple == 0.0 {
+        return (0.0, 0.0);
+    }
+    (
+        triangle_solid_angle(triple, [c[0], c[1], c[2]], [l[0], l[1], l[2]]),
+        triangle_solid_angle(triple, [c[0], c[2], c[3]], [l[0], l[2], l[3]]),
+    )
 }
 
 /// Solid angle of the triangle with vertices `v` = (a, b, c) relative to the viewpoint (not
@@ -769,8 +781,8 @@ mod tests {
         }
         assert!(both > 100, "{both} samples through both portals");
         // A sliver (1 m × 0.1 mm, skewed) and a portal at 10 km from the origin (seen from 2 m)
-        // keep their footprint: every
-        // direction sampled through them is found crossing them again.
+        // keep their footprint: every direction sampled through them is found crossing them
+        // again.
         for (o, eu, ev, p) in [
             (
                 Vec3::new(0.0, 2.0, 0.0),
@@ -897,12 +909,11 @@ mod tests {
                     // The cell's corners relative to p, in f64 (points a micron away see
                     // cells of any size).
                     let c0 = o_p + eu_d * i as f64 + ev_d * j as f64;
-                    let c = [c0, c0 + eu_d, c0 + eu_d + ev_d, c0 + ev_d];
-                    let l = c.map(|v| v.length());
-                    let triple = c0.dot(n_cell);
-                    let omega =
-                        triangle_solid_angle(triple, [c[0], c[1], c[2]], [l[0], l[1], l[2]])
-                            + triangle_solid_angle(triple, [c[0], c[2], c[3]], [l[0], l[2], l[3]]);
+                    let (a, b) = parallelogram_solid_angles(
+                        [c0, c0 + eu_d, c0 + eu_d + ev_d, c0 + ev_d],
+                        n_cell,
+                    );
+                    let omega = a + b;
                     let centre = c0 + 0.5 * (eu_d + ev_d);
                     let pdf = portals.pdf(p, centre.normalize().as_vec3()) as f64;
                     expected[(i / sub) * nb + j / sub] += pdf * omega;
@@ -920,13 +931,7 @@ mod tests {
                     lost += 1;
                     continue;
                 };
-                // (s, t) of the crossing, from the same f64 construction as `crossing`.
-                let portal = &portals.portals[0];
-                let (t, _) = portal.crossing(p, wi).expect("crosses");
-                let q = wi.as_dvec3() * t - (portal.origin.as_dvec3() - p.as_dvec3());
-                let nn = portal.n.length_squared();
-                let s = q.cross(portal.ev.as_dvec3()).dot(portal.n) / nn;
-                let r = portal.eu.as_dvec3().cross(q).dot(portal.n) / nn;
+                let (_, _, s, r) = portals.portals[0].plane_crossing(p, wi).expect("crosses");
                 let bin = |x: f64| ((x * nb as f64) as usize).min(nb - 1);
                 observed[bin(s) * nb + bin(r)] += 1;
                 first_triangle += (s > r) as usize;
