@@ -12,6 +12,21 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+/// `println!` / `print!` that ignore a closed standard output (e.g. `candela … | head -1`): the
+/// outputs are files, and a reader that stopped early must not make the command fail or panic.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+macro_rules! say_raw {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 #[derive(Parser)]
 #[command(
     name = "candela",
@@ -156,18 +171,18 @@ fn main() -> ExitCode {
             } else {
                 Observer::Cie1931_2
             };
-            candela::cli_colour::spectrum_command(&source, obs, json).map(|s| print!("{s}"))
+            candela::cli_colour::spectrum_command(&source, obs, json).map(|s| say_raw!("{s}"))
         }
         Command::Convert { value, from, to } => {
-            candela::cli_colour::convert_command(value, &from, &to).map(|s| print!("{s}"))
+            candela::cli_colour::convert_command(value, &from, &to).map(|s| say_raw!("{s}"))
         }
         Command::Luminaire { file, diagram } => {
-            candela::luminaire::cli::run(&file, diagram.as_deref()).map(|s| print!("{s}"))
+            candela::luminaire::cli::run(&file, diagram.as_deref()).map(|s| say_raw!("{s}"))
         }
         Command::Bench(args) => candela::bench::main(&args),
-        Command::Probe(args) => candela::report::probe::run(&args).map(|s| print!("{s}")),
+        Command::Probe(args) => candela::report::probe::run(&args).map(|s| say_raw!("{s}")),
         Command::Falsecolour(args) => {
-            candela::report::falsecolour::run(&args).map(|s| print!("{s}"))
+            candela::report::falsecolour::run(&args).map(|s| say_raw!("{s}"))
         }
     };
     match result {
@@ -322,6 +337,7 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
     ctrlc::set_handler(|| {
         if STOP.swap(true, Ordering::SeqCst) {
             eprintln!("\ninterrupted twice: exiting without a checkpoint");
+            candela::output::remove_temporary_files();
             std::process::exit(130);
         }
         eprintln!(
@@ -365,6 +381,14 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
     )?;
     bar.finish_and_clear();
     if reason == candela::render::StopReason::Interrupted {
+        if result.film.total_samples() == 0 {
+            // No pass finished: an all-zero image would replace the files of an earlier render.
+            eprintln!(
+                "interrupted after {:.1} s, before the first pass finished: nothing written",
+                result.elapsed.as_secs_f64()
+            );
+            std::process::exit(130);
+        }
         write_checkpoint(&result.film)?;
         eprintln!(
             "interrupted after {:.1} s: wrote {} and {}; continue with --resume",
@@ -379,29 +403,41 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
             .save(&state_path)?;
     }
     match (reason, &target) {
-        (candela::render::StopReason::TargetReached, Some(t)) => println!(
+        (candela::render::StopReason::TargetReached, Some(t)) => say!(
             "target reached: {:.1} % of eligible pixels have a 95 % interval within ±{} % ",
             100.0 * last.converged_fraction.unwrap_or(1.0),
             100.0 * t.relative
         ),
-        (_, Some(t)) => println!(
-            "target not reached ({:?}): {:.1} % of eligible pixels within ±{} % (goal {:.1} %)",
-            reason,
+        (_, Some(t)) => say!(
+            "target not reached ({}): {:.1} % of eligible pixels within ±{} % (goal {:.1} %)",
+            if reason == candela::render::StopReason::MaxTime {
+                "stopped at --max-time"
+            } else {
+                "the pixels that miss it have --max-spp samples"
+            },
             100.0 * last.converged_fraction.unwrap_or(0.0),
             100.0 * t.relative,
             100.0 * t.fraction
         ),
         (candela::render::StopReason::MaxTime, None) => {
-            println!("stopped at --max-time before every pixel had its samples")
+            say!("stopped at --max-time before every pixel had its samples")
         }
         _ => {}
     }
     let spp = result.film.total_samples() as f64 / (w * h) as f64;
     let t_measure = std::time::Instant::now();
-    let measurements = candela::meter::measure_all(&world);
+    let measurements = candela::meter::measure_all_until(&world, &STOP);
     let measure_seconds = t_measure.elapsed().as_secs_f64();
     write_exr(scene_path, &world, &result.film, &exr_path)?;
     write_png(&result.film, &png_path, exposure)?;
+    let Some(measurements) = measurements else {
+        eprintln!(
+            "interrupted during the meter and grid measurements: wrote {} and {} (the render had finished); no meter, grid or report output",
+            exr_path.display(),
+            png_path.display()
+        );
+        std::process::exit(130);
+    };
     let mut outputs = vec![
         exr_path.display().to_string(),
         png_path.display().to_string(),
@@ -481,7 +517,7 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
                 units.symbol(Quantity::Luminance),
             ),
         };
-        println!(
+        say!(
             "meter {:?}: {:.4} ± {:.4} {unit} (95 %, {} samples)",
             m.name,
             e.mean * k,
@@ -495,7 +531,7 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
             units.from_si(Quantity::Illuminance, 1.0),
             units.symbol(Quantity::Illuminance),
         );
-        println!(
+        say!(
             "grid {:?} ({}×{}): E_min {:.2} {u}, E_avg {:.2} {u}, E_max {:.2} {u}, U0 {:.3}",
             g.name,
             g.nx,
@@ -513,7 +549,7 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
         .map(|p| p.mean_xyz()[1])
         .sum::<f64>()
         / (w * h) as f64;
-    println!(
+    say!(
         "rendered {w}×{h} at {spp:.1} spp (image samples) in {:.2} s on {} threads: {:.3} M samples/s, {:.3} M rays/s; mean luminance {:.4} cd/m²; wrote {} and {}",
         result.elapsed.as_secs_f64(),
         result.threads,
@@ -538,6 +574,18 @@ fn write_exr(
     film: &candela::film::Film,
     exr_path: &Path,
 ) -> Result<()> {
+    let layers = film_layers(
+        &scene_path.display().to_string(),
+        film,
+        world.settings.illuminance,
+    );
+    output::write_exr(exr_path, &layers)
+        .with_context(|| format!("writing {}", exr_path.display()))?;
+    Ok(())
+}
+
+/// The EXR channels and attributes of a film (renders and merges alike).
+fn film_layers(scene: &str, film: &candela::film::Film, illuminance: bool) -> Layers {
     let xyz = film.xyz_image();
     let mut layers = Layers::from_xyz(film.width, film.height, &xyz, &film.y_stderr_image());
     layers.attributes.extend([
@@ -545,7 +593,7 @@ fn write_exr(
             "software".to_string(),
             format!("candela {}", env!("CARGO_PKG_VERSION")),
         ),
-        ("scene".to_string(), scene_path.display().to_string()),
+        ("scene".to_string(), scene.to_string()),
         (
             "channel_units".to_string(),
             "X,Y,Z: absolute CIE 1931 2° tristimulus values, Y = luminance in cd/m^2; stderr.Y: standard error of Y in cd/m^2".to_string(),
@@ -555,7 +603,7 @@ fn write_exr(
             format!("{:.2}", film.total_samples() as f64 / (film.width * film.height) as f64),
         ),
     ]);
-    if world.settings.illuminance {
+    if illuminance {
         let (e, se, mask) = film.illuminance_images();
         layers.channels.extend([
             (output::CHANNEL_E.to_string(), e),
@@ -570,9 +618,7 @@ fn write_exr(
             ),
         ));
     }
-    output::write_exr(exr_path, &layers)
-        .with_context(|| format!("writing {}", exr_path.display()))?;
-    Ok(())
+    layers
 }
 
 fn write_png(film: &candela::film::Film, png_path: &Path, exposure: Option<f64>) -> Result<()> {
@@ -623,24 +669,10 @@ fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()
         _ => out.to_path_buf(),
     };
     let exr_path = with_suffix(&stem, ".exr");
-    let xyz = film.xyz_image();
-    let mut layers = Layers::from_xyz(film.width, film.height, &xyz, &film.y_stderr_image());
-    layers.attributes.extend([
-        (
-            "software".to_string(),
-            format!("candela {}", env!("CARGO_PKG_VERSION")),
-        ),
-        ("scene".to_string(), first.scene.clone()),
-        ("merged_seeds".to_string(), format!("{seeds:?}")),
-    ]);
-    if first.illuminance {
-        let (e, se, mask) = film.illuminance_images();
-        layers.channels.extend([
-            (output::CHANNEL_E.to_string(), e),
-            (output::CHANNEL_E_STDERR.to_string(), se),
-            (output::CHANNEL_E_MASK.to_string(), mask),
-        ]);
-    }
+    let mut layers = film_layers(&first.scene, &film, first.illuminance);
+    layers
+        .attributes
+        .push(("merged_seeds".to_string(), format!("{seeds:?}")));
     output::write_exr(&exr_path, &layers)?;
     write_png(&film, &with_suffix(&stem, ".png"), exposure)?;
     let merged = candela::state::RenderState {
@@ -650,7 +682,7 @@ fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()
         ..first.clone()
     };
     merged.save(&with_suffix(&stem, ".state"))?;
-    println!(
+    say!(
         "merged {} renders (seeds {seeds:?}): {:.1} image samples per pixel; wrote {}",
         loaded.len(),
         merged.film.total_samples() as f64 / (merged.film.width * merged.film.height) as f64,

@@ -11,6 +11,7 @@ use crate::spectrum::SampledWavelengths;
 use crate::world::World;
 use glam::Vec3;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 #[derive(Clone, Debug)]
 pub enum MeterKind {
@@ -148,6 +149,26 @@ pub fn measure(
     settings: &MeasureSettings,
     stats: &mut RayStats,
 ) -> Estimate {
+    measure_until(
+        world,
+        kind,
+        stream,
+        settings,
+        stats,
+        &AtomicBool::new(false),
+    )
+    .expect("never stopped")
+}
+
+/// [`measure`], giving up (`None`) once `stop` is set; it is polled every `BATCH` samples.
+fn measure_until(
+    world: &World,
+    kind: &MeterKind,
+    stream: u64,
+    settings: &MeasureSettings,
+    stats: &mut RayStats,
+    stop: &AtomicBool,
+) -> Option<Estimate> {
     let (mut sum, mut sum2, mut n) = (0.0f64, 0.0f64, 0u64);
     let min = settings.samples.max(2);
     let max = settings.max_samples.max(min);
@@ -158,6 +179,9 @@ pub fn measure(
             Some(_) => (n + BATCH).min(max),
         };
         while n < target {
+            if n % BATCH == 0 && stop.load(Ordering::Relaxed) {
+                return None;
+            }
             let v = sample_meter(world, kind, stream, n, stats);
             sum += v;
             sum2 += v * v;
@@ -170,7 +194,7 @@ pub fn measure(
         };
         match settings.target_relative_error {
             Some(t) if n < max && est.relative_error() > t => continue,
-            _ => return est,
+            _ => return Some(est),
         }
     }
 }
@@ -186,6 +210,11 @@ pub struct Measurements {
 
 /// Measure every meter and grid point in parallel (each with its own stream).
 pub fn measure_all(world: &World) -> Measurements {
+    measure_all_until(world, &AtomicBool::new(false)).expect("never stopped")
+}
+
+/// [`measure_all`], giving up (`None`) soon after `stop` is set (e.g. by Ctrl-C).
+pub fn measure_all_until(world: &World, stop: &AtomicBool) -> Option<Measurements> {
     let mut jobs: Vec<(MeterKind, u64)> = Vec::new();
     for (k, m) in world.meters.iter().enumerate() {
         jobs.push((m.kind.clone(), mix64(0x6d65_7465_7200 ^ k as u64)));
@@ -207,10 +236,10 @@ pub fn measure_all(world: &World) -> Measurements {
         .par_iter()
         .map(|(kind, stream)| {
             let mut stats = RayStats::default();
-            let e = measure(world, kind, *stream, &world.measure, &mut stats);
-            (e, stats)
+            let e = measure_until(world, kind, *stream, &world.measure, &mut stats, stop)?;
+            Some((e, stats))
         })
-        .collect();
+        .collect::<Option<_>>()?;
     let mut out = Measurements::default();
     let mut it = results.into_iter();
     for _ in &world.meters {
@@ -227,7 +256,7 @@ pub fn measure_all(world: &World) -> Measurements {
         }
         out.grids.push(v);
     }
-    out
+    Some(out)
 }
 
 /// Statistics of a grid, in the units of the values they were computed from.

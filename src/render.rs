@@ -171,7 +171,8 @@ pub struct PassStatus {
 /// Why a progressive render ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopReason {
-    /// Every pixel has max_spp samples (or the target was met where set).
+    /// No pixel needs more samples: every pixel has max_spp samples, or (with a target) every
+    /// pixel either meets the target or has max_spp samples while too few meet it.
     Done,
     TargetReached,
     MaxTime,
@@ -220,22 +221,21 @@ fn plan_pass(world: &World, film: &Film, prog: &Progressive) -> (Vec<u64>, Optio
     };
     for (i, slot) in plan.iter_mut().enumerate() {
         let taken = film.samples_taken(i);
-        if taken >= max {
-            continue;
-        }
         if let (Some(t), Some(d)) = (&prog.target, &film.decision) {
+            // A pixel at max_spp that misses the target still counts against the fraction:
+            // running out of samples is not reaching the target.
             let (ok, counts) = pixel_converged(&d[i], t, floor, world.settings.illuminance);
             if counts {
                 eligible += 1;
                 converged += ok as u64;
             }
-            if ok {
+            if ok || taken >= max {
                 continue;
             }
             // Even sample counts keep the two buffers balanced.
             let add = taken.clamp(2, MAX_PASS_SPP).min(max - taken);
             *slot = add + (add & 1);
-        } else {
+        } else if taken < max {
             *slot = taken.clamp(1, MAX_PASS_SPP).min(max - taken);
         }
     }

@@ -71,6 +71,40 @@ fn adaptive_render_to_target_error_is_unbiased() {
 }
 
 #[test]
+fn running_out_of_samples_is_not_reaching_the_target() {
+    // ±0.1 % needs ~10⁵ samples per pixel here; with a cap of 16 every pixel stops at the cap
+    // unconverged, and the render must say so: stop reason Done (samples exhausted), not
+    // TargetReached, and a converged fraction that counts the capped pixels as failures.
+    let w = world(FURNACE);
+    let mut film = Film::new_adaptive(10, 10);
+    let prog = Progressive {
+        max_spp: 16,
+        target: Some(TargetError {
+            relative: 0.001,
+            fraction: 1.0,
+            floor_cd_m2: None,
+        }),
+        ..Default::default()
+    };
+    let stop = AtomicBool::new(false);
+    let mut last = None;
+    let (_, reason) = render_progressive(
+        &w,
+        &mut film,
+        Some(2),
+        &prog,
+        &stop,
+        &mut |s| last = s.converged_fraction,
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    assert_eq!(reason, StopReason::Done);
+    assert!((0..100).all(|i| film.samples_taken(i) == 16));
+    let frac = last.expect("a converged fraction with a target");
+    assert!(frac < 0.05, "converged fraction {frac}");
+}
+
+#[test]
 fn interrupted_and_resumed_equals_uninterrupted() {
     let w = world(FURNACE);
     let prog = Progressive {

@@ -104,6 +104,35 @@ fn single_pixel() {
 }
 
 #[test]
+fn one_sample_per_pixel_has_an_unknown_interval() {
+    // A render with 1 spp writes 0 into stderr.Y (no sample variance) and spp "1.00": the
+    // probe must not claim ± 0. With spp "2.00" the same channel is a real standard error.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("p.exr");
+    for (spp, known) in [("1.00", false), ("2.00", true)] {
+        let mut layers = image(&path);
+        layers.attributes.push(("spp".into(), spp.into()));
+        output::write_exr(&path, &layers).unwrap();
+        let r = probe(
+            &output::read_exr(&path).unwrap(),
+            4,
+            3,
+            None,
+            UnitSystem::Si,
+        )
+        .unwrap();
+        assert_eq!(r.luminance.stderr.is_some(), known, "spp {spp}");
+        assert_eq!(r.luminance.ci95().is_some(), known, "spp {spp}");
+        match r.illuminance {
+            IlluminanceProbe::Defined { estimate, .. } => {
+                assert_eq!(estimate.stderr.is_some(), known, "spp {spp}")
+            }
+            ref other => panic!("{other:?}"),
+        }
+    }
+}
+
+#[test]
 fn disc_average() {
     let dir = tempfile::tempdir().unwrap();
     let layers = image(&dir.path().join("p.exr"));

@@ -203,7 +203,8 @@ impl RayFile {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("cannot create the directory '{}'", dir.display()))?;
         }
-        std::fs::write(path, self.to_bytes()?)
+        let bytes = self.to_bytes()?;
+        crate::output::write_atomic(path, |w| w.write_all(&bytes))
             .with_context(|| format!("cannot write the ray file '{}'", path.display()))
     }
 

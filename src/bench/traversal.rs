@@ -560,7 +560,8 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
     }
 
     if let Some(path) = &args.hits_out {
-        std::fs::write(path, super::rayfile::hits_to_bytes(&candela_hits))
+        let bytes = super::rayfile::hits_to_bytes(&candela_hits);
+        crate::output::write_atomic(path, |w| w.write_all(&bytes))
             .with_context(|| format!("cannot write the hit file '{}'", path.display()))?;
     }
 

@@ -127,16 +127,48 @@ impl OutputError {
     }
 }
 
+/// Temporary files being written right now, so that [`remove_temporary_files`] can delete them
+/// before a forced exit (which runs no destructors).
+static IN_FLIGHT: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn in_flight() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    IN_FLIGHT.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Deletes the temporary files of the atomic writes in progress. For a process about to end
+/// without unwinding (`std::process::exit`, e.g. on a second Ctrl-C): their targets are left
+/// as they were, and no temporary file is left beside them.
+pub fn remove_temporary_files() {
+    for path in in_flight().drain(..) {
+        let _ = fs::remove_file(path);
+    }
+}
+
 /// Removes the temporary file when dropped, unless disarmed after the rename. This also
 /// cleans up if the writer closure panics.
 struct TempGuard {
     path: Option<PathBuf>,
 }
 
+impl TempGuard {
+    fn new(path: PathBuf) -> Self {
+        in_flight().push(path.clone());
+        TempGuard { path: Some(path) }
+    }
+
+    /// After the rename: the temporary name no longer exists.
+    fn disarm(&mut self) {
+        if let Some(path) = self.path.take() {
+            in_flight().retain(|p| *p != path);
+        }
+    }
+}
+
 impl Drop for TempGuard {
     fn drop(&mut self) {
         if let Some(path) = self.path.take() {
-            let _ = fs::remove_file(path);
+            let _ = fs::remove_file(&path);
+            in_flight().retain(|p| *p != path);
         }
     }
 }
@@ -196,16 +228,14 @@ pub fn write_atomic(
         return Err(OutputError::invalid(path, "is a directory"));
     }
     let (temp, file) = create_temp_beside(path)?;
-    let mut guard = TempGuard {
-        path: Some(temp.clone()),
-    };
+    let mut guard = TempGuard::new(temp.clone());
     let mut writer = BufWriter::new(file);
     write(&mut writer).map_err(io_err)?;
     let file = writer.into_inner().map_err(|e| io_err(e.into_error()))?;
     file.sync_all().map_err(io_err)?;
     drop(file);
     fs::rename(&temp, path).map_err(io_err)?;
-    guard.path = None;
+    guard.disarm();
     #[cfg(unix)]
     if let Some(dir) = path.parent() {
         let dir = if dir.as_os_str().is_empty() {

@@ -188,12 +188,19 @@ pub fn probe(
             .sqrt()
             / ids.len() as f64
     };
+    // With fewer than 2 samples per pixel a pixel's sample variance is undefined (the render
+    // writes 0 for it): its standard error is unknown, not zero. candela's EXRs carry their
+    // mean samples per pixel, and all pixels have the same count until the passes that
+    // already give every pixel 2 or more, so the mean decides.
+    let too_few_samples = layers
+        .attribute("spp")
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .is_some_and(|spp| spp < 2.0);
+    let error_channel = |name: &str| layers.channel(name).filter(|_| !too_few_samples);
     let lq = Quantity::Luminance;
     let luminance = Estimate {
         mean: units.from_si(lq, mean_of(lum, &idx)),
-        stderr: layers
-            .channel(CHANNEL_Y_STDERR)
-            .map(|c| units.from_si(lq, se_of(c, &idx))),
+        stderr: error_channel(CHANNEL_Y_STDERR).map(|c| units.from_si(lq, se_of(c, &idx))),
     };
 
     let eq = Quantity::Illuminance;
@@ -218,8 +225,7 @@ pub fn probe(
                 IlluminanceProbe::Defined {
                     estimate: Estimate {
                         mean: units.from_si(eq, mean_of(e, &defined)),
-                        stderr: layers
-                            .channel(CHANNEL_E_STDERR)
+                        stderr: error_channel(CHANNEL_E_STDERR)
                             .map(|c| units.from_si(eq, se_of(c, &defined))),
                     },
                     pixels: defined.len(),
@@ -299,7 +305,7 @@ fn estimate_text(e: &Estimate, unit: &str) -> String {
             format_sig(se, 3)
         ),
         _ => format!(
-            "{} {unit}   (no standard error channel: confidence interval unknown)",
+            "{} {unit}   (confidence interval unknown: no standard error channel, or fewer than 2 samples per pixel)",
             format_sig(e.mean, 5)
         ),
     }
