@@ -15,7 +15,7 @@ fn furnace_scene(material: &str) -> String {
     format!(
         r#"(
         camera: (position: (0.3, 0.2, -3.0), look_at: (0, 0, 0), vfov_deg: 30, resolution: (10, 10)),
-        render: (spp: 64, max_depth: 64),
+        render: (spp: 256, max_depth: 64),
         materials: {{ "m": {material} }},
         objects: [(shape: Sphere(center: (0, 0, 0), radius: 1), material: "m")],
         lights: [Environment(spectrum: Named("E"), amount: Luminance(1.0))],

@@ -50,6 +50,12 @@ fn check(spectrum: &str, luminance: f64) {
             ["X", "Y", "Z"][k],
             expected[k]
         );
+        assert!(
+            se <= 0.01 * expected[k].abs(),
+            "{spectrum}: {} standard error {se} above 1 % of {}",
+            ["X", "Y", "Z"][k],
+            expected[k]
+        );
     }
     eprintln!(
         "{spectrum:<24} library XYZ = ({:.4}, {:.4}, {:.4})",

@@ -106,10 +106,7 @@ fn point_light_given_in_lumens() {
     "#;
     let expected = 0.8 * 50.0 / std::f64::consts::PI;
     let (l, se) = spot_meter(body, [0.3, 0.5, 0.0], [0.0, 0.0, 0.0], 1024);
-    assert!(
-        (l - expected).abs() <= 5.0 * se,
-        "L = {l} ± {se}, expected {expected}"
-    );
+    assert_meter(l, se, expected);
 }
 
 #[test]
@@ -124,10 +121,7 @@ fn spot_light_inside_its_cone_obeys_inverse_square() {
     let d2: f64 = 9.0 + 1.0;
     let expected = 0.5 * 1000.0 * (3.0 / d2.sqrt()) / (std::f64::consts::PI * d2);
     let (l, se) = spot_meter(body, [1.0, 1.0, -1.0], [1.0, 0.0, 0.0], 1024);
-    assert!(
-        (l - expected).abs() <= 5.0 * se,
-        "L = {l} ± {se}, expected {expected}"
-    );
+    assert_meter(l, se, expected);
     // Outside the outer cone (θ = atan(3/3) = 45°): dark.
     let (l, _) = spot_meter(body, [3.0, 1.0, -1.0], [3.0, 0.0, 0.0], 64);
     assert_eq!(l, 0.0);
@@ -143,10 +137,7 @@ fn distant_light_cosine_law() {
     "#;
     let expected = 0.25 * 10000.0 * 0.5 / std::f64::consts::PI;
     let (l, se) = spot_meter(body, [0.0, 1.0, -1.0], [0.0, 0.0, 0.0], 1024);
-    assert!(
-        (l - expected).abs() <= 5.0 * se,
-        "L = {l} ± {se}, expected {expected}"
-    );
+    assert_meter(l, se, expected);
 }
 
 #[test]
@@ -237,4 +228,17 @@ fn same_seed_same_image_for_any_thread_count() {
     let b = render(&w, 2);
     assert_eq!(a.pixels, b.pixels);
     assert!(a.total_samples() == 24 * 24 * 4);
+}
+
+/// A meter reading `l` ± `se` agrees with `expected` within 5 standard errors, and the standard
+/// error is below 1 % of it (so the check keeps its power).
+fn assert_meter(l: f64, se: f64, expected: f64) {
+    assert!(
+        (l - expected).abs() <= 5.0 * se,
+        "L = {l} ± {se}, expected {expected}"
+    );
+    assert!(
+        se <= 0.01 * expected.abs(),
+        "L = {l} ± {se}: standard error above 1 % of {expected}"
+    );
 }

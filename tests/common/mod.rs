@@ -46,7 +46,8 @@ pub fn image_mean(film: &Film) -> ([f64; 3], f64) {
 }
 
 /// Assert that every pixel's Y is within `k` standard errors of `expected`, and the image mean
-/// within 4 standard errors.
+/// within 4 standard errors, which must be below 1 % of `expected` (so that the test keeps its
+/// power: a change that made the render much noisier would otherwise widen its own tolerance).
 pub fn assert_every_pixel(film: &Film, expected: f64, k: f64) {
     for (i, p) in film.pixels.iter().enumerate() {
         let y = p.mean_xyz()[1];
@@ -61,6 +62,10 @@ pub fn assert_every_pixel(film: &Film, expected: f64, k: f64) {
         (m[1] - expected).abs() <= 4.0 * se,
         "image mean Y = {} cd/m², expected {expected} ± 4·{se}",
         m[1]
+    );
+    assert!(
+        se <= 0.01 * expected.abs(),
+        "image mean Y: standard error {se} cd/m² is above 1 % of {expected}"
     );
 }
 
