@@ -169,7 +169,12 @@ fn disc_average() {
     }
     // Pixel (0, 0) alone sees no surface.
     let r = probe(&layers, 0, 0, None, UnitSystem::Si).unwrap();
-    assert_eq!(r.illuminance, IlluminanceProbe::Undefined);
+    assert_eq!(
+        r.illuminance,
+        IlluminanceProbe::Undefined {
+            mask_mean: Some(0.0)
+        }
+    );
     assert!(r
         .to_text("p.exr")
         .contains("undefined: pixel sees no surface"));

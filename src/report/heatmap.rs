@@ -187,7 +187,7 @@ pub fn render_grid_heatmap(
         .map(|&m| draw::text_width(LABEL_PX, &format_sig(units.length_from_m(m), 3)))
         .max()
         .unwrap_or(0)
-        .max(draw::text_width(LABEL_PX, "y (m)"));
+        .max(draw::text_width(LABEL_PX, "v (m)"));
     let (gw, gh) = (nx as u32 * cell, ny as u32 * cell);
     let gx = PAD + axis_label_w + 10;
     let gy = header_h;
@@ -289,7 +289,7 @@ pub fn render_grid_heatmap(
             BLACK,
         );
     }
-    let xlabel = format!("x ({len}), row 0 at the bottom");
+    let xlabel = format!("u ({len}) along edge_u, row 0 at the bottom");
     draw::draw_text(
         &mut img,
         gx as i32,
@@ -298,7 +298,7 @@ pub fn render_grid_heatmap(
         &xlabel,
         DARK_GREY,
     );
-    let ylabel = format!("y ({len})");
+    let ylabel = format!("v ({len}) along edge_v");
     draw::draw_text(
         &mut img,
         PAD as i32,

@@ -78,7 +78,10 @@ pub enum IlluminanceProbe {
     /// The image has no `E` channel (rendered without `--illuminance`).
     NoChannel,
     /// No probed pixel sees a surface (sky, emitter, nothing): illuminance is undefined.
-    Undefined,
+    Undefined {
+        /// Mean of `mask.E` over all probed pixels (`None` without a mask channel).
+        mask_mean: Option<f64>,
+    },
     /// Mean over the probed pixels where `E` is defined.
     Defined {
         /// Mean and standard error, display units.
@@ -219,8 +222,9 @@ pub fn probe(
                         && mask.is_none_or(|m| m[i] > 0.0)
                 })
                 .collect();
+            let mask_mean = mask.map(|m| mean_of(m, &idx));
             if defined.is_empty() {
-                IlluminanceProbe::Undefined
+                IlluminanceProbe::Undefined { mask_mean }
             } else {
                 IlluminanceProbe::Defined {
                     estimate: Estimate {
@@ -229,7 +233,7 @@ pub fn probe(
                             .map(|c| units.from_si(eq, se_of(c, &defined))),
                     },
                     pixels: defined.len(),
-                    mask_mean: mask.map(|m| mean_of(m, &idx)),
+                    mask_mean,
                 }
             }
         }
@@ -317,11 +321,12 @@ impl ProbeResult {
         let u = self.units;
         let illuminance = match &self.illuminance {
             IlluminanceProbe::NoChannel => Value::Null,
-            IlluminanceProbe::Undefined => json!({
+            IlluminanceProbe::Undefined { mask_mean } => json!({
                 "defined": false,
                 "reason": "pixel sees no surface",
                 "pixels": 0,
                 "mean": null, "stderr": null, "ci95": null,
+                "mask_mean": mask_mean,
             }),
             IlluminanceProbe::Defined {
                 estimate,
@@ -379,7 +384,7 @@ impl ProbeResult {
             IlluminanceProbe::NoChannel => {
                 "no E channel in this image (render with --illuminance)".to_string()
             }
-            IlluminanceProbe::Undefined => "undefined: pixel sees no surface".to_string(),
+            IlluminanceProbe::Undefined { .. } => "undefined: pixel sees no surface".to_string(),
             IlluminanceProbe::Defined {
                 estimate,
                 pixels,
