@@ -172,12 +172,17 @@ fn rectangle_source_below_a_corner() {
     );
 }
 
+/// An isotropic source of flux Φ at the centre of a closed sphere (radius R, area A = 4πR²,
+/// Lambertian walls of reflectance ρ): closed-forms.md §2.6. Every wall point receives
+/// E_dir = Φ/A directly and E_ind = ρΦ/(A(1 − ρ)) by inter-reflection, so
+/// E = Φ/(A(1 − ρ)) and the wall's luminance L = ρE/π = ρΦ/(πA(1 − ρ)) everywhere.
 #[test]
 fn integrating_sphere_interreflection() {
-    // Isotropic Φ = 1000 lm at the centre of a closed sphere R = 1, ρ = 0.6:
-    // E = Φ / (A (1 − ρ)) on the wall, everywhere.
+    // Φ = 1000 lm, R = 1, ρ = 0.6: E = 198.944 lx, L = 37.995 cd/m².
     let (phi, r, rho) = (1000.0, 1.0, 0.6);
-    let expected = phi / (4.0 * PI * r * r * (1.0 - rho));
+    let area = 4.0 * PI * r * r;
+    let expected = phi / (area * (1.0 - rho));
+    let expected_l = rho * phi / (PI * area * (1.0 - rho));
     let w = world(&format!(
         r#"(
         camera: (position: (0.2, 0.1, -0.3), look_at: (0, 0, 1), vfov_deg: 100, resolution: (8, 8)),
@@ -186,10 +191,12 @@ fn integrating_sphere_interreflection() {
         objects: [(shape: Sphere(center: (0, 0, 0), radius: {r}), material: "wall")],
         lights: [Point(position: (0, 0, 0), spectrum: Named("FL2"), amount: Flux({phi}))],
         meters: [Illuminance(name: "wall", position: (0, -0.99999, 0), normal: (0, 1, 0))],
-        measure: (samples: 8192),
+        measure: (samples: 131072),
     )"#
     ));
     let film = render(&w, 2);
+    let n = film.pixels.len() as f64;
+    let (mut sum_e, mut var_e, mut sum_l, mut var_l) = (0.0, 0.0, 0.0, 0.0);
     for (i, p) in film.pixels.iter().enumerate() {
         let e = p.mean_e().unwrap();
         let se = p.e_standard_error();
@@ -201,15 +208,45 @@ fn integrating_sphere_interreflection() {
         let l = p.mean_xyz()[1];
         let lse = p.y_standard_error();
         assert!(
-            (l - rho * expected / PI).abs() <= 5.0 * lse,
-            "pixel {i}: L = {l} ± {lse}, expected {}",
-            rho * expected / PI
+            (l - expected_l).abs() <= 5.0 * lse,
+            "pixel {i}: L = {l} ± {lse}, expected {expected_l}"
         );
+        sum_e += e;
+        var_e += se * se;
+        sum_l += l;
+        var_l += lse * lse;
     }
-    let m = measure_all(&w).meters[0];
+    // Pooled over the (independent) pixels, whose expectations are all equal: a systematic
+    // error of a few per cent cannot hide in the per-pixel noise.
+    let (mean_e, se_e) = (sum_e / n, var_e.sqrt() / n);
+    let (mean_l, se_l) = (sum_l / n, var_l.sqrt() / n);
+    println!(
+        "integrating sphere: mean E = {mean_e} ± {se_e} (expected {expected}, rel. se {:.4}), \
+         mean L = {mean_l} ± {se_l} (expected {expected_l}, rel. se {:.4})",
+        se_e / expected,
+        se_l / expected_l
+    );
     assert!(
-        (m.mean - expected).abs() <= 5.0 * m.stderr && m.stderr < 0.02 * expected,
-        "meter: {} ± {}, expected {expected}",
+        (mean_e - expected).abs() <= 4.0 * se_e && se_e < 0.01 * expected,
+        "pixel-mean E = {mean_e} ± {se_e}, expected {expected}"
+    );
+    assert!(
+        (mean_l - expected_l).abs() <= 4.0 * se_l && se_l < 0.01 * expected_l,
+        "pixel-mean L = {mean_l} ± {se_l}, expected {expected_l}"
+    );
+    // The meter sits 10 µm inside the wall: E_dir = Φ/(4π d²) at d = 0.99999 m, plus E_ind.
+    let d = 0.99999;
+    let expected_meter = phi / (4.0 * PI * d * d) + rho * phi / (area * (1.0 - rho));
+    let m = measure_all(&w).meters[0];
+    println!(
+        "integrating sphere meter: {} ± {} (expected {expected_meter}, rel. se {:.5})",
+        m.mean,
+        m.stderr,
+        m.stderr / expected_meter
+    );
+    assert!(
+        (m.mean - expected_meter).abs() <= 5.0 * m.stderr && m.stderr < 0.005 * expected_meter,
+        "meter: {} ± {}, expected {expected_meter}",
         m.mean,
         m.stderr
     );
