@@ -133,6 +133,72 @@ fn one_sample_per_pixel_has_an_unknown_interval() {
 }
 
 #[test]
+fn one_illuminance_sample_has_an_unknown_interval() {
+    // 4 samples per pixel, but at pixel (4, 3) only a quarter of them saw a receiving surface:
+    // its E rests on one sample, whose variance is unknown; the luminance interval stays known.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("p.exr");
+    let mut layers = image(&path);
+    layers.attributes.push(("spp".into(), "4.00".into()));
+    let mask = &mut layers
+        .channels
+        .iter_mut()
+        .find(|(n, _)| n == CHANNEL_E_MASK)
+        .unwrap()
+        .1;
+    mask[3 * W + 4] = 0.25;
+    output::write_exr(&path, &layers).unwrap();
+    let layers = output::read_exr(&path).unwrap();
+    let r = probe(&layers, 4, 3, None, UnitSystem::Si).unwrap();
+    assert!(r.luminance.stderr.is_some());
+    match r.illuminance {
+        IlluminanceProbe::Defined { estimate, .. } => assert_eq!(estimate.stderr, None),
+        ref other => panic!("{other:?}"),
+    }
+    // Its neighbour, with all 4 samples on a surface, keeps its interval.
+    match probe(&layers, 5, 3, None, UnitSystem::Si)
+        .unwrap()
+        .illuminance
+    {
+        IlluminanceProbe::Defined { estimate, .. } => assert_eq!(estimate.stderr, Some(5.0)),
+        ref other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn values_candela_never_writes_are_refused() {
+    // A negative luminance, a negative standard error or a mask above 1 means a corrupt or
+    // edited file: probe and falsecolour refuse it, naming the file, the channel and the pixel.
+    let dir = tempfile::tempdir().unwrap();
+    for (channel, value) in [("Y", -5.0f32), ("stderr.Y", -1.0), ("mask.E", 1.5)] {
+        let path = dir.path().join("bad.exr");
+        let mut layers = image(&path);
+        let c = &mut layers
+            .channels
+            .iter_mut()
+            .find(|(n, _)| n == channel)
+            .unwrap()
+            .1;
+        c[2 * W + 6] = value;
+        output::write_exr(&path, &layers).unwrap();
+        for args in [
+            vec!["probe", "bad.exr", "0", "0"],
+            vec!["falsecolour", "bad.exr", "-o", "bad.png"],
+        ] {
+            let (code, _, err) = cli(&args, dir.path());
+            assert_eq!(code, 1, "{args:?} on {channel} = {value}: {err}");
+            assert!(
+                err.contains("bad.exr")
+                    && err.contains(&format!("channel {channel}"))
+                    && err.contains("(6, 2)"),
+                "{err}"
+            );
+        }
+        assert!(!dir.path().join("bad.png").exists());
+    }
+}
+
+#[test]
 fn disc_average() {
     let dir = tempfile::tempdir().unwrap();
     let layers = image(&dir.path().join("p.exr"));

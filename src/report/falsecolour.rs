@@ -958,6 +958,7 @@ pub fn run(args: &FalsecolourArgs) -> anyhow::Result<String> {
         anyhow::bail!("{}: refusing to overwrite the input image", out.display());
     }
     let layers = crate::output::read_exr(&args.exr).map_err(|e| anyhow::anyhow!("{e}"))?;
+    super::check_photometric_layers(&args.exr, &layers).map_err(|e| anyhow::anyhow!(e))?;
     let file_name = args
         .exr
         .file_name()

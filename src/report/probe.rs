@@ -195,10 +195,10 @@ pub fn probe(
     // writes 0 for it): its standard error is unknown, not zero. candela's EXRs carry their
     // mean samples per pixel, and all pixels have the same count until the passes that
     // already give every pixel 2 or more, so the mean decides.
-    let too_few_samples = layers
+    let spp = layers
         .attribute("spp")
-        .and_then(|v| v.trim().parse::<f64>().ok())
-        .is_some_and(|spp| spp < 2.0);
+        .and_then(|v| v.trim().parse::<f64>().ok());
+    let too_few_samples = spp.is_some_and(|spp| spp < 2.0);
     let error_channel = |name: &str| layers.channel(name).filter(|_| !too_few_samples);
     let lq = Quantity::Luminance;
     let luminance = Estimate {
@@ -223,6 +223,12 @@ pub fn probe(
                 })
                 .collect();
             let mask_mean = mask.map(|m| mean_of(m, &idx));
+            // A pixel's illuminance samples are its samples that saw a receiving surface,
+            // mask.E × spp of them: with fewer than 2 its E has no sample variance either.
+            let too_few_e = match (spp, mask) {
+                (Some(spp), Some(m)) => defined.iter().any(|&i| m[i] as f64 * spp < 1.5),
+                _ => false,
+            };
             if defined.is_empty() {
                 IlluminanceProbe::Undefined { mask_mean }
             } else {
@@ -230,6 +236,7 @@ pub fn probe(
                     estimate: Estimate {
                         mean: units.from_si(eq, mean_of(e, &defined)),
                         stderr: error_channel(CHANNEL_E_STDERR)
+                            .filter(|_| !too_few_e)
                             .map(|c| units.from_si(eq, se_of(c, &defined))),
                     },
                     pixels: defined.len(),
@@ -274,6 +281,7 @@ pub fn probe_file(
     units: UnitSystem,
 ) -> anyhow::Result<ProbeResult> {
     let layers = read_exr(path)?;
+    super::check_photometric_layers(path, &layers).map_err(|e| anyhow!(e))?;
     probe(&layers, x, y, radius, units).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
