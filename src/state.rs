@@ -120,9 +120,12 @@ impl RenderState {
             "{} is not a candela render state of version {VERSION}",
             path.display()
         );
-        let n = s.film.width * s.film.height;
+        // checked: a corrupt size must not wrap to the length of the arrays.
+        let n = s.film.width.checked_mul(s.film.height).unwrap_or(0);
         anyhow::ensure!(
-            s.film.pixels.len() == n && s.film.decision.as_ref().is_none_or(|d| d.len() == n),
+            n > 0
+                && s.film.pixels.len() == n
+                && s.film.decision.as_ref().is_none_or(|d| d.len() == n),
             "{} is corrupt: its pixel arrays do not match its {}×{} size",
             path.display(),
             s.film.width,

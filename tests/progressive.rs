@@ -172,6 +172,28 @@ fn corrupt_state_file_is_an_error() {
 }
 
 #[test]
+fn state_with_a_corrupt_size_is_refused_by_name() {
+    // Width and height whose product wraps to 0, the length of the (empty) pixel arrays, and a
+    // zero size: corrupt files, named as such.
+    let dir = tempfile::tempdir().unwrap();
+    let w = world(FURNACE);
+    for (width, height) in [(1usize << 32, 1usize << 32), (0, 4)] {
+        let mut film = Film::new(4, 4);
+        film.width = width;
+        film.height = height;
+        film.pixels.clear();
+        let path = dir.path().join("sized.state");
+        candela::state::RenderState::new(std::path::Path::new("s.ron"), 1, &w, film)
+            .save(&path)
+            .unwrap();
+        let e = candela::state::RenderState::load(&path)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("sized.state") && e.contains("corrupt"), "{e}");
+    }
+}
+
+#[test]
 fn state_of_an_older_format_version_is_refused_by_name() {
     // A version-2 file: the current fields minus the merged-seed list, so postcard alone would
     // only report a truncated file.
