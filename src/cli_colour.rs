@@ -362,10 +362,40 @@ mod tests {
         assert!((v["cct_k"].as_f64().unwrap() - 2856.0).abs() < 1.0);
         assert!(v["duv"].as_f64().unwrap().abs() < 1e-4);
         assert!((v["cri"]["ra"].as_f64().unwrap() - 100.0).abs() < 0.05);
-        assert!(v["blackbody_luminous_efficacy_lm_per_w"].as_f64().unwrap() > 16.0);
+        // Luminous efficacy of blackbody radiation, K = K_m Σ L_λ V Δλ (360–830 nm, 1 nm) /
+        // (σT⁴/π). candela, like colour-science, uses CIE 015's radiation constants
+        // (c1 = 3.741771e-16 W·m², c2 = 1.4388e-2 m·K, σ = π⁴c1/(15c2⁴)); colour-science 0.4.7
+        // `planck_law` with those constants and its photopic V gives 16.4449497 lm/W at 2856 K
+        // (computed in target/venv). closed-forms.md §2.9 lists 16.446 from CODATA 2018
+        // constants, 6.4e-5 higher; photometry.rs's table test allows for that difference.
+        let k = v["blackbody_luminous_efficacy_lm_per_w"].as_f64().unwrap();
+        let k_ref = 16.444_949_7;
+        assert!(
+            (k / k_ref - 1.0).abs() <= 1e-6,
+            "blackbody 2856 K efficacy {k} lm/W vs colour-science {k_ref} lm/W \
+             (difference {:+.2e} relative)",
+            k / k_ref - 1.0
+        );
+    }
+
+    #[test]
+    fn colorchecker_dark_skin_lab() {
+        // ColorChecker "dark skin" (colour-science "ColorChecker N Ohta" spectrum) under D65,
+        // CIE 1964 10° observer, 1 nm integration, white = D65 under the same observer:
+        // colour-science 0.4.7 `XYZ_to_Lab(sd_to_XYZ(sd, cmfs_10, D65, method="Integration")
+        // / 100, xy(D65, 10°))` = (36.785872, 13.942426, 14.586083). Both use the same 1 nm
+        // tables, so they agree to rounding; 1e-4 in L*, a*, b* is far below any data error
+        // (a 1 % error in Y moves L* by ~0.3).
         let j = spectrum_command("colorchecker:dark skin", Observer::Cie1964_10, true).unwrap();
         let v: serde_json::Value = serde_json::from_str(&j).unwrap();
-        assert!(v["object_under_d65"]["lab"][0].as_f64().unwrap() > 30.0);
+        let lab_ref = [36.785872, 13.942426, 14.586083];
+        for (i, r) in lab_ref.iter().enumerate() {
+            let l = v["object_under_d65"]["lab"][i].as_f64().unwrap();
+            assert!(
+                (l - r).abs() < 1e-4,
+                "dark skin CIELAB[{i}] {l} vs colour-science {r}"
+            );
+        }
     }
 
     #[test]
@@ -398,7 +428,19 @@ mod tests {
     #[test]
     fn convert() {
         let s = convert_command(100.0, "fc", "lux").unwrap();
-        assert!(s.starts_with("100 footcandle = 1076.39"), "{s}");
+        assert!(s.starts_with("100 footcandle = "), "{s}");
+        // 1 fc = 1 lm/ft², 1 ft = 0.3048 m exactly (NIST SP 811): 100 fc = 1076.391041670972 lx.
+        let lx: f64 = s
+            .split('=')
+            .nth(1)
+            .unwrap()
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        let want = 100.0 / (0.3048f64 * 0.3048);
+        assert!((lx / want - 1.0).abs() < 1e-12, "{s}: expected {want}");
         let e = convert_command(1.0, "lux", "nit").unwrap_err();
         assert!(e.to_string().contains("different quantities"), "{e}");
         assert!(convert_command(1.0, "lux", "bogus").is_err());

@@ -165,7 +165,7 @@ fn mean_se(xs: &[f64]) -> (f64, f64) {
 #[test]
 fn albedo_never_exceeds_one_and_eval_agrees_with_sampling() {
     let mats = materials();
-    let angles = [5.0f32, 45.0, 75.0, 88.0, 135.0];
+    let angles = [0.0f32, 5.0, 45.0, 75.0, 88.0, 135.0];
     let comparisons = (mats.len() * angles.len()) as f64;
     let z1 = z_one_sided(0.01 / comparisons);
     let z2 = z_two_sided(0.01 / comparisons);
@@ -366,6 +366,213 @@ fn furnace_white_coated_is_lossless_and_rough_materials_gain_nothing() {
             let (a, se) = mean_se(&w);
             println!("{name} θo={t}: energy albedo {a:.5} ± {se:.5}");
             assert!(a - 1.0 <= z * se, "{name} θo={t}: {a} ± {se} gains energy");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Closed forms for the analytic reflection models.
+
+/// Gauss–Legendre nodes and weights on [0, 1] (Newton iteration on Pₙ, f64). An N-point rule
+/// integrates polynomials of degree ≤ 2N − 1 exactly.
+fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 0.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, x);
+            for k in 2..=n {
+                let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                p0 = p1;
+                p1 = p2;
+            }
+            dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+            let dx = p1 / dp;
+            x -= dx;
+            if dx.abs() < 1e-16 {
+                break;
+            }
+        }
+        // Map [−1, 1] → [0, 1].
+        out.push((0.5 * (x + 1.0), 1.0 / ((1.0 - x * x) * dp * dp)));
+    }
+    out
+}
+
+/// Directional albedo a(ωo) = ∫ f(ωo, ωi) cos θi dωi over the upper hemisphere by a product
+/// rule: Gauss–Legendre in μ = cos θi (n_mu nodes) × the midpoint rule in φ (n_phi nodes).
+fn albedo_quadrature(m: &Material, wo: Vec3, lane: usize, n_mu: usize, n_phi: usize) -> f64 {
+    let wl = wavelengths();
+    let mut sum = 0.0;
+    for (mu, w) in gauss_legendre_01(n_mu) {
+        let s = (1.0 - mu * mu).max(0.0).sqrt();
+        for j in 0..n_phi {
+            let phi = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / n_phi as f64;
+            let wi = Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, mu as f32);
+            sum += m.eval(wo, wi, &wl)[lane] as f64 * mu * w;
+        }
+    }
+    sum * 2.0 * std::f64::consts::PI / n_phi as f64
+}
+
+#[test]
+fn gauss_legendre_is_exact_for_polynomials() {
+    // Sanity check of the rule itself: ∫₀¹ μ^k dμ = 1/(k + 1) for k ≤ 2N − 1.
+    for (n, k) in [(8usize, 15i32), (600, 1001), (600, 1199)] {
+        let q: f64 = gauss_legendre_01(n)
+            .iter()
+            .map(|&(x, w)| w * x.powi(k))
+            .sum();
+        assert!((q * (k + 1) as f64 - 1.0).abs() < 1e-12, "N={n} k={k}: {q}");
+    }
+}
+
+/// Oren–Nayar, the qualitative model that candela implements (src/bxdf/oren_nayar.rs;
+/// docs/scene-format.md: "Oren–Nayar rough diffuse (qualitative model); σ = facet slope
+/// deviation in degrees"; the BxDF itself takes σ in radians): Oren & Nayar 1994,
+/// "Generalization of Lambert's Reflectance Model", SIGGRAPH '94, eq. 30 with the
+/// qualitative simplification; pbrt-v3 §8.4.2:
+/// f = ρ/π (A + B max(0, cos Δφ) sin α tan β), A = 1 − σ²/(2(σ² + 0.33)),
+/// B = 0.45 σ²/(σ² + 0.09), α = max(θi, θo), β = min(θi, θo).
+fn oren_nayar_closed_form(rho: f64, sigma: f64, ti: f64, to: f64, dphi: f64) -> f64 {
+    let s2 = sigma * sigma;
+    let a = 1.0 - s2 / (2.0 * (s2 + 0.33));
+    let b = 0.45 * s2 / (s2 + 0.09);
+    let (alpha, beta) = (ti.max(to), ti.min(to));
+    rho / std::f64::consts::PI * (a + b * dphi.cos().max(0.0) * alpha.sin() * beta.tan())
+}
+
+#[test]
+fn oren_nayar_eval_matches_the_published_formula() {
+    let rho = 0.6f32;
+    let wl = wavelengths();
+    let mut n_checked = 0;
+    for sigma_deg in [0.0f32, 10.0, 20.0, 45.0, 60.0, 90.0] {
+        let m = oren_nayar(rho, sigma_deg);
+        let sigma = (sigma_deg as f64).to_radians();
+        for ti in [0.0f32, 15.0, 30.0, 50.0, 70.0, 80.0] {
+            for to in [0.0f32, 10.0, 35.0, 60.0, 75.0] {
+                for dphi in [0.0f32, 30.0, 60.0, 89.0, 120.0, 180.0, 270.0] {
+                    // θo in the plane φ = 0, θi at azimuth Δφ.
+                    let wo = dir_deg(to, 0.0);
+                    let wi = dir_deg(ti, dphi);
+                    let expected = oren_nayar_closed_form(
+                        rho as f64,
+                        sigma,
+                        (ti as f64).to_radians(),
+                        (to as f64).to_radians(),
+                        (dphi as f64).to_radians(),
+                    );
+                    let f = m.eval(wo, wi, &wl);
+                    for k in 0..4 {
+                        // f32 evaluation (directions, sines, the tangent): relative 1e-5.
+                        assert!(
+                            ((f[k] as f64) - expected).abs() <= 1e-5 * expected,
+                            "σ={sigma_deg}° θi={ti}° θo={to}° Δφ={dphi}°: eval {} vs closed \
+                             form {expected}",
+                            f[k]
+                        );
+                    }
+                    if sigma_deg == 0.0 {
+                        // σ = 0: Lambertian, exactly ρ/π.
+                        let lambert = rho as f64 / std::f64::consts::PI;
+                        assert!(
+                            ((f[0] as f64) - lambert).abs() <= 1e-6 * lambert,
+                            "σ=0 θi={ti} θo={to} Δφ={dphi}: {} vs ρ/π = {lambert}",
+                            f[0]
+                        );
+                    }
+                    // Below the surface on the other side: nothing.
+                    let below = Vec3::new(wi.x, wi.y, -wi.z);
+                    if wi.z > 0.0 && wo.z > 0.0 {
+                        assert_eq!(m.eval(wo, below, &wl)[0], 0.0);
+                    }
+                    n_checked += 1;
+                }
+            }
+        }
+    }
+    assert!(n_checked > 1000);
+    // One value by hand (σ = 20°, θi = 60°, θo = 30°, Δφ = 0, ρ = 0.6): σ² = 0.121847,
+    // A = 0.865168, B = 0.258824, sin 60° tan 30° = 0.5 → f = 0.6/π·0.994580 = 0.189951.
+    let f = oren_nayar(0.6, 20.0).eval(dir_deg(30.0, 0.0), dir_deg(60.0, 0.0), &wl)[0] as f64;
+    assert!((f - 0.189951).abs() < 2e-6, "{f}");
+}
+
+#[test]
+fn phong_albedo_at_normal_incidence_is_kd_plus_ks() {
+    // candela's lobe (src/bxdf/phong.rs, Lafortune & Willems 1994): f = k_d/π + k_s (n+2)/(2π)
+    // cosⁿ α, α from the mirror direction of ωo. At θo = 0 the mirror direction is the normal,
+    // so α = θi and the whole lobe lies in the hemisphere:
+    // a(0) = k_d ∫ cos θ/π dω + k_s ∫ (n+2)/(2π) cosⁿ⁺¹ θ dω = k_d + k_s·(n+2)/(n+2) = k_d + k_s.
+    // In μ = cos θ (after the φ integral) the integrand is 2 k_d μ + k_s (n+2) μⁿ⁺¹, a
+    // polynomial of degree n + 1 for integer n, which N-point Gauss–Legendre integrates exactly
+    // for n + 1 ≤ 2N − 1 (quadrature error 0; the φ rule is exact for a φ-independent integrand).
+    // What is left is the f32 evaluation: μ is rounded to f32 (relative 2⁻²⁴) and raised to the
+    // n-th power, so each node's value carries at most (n + 4)·2⁻²⁴ relative error; that bound
+    // is the tolerance.
+    let wo = Vec3::Z;
+    for (kd, ks, n) in [
+        (0.4f32, 0.6f32, 10.0f32),
+        (0.0, 1.0, 1000.0),
+        (0.25, 0.5, 100.0),
+        (0.7, 0.0, 50.0),
+        (0.1, 0.3, 1.0),
+    ] {
+        let m = phong(kd, ks, n);
+        let n_mu = (n as usize + 3).div_ceil(2).max(8) + 8;
+        assert!(n as usize + 1 <= 2 * n_mu - 1);
+        let expected = (kd + ks) as f64;
+        for lane in 0..4 {
+            let a = albedo_quadrature(&m, wo, lane, n_mu, 4);
+            let tol = (n as f64 + 4.0) * 2f64.powi(-24) * expected + 1e-9;
+            assert!(
+                (a - expected).abs() <= tol,
+                "Phong k_d={kd} k_s={ks} n={n}: a(θo=0) = {a}, expected k_d + k_s = {expected} \
+                 (tolerance {tol:.2e})"
+            );
+        }
+    }
+}
+
+#[test]
+fn diffuse_albedo_is_rho_with_zero_variance_under_cosine_sampling() {
+    for rho in [0.2f32, 0.6, 0.9, 1.0] {
+        let m = diffuse(rho);
+        // Quadrature: the integrand ρ μ/π is linear in μ, so Gauss–Legendre is exact; f32
+        // evaluation of ρ/π leaves a few ulps.
+        for t in [0.0f32, 45.0, 80.0] {
+            let a = albedo_quadrature(&m, dir_deg(t, 20.0), 0, 8, 4);
+            assert!(
+                (a - rho as f64).abs() <= 1e-6 * rho as f64,
+                "diffuse ρ={rho} θo={t}: albedo {a}"
+            );
+        }
+        // Cosine sampling: every sample's weight f·cos θi/pdf equals ρ (zero variance).
+        let mut rng = Rng::new(31);
+        let wl0 = wavelengths();
+        for t in [0.0f32, 30.0, 70.0, 89.0, 150.0] {
+            let wo = dir_deg(t, 45.0);
+            for _ in 0..5000 {
+                let mut wl = wl0;
+                let Some(bs) = m.sample(wo, rng.f32(), rng.vec2(), &mut wl) else {
+                    continue;
+                };
+                if bs.pdf <= 0.0 {
+                    continue;
+                }
+                assert!(bs.wi.z * wo.z > 0.0, "ρ={rho} θo={t}: wi on the wrong side");
+                for k in 0..4 {
+                    let w = bs.f[k] as f64 * bs.wi.z.abs() as f64 / bs.pdf as f64;
+                    assert!(
+                        (w - rho as f64).abs() <= 1e-6 * rho as f64,
+                        "ρ={rho} θo={t}: sample weight {w} ≠ ρ (wi = {:?}, pdf {})",
+                        bs.wi,
+                        bs.pdf
+                    );
+                }
+            }
         }
     }
 }

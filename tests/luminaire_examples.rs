@@ -237,19 +237,82 @@ fn write_then_read_gives_the_same_candela() {
     }
 }
 
+/// The number that ends just before `marker` in `text` (e.g. "767.02" in "767.02 lm integrated").
+fn number_before(text: &str, marker: &str) -> f64 {
+    let head = &text[..text
+        .find(marker)
+        .unwrap_or_else(|| panic!("no '{marker}' in {text}"))];
+    let tok = head.rsplit(|c: char| c.is_whitespace()).next().unwrap();
+    tok.parse()
+        .unwrap_or_else(|_| panic!("'{tok}' before '{marker}' is not a number"))
+}
+
+/// The number that starts right after `marker` in `text` (trailing unit or ° stripped).
+fn number_after(text: &str, marker: &str) -> f64 {
+    let at = text
+        .find(marker)
+        .unwrap_or_else(|| panic!("no '{marker}' in {text}"))
+        + marker.len();
+    let tok: String = text[at..]
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == '.' || *c == '-')
+        .collect();
+    tok.parse()
+        .unwrap_or_else(|_| panic!("'{tok}' after '{marker}' is not a number"))
+}
+
 #[test]
 fn luminaire_command_reports_and_draws() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("spot.png");
     let out =
         luminaire::cli::run(Path::new("data/luminaires/narrow-spot.ies"), Some(&png)).unwrap();
+    // Flux: the closed form Φ = 2π·5000/41 = 766.24 lm (∫ cos⁴⁰ γ dω over the lower
+    // hemisphere), within the 0.5 % this file uses for every integrated table.
+    let integrated = number_before(&out, " lm integrated");
     assert!(
-        out.contains("767.02 lm integrated") && out.contains("stated 766.24 lm"),
-        "{out}"
+        (integrated / SPOT_LM - 1.0).abs() < 0.005,
+        "integrated {integrated} lm vs analytic {SPOT_LM} lm\n{out}"
+    );
+    // The stated flux is the file's header value, round6(SPOT_LM), printed to 0.01 lm.
+    let stated = number_after(&out, "stated ");
+    assert!(
+        (stated - SPOT_LM).abs() <= 0.005 + 1e-9,
+        "stated {stated} lm vs {SPOT_LM}\n{out}"
     );
     assert!(out.contains("5000.00 cd at C 0°, γ 0°"), "{out}");
-    // cos⁴⁰ γ = 1/2 at γ = 10.7°: beam 21.4° (the bilinear table and 0.1° scan give 21.2°).
-    assert!(out.contains("beam angle (50 %): 21.2°"), "{out}");
+    // Beam angle (50 %): cos⁴⁰ γ½ = 1/2 → γ½ = acos(2^(−1/40)) = 10.6357°, beam 2γ½ = 21.271°.
+    // Tolerance from how the number is obtained (luminaire::spread_angle): the table holds
+    // I at 1° steps and is interpolated linearly, which moves the half-value angle by at
+    // most (h²/8)·max|I''|/|I'(γ½)| (h = 1°, max over the bracketing interval [10°, 11°]);
+    // the curve is then walked in 0.1° steps from the peak and only whole steps still ≥ 50 %
+    // are counted, which shortens each side by less than 0.1° and never lengthens it. So
+    // 2(γ½ − e) − 0.2° < beam ≤ 2(γ½ + e), e the interpolation bound.
+    let beam = number_after(&out, "beam angle (50 %): ");
+    let gamma_half = 0.5f64.powf(1.0 / 40.0).acos().to_degrees();
+    let analytic = 2.0 * gamma_half;
+    let d1 = |g: f64| {
+        let r = g.to_radians();
+        -40.0 * 5000.0 * r.cos().powi(39) * r.sin()
+    };
+    let d2 = |g: f64| {
+        let r = g.to_radians();
+        5000.0 * (1560.0 * r.cos().powi(38) * r.sin().powi(2) - 40.0 * r.cos().powi(40))
+    };
+    let max_d2 = (0..=100)
+        .map(|k| d2(10.0 + k as f64 / 100.0).abs())
+        .fold(0.0, f64::max);
+    let h = 1f64.to_radians();
+    let interp_deg = (h * h / 8.0 * max_d2 / d1(gamma_half).abs()).to_degrees();
+    let (lo, hi) = (
+        analytic - 2.0 * interp_deg - 0.2,
+        analytic + 2.0 * interp_deg,
+    );
+    assert!(
+        beam > lo && beam <= hi,
+        "beam angle {beam}° vs analytic {analytic:.3}°: outside ({lo:.3}°, {hi:.3}°] \
+         (interpolation {interp_deg:.4}° per side, 0.1° scan step)\n{out}"
+    );
     let img = image::open(&png).unwrap().to_rgb8();
     assert_eq!((img.width(), img.height()), (800, 800));
     // Some red (C0–C180 curve) and blue (C90–C270) pixels.
