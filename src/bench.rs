@@ -24,7 +24,7 @@ const CORNELL: &str = include_str!("../scenes/cornell-box.ron");
 pub struct BenchArgs {
     #[command(subcommand)]
     pub mode: Option<BenchMode>,
-    /// Worker threads (default: all cores).
+    /// Worker threads (default: all cores; at most 16 per available core).
     #[arg(long)]
     pub threads: Option<usize>,
     /// Samples per pixel for each benchmark scene.
@@ -44,8 +44,58 @@ pub enum BenchMode {
     Scaling(scaling::ScalingArgs),
 }
 
+/// Largest thread count any `--threads` accepts: 16 per available core
+/// ([`std::thread::available_parallelism`]). More only adds contention and memory, and tens of
+/// thousands of threads make the process unresponsive.
+pub fn max_threads() -> usize {
+    16 * std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Refuses a `--threads` value (named `flag` in the message) of 0 or above [`max_threads`].
+pub fn check_threads(flag: &str, n: usize) -> anyhow::Result<()> {
+    if n == 0 {
+        anyhow::bail!("{flag} must be at least 1, got 0");
+    }
+    let max = max_threads();
+    if n > max {
+        anyhow::bail!(
+            "{flag} {n} is too many: at most {max} threads are accepted (16 per available core, {} cores here)",
+            max / 16
+        );
+    }
+    Ok(())
+}
+
+/// Largest triangle count of a generated benchmark mesh (about 10 GB of mesh and BVH).
+pub const MAX_TRIANGLES: usize = 100_000_000;
+
+/// Refuses a triangle count (of option `flag`) above [`MAX_TRIANGLES`].
+pub fn check_triangles(flag: &str, n: usize) -> anyhow::Result<()> {
+    if n > MAX_TRIANGLES {
+        anyhow::bail!(
+            "{flag} {n} is too many: at most {MAX_TRIANGLES} triangles are generated (each needs about 100 bytes of mesh and BVH)"
+        );
+    }
+    Ok(())
+}
+
+/// Refuses 0 for a count option (`flag`) that needs at least 1.
+pub fn check_positive(flag: &str, n: u64) -> anyhow::Result<()> {
+    if n == 0 {
+        anyhow::bail!("{flag} must be at least 1, got 0");
+    }
+    Ok(())
+}
+
 /// Entry point of `candela bench`.
 pub fn main(args: &BenchArgs) -> anyhow::Result<()> {
+    if args.mode.is_none() {
+        if let Some(n) = args.threads {
+            check_threads("--threads", n)?;
+        }
+        check_positive("--spp", args.spp.into())?;
+        check_triangles("--triangles", args.triangles)?;
+    }
     match &args.mode {
         None => run(args.threads, args.spp, args.triangles),
         Some(BenchMode::Traversal(a)) => traversal::run(a),

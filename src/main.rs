@@ -47,10 +47,10 @@ enum Command {
         /// State files written with --save-state (or checkpoints).
         #[arg(required = true, num_args = 2..)]
         states: Vec<PathBuf>,
-        /// Output name: writes OUT.exr, OUT.png and OUT.state.
+        /// Output name: writes OUT.exr, OUT.png and OUT.state; an existing directory (or a path ending in `/`) writes DIR/merged.exr, .png and .state. Refused if an output would replace an input.
         #[arg(short, long)]
         out: PathBuf,
-        /// Exposure of the PNG in EV (default: automatic).
+        /// Exposure of the PNG in EV, between -100 and 100 (default: automatic).
         #[arg(long, allow_hyphen_values = true)]
         exposure: Option<f64>,
     },
@@ -76,7 +76,7 @@ enum Command {
     Luminaire {
         /// Photometric file: IES LM-63 (.ies) or EULUMDAT (.ldt).
         file: PathBuf,
-        /// Where to write the polar diagram (default: FILE-STEM-polar.png in the current directory).
+        /// Where to write the polar diagram (default: FILE-STEM-polar.png in the current directory); refused if it is FILE itself.
         #[arg(long)]
         diagram: Option<PathBuf>,
     },
@@ -99,7 +99,7 @@ struct RenderOpts {
     /// Output directory, or output file name (NAME, NAME.exr or NAME.png: both files are written). Default: the current directory, named after the scene.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Worker threads (default: all cores). The image does not depend on it.
+    /// Worker threads (default: all cores; at most 16 per available core). The image does not depend on it.
     #[arg(long)]
     threads: Option<usize>,
     /// Random seed (overrides render.seed).
@@ -108,7 +108,7 @@ struct RenderOpts {
     /// Maximum path depth (overrides render.max_depth).
     #[arg(long)]
     max_depth: Option<u32>,
-    /// Exposure of the PNG in EV (ISO 100); default: automatic. Does not affect the EXR.
+    /// Exposure of the PNG in EV (ISO 100), between -100 and 100; default: automatic. Does not affect the EXR.
     #[arg(long, allow_hyphen_values = true)]
     exposure: Option<f64>,
     /// Also estimate the illuminance (lx) on the surface seen through each pixel (EXR channels E, stderr.E, mask.E).
@@ -188,9 +188,56 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_message(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The error and its causes joined by ": ", like `{:#}`, but a cause whose text an outer
+/// message already contains (e.g. "cannot read scene file X: {source}" whose source is also
+/// the next cause in the chain) is not repeated.
+fn error_message(e: &anyhow::Error) -> String {
+    let mut msg = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if msg.is_empty() {
+            msg = text;
+        } else if !text.is_empty() && !msg.contains(&text) {
+            msg.push_str(": ");
+            msg.push_str(&text);
+        }
+    }
+    msg
+}
+
+/// Largest |EV| accepted by `--exposure`: ±100 EV is already 2^100 away from any real scene.
+const MAX_ABS_EXPOSURE_EV: f64 = 100.0;
+
+/// Refuses a non-finite `--exposure` or one beyond ±[`MAX_ABS_EXPOSURE_EV`].
+fn check_exposure(exposure: Option<f64>) -> Result<()> {
+    if let Some(ev) = exposure {
+        if !(ev.is_finite() && ev.abs() <= MAX_ABS_EXPOSURE_EV) {
+            // Large values in exponent form (-1e308 rather than 309 digits).
+            let got = if ev.abs() >= 1e6 {
+                format!("{ev:e}")
+            } else {
+                format!("{ev}")
+            };
+            bail!(
+                "--exposure must be a finite number of EV between -{MAX_ABS_EXPOSURE_EV} and {MAX_ABS_EXPOSURE_EV}, got {got}"
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Whether `a` and `b` name the same existing file (after resolving links and `..`); paths
+/// that do not both exist are compared as given.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
     }
 }
 
@@ -259,14 +306,10 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
     } else {
         Units::Si
     };
-    if let Some(0) = threads {
-        bail!("--threads must be at least 1");
+    if let Some(n) = threads {
+        candela::bench::check_threads("--threads", n)?;
     }
-    if let Some(ev) = exposure {
-        if !ev.is_finite() {
-            bail!("--exposure must be a finite number of EV, got {ev}");
-        }
-    }
+    check_exposure(exposure)?;
     if !(a.target_fraction > 0.0 && a.target_fraction <= 1.0) {
         bail!(
             "--target-fraction must lie in (0, 1], got {}",
@@ -315,6 +358,14 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
                 "cannot resume from {}: the scene file {}, a file it refers to (mesh, spectrum, luminaire data) or its settings (seed, max depth, resolution, illuminance, caustics) changed since the state was written",
                 state_path.display(),
                 scene_path.display()
+            );
+        }
+        if (st.film.width, st.film.height) != (w, h) {
+            bail!(
+                "{} is corrupt: its film is {}×{} but the scene it was rendered from (whose hash it carries) renders {w}×{h}",
+                state_path.display(),
+                st.film.width,
+                st.film.height
             );
         }
         if st.film.decision.is_some() != target.is_some() {
@@ -579,8 +630,7 @@ fn write_exr(
         film,
         world.settings.illuminance,
     );
-    output::write_exr(exr_path, &layers)
-        .with_context(|| format!("writing {}", exr_path.display()))?;
+    output::write_exr(exr_path, &layers).context("cannot write the EXR")?;
     Ok(())
 }
 
@@ -631,11 +681,48 @@ fn write_png(film: &candela::film::Film, png_path: &Path, exposure: Option<f64>)
             exposure_ev: exposure,
         },
     )
-    .with_context(|| format!("writing {}", png_path.display()))?;
+    .context("cannot write the PNG")?;
     Ok(())
 }
 
+/// The output stem of `merge -o OUT`: like `render --out`, an existing directory (or a path
+/// ending in `/`) is the output directory, and the files are named `merged.*` there; otherwise
+/// OUT, with a `.exr`, `.png` or `.state` extension removed.
+fn merge_stem(out: &Path) -> PathBuf {
+    if out.is_dir() || out.as_os_str().to_string_lossy().ends_with('/') {
+        return out.join("merged");
+    }
+    match out.extension().and_then(|e| e.to_str()) {
+        Some("exr") | Some("png") | Some("state") => out.with_extension(""),
+        _ => out.to_path_buf(),
+    }
+}
+
 fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()> {
+    check_exposure(exposure)?;
+    let stem = merge_stem(out);
+    let exr_path = with_suffix(&stem, ".exr");
+    let png_path = with_suffix(&stem, ".png");
+    let state_path = with_suffix(&stem, ".state");
+    if let Some(dir) = exr_path.parent() {
+        if !dir.as_os_str().is_empty() && !dir.is_dir() {
+            bail!(
+                "-o {}: output directory {} does not exist",
+                out.display(),
+                dir.display()
+            );
+        }
+    }
+    for output in [&exr_path, &png_path, &state_path] {
+        if let Some(input) = states.iter().find(|s| same_file(output, s)) {
+            bail!(
+                "-o {}: refusing to overwrite the input state file {} with the merged {}; choose another output name",
+                out.display(),
+                input.display(),
+                output.display()
+            );
+        }
+    }
     let mut loaded = Vec::new();
     for p in states {
         loaded.push((p, candela::state::RenderState::load(p)?));
@@ -664,24 +751,21 @@ fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()
         seeds.extend(s.seeds());
         film.merge(&s.film);
     }
-    let stem = match out.extension().and_then(|e| e.to_str()) {
-        Some("exr") | Some("png") | Some("state") => out.with_extension(""),
-        _ => out.to_path_buf(),
-    };
-    let exr_path = with_suffix(&stem, ".exr");
     let mut layers = film_layers(&first.scene, &film, first.illuminance);
     layers
         .attributes
         .push(("merged_seeds".to_string(), format!("{seeds:?}")));
-    output::write_exr(&exr_path, &layers)?;
-    write_png(&film, &with_suffix(&stem, ".png"), exposure)?;
+    output::write_exr(&exr_path, &layers).context("cannot write the EXR")?;
+    write_png(&film, &png_path, exposure)?;
     let merged = candela::state::RenderState {
         seed: seeds[0],
         merged_seeds: seeds[1..].to_vec(),
         film,
         ..first.clone()
     };
-    merged.save(&with_suffix(&stem, ".state"))?;
+    merged
+        .save(&state_path)
+        .context("cannot write the merged state")?;
     say!(
         "merged {} renders (seeds {seeds:?}): {:.1} image samples per pixel; wrote {}",
         loaded.len(),

@@ -14,6 +14,15 @@ const GOOD: &str = r#"(
 
 /// Run `candela render` on `text` in a fresh directory; returns (exit code, stderr, files left).
 fn run(text: &str, extra_files: &[(&str, &[u8])]) -> (i32, String, Vec<String>) {
+    run_with(text, extra_files, &[])
+}
+
+/// [`run`] with extra `render` options.
+fn run_with(
+    text: &str,
+    extra_files: &[(&str, &[u8])],
+    options: &[&str],
+) -> (i32, String, Vec<String>) {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("scene.ron");
     std::fs::write(&scene, text).unwrap();
@@ -21,7 +30,9 @@ fn run(text: &str, extra_files: &[(&str, &[u8])]) -> (i32, String, Vec<String>) 
         std::fs::write(dir.path().join(name), bytes).unwrap();
     }
     let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args(["render", "--quiet", "--out"])
+        .args(["render", "--quiet"])
+        .args(options)
+        .arg("--out")
         .arg(dir.path())
         .arg(&scene)
         .output()
@@ -173,4 +184,220 @@ fn out_file_name_is_respected() {
     );
     assert!(Path::new(&dir.path().join("named.exr")).exists());
     assert!(Path::new(&dir.path().join("named.png")).exists());
+}
+
+/// Run `candela ARGS` in `dir`; returns (exit code, stderr).
+fn candela_in(dir: &Path, args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The sorted names of the files in `dir`.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut files: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    files
+}
+
+/// Exit code 1, no panic, and every needle in the message.
+fn assert_refused(code: i32, stderr: &str, needles: &[&str]) {
+    assert_eq!(code, 1, "exit code {code}, stderr:\n{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(
+        stderr.trim_end().lines().count(),
+        1,
+        "not a one-paragraph message:\n{stderr}"
+    );
+    for n in needles {
+        assert!(stderr.contains(n), "message lacks {n:?}:\n{stderr}");
+    }
+}
+
+#[test]
+fn luminaire_diagram_over_the_input_is_refused() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/luminaires");
+    for name in ["batwing-office.ldt", "narrow-spot.ies"] {
+        let dir = tempfile::tempdir().unwrap();
+        let original = std::fs::read(data.join(name)).unwrap();
+        std::fs::write(dir.path().join(name), &original).unwrap();
+        std::fs::create_dir(dir.path().join("sub")).unwrap();
+        // The same path, and the same file by another path.
+        for diagram in [name.to_string(), format!("sub/../{name}")] {
+            let (code, stderr) =
+                candela_in(dir.path(), &["luminaire", name, "--diagram", &diagram]);
+            assert_refused(code, &stderr, &[name, "--diagram", "refusing to overwrite"]);
+            assert_eq!(std::fs::read(dir.path().join(name)).unwrap(), original);
+            assert_eq!(listing(dir.path()), vec![name.to_string(), "sub".into()]);
+        }
+    }
+}
+
+#[test]
+fn absurd_thread_counts_are_refused() {
+    let (code, stderr, files) = run_with(GOOD, &[], &["--threads", "100000"]);
+    assert_refused(code, &stderr, &["--threads", "100000"]);
+    assert!(
+        files.is_empty(),
+        "output written despite the error: {files:?}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        &["bench", "--threads", "100000"][..],
+        &["bench", "scaling", "--threads", "100000"],
+        &["bench", "traversal", "--threads", "1,100000"],
+    ] {
+        let (code, stderr) = candela_in(dir.path(), args);
+        assert_refused(code, &stderr, &["--threads", "100000"]);
+    }
+    assert!(listing(dir.path()).is_empty());
+}
+
+#[test]
+fn render_exposure_out_of_range_is_refused() {
+    for ev in ["-1e308", "1e308", "101", "nan"] {
+        let (code, stderr, files) = run_with(GOOD, &[], &["--exposure", ev]);
+        assert_refused(code, &stderr, &["--exposure"]);
+        assert!(
+            files.is_empty(),
+            "output written despite the error: {files:?}"
+        );
+    }
+    let (code, stderr, _) = run_with(GOOD, &[], &["--exposure", "-20"]);
+    assert_eq!(code, 0, "{stderr}");
+}
+
+/// A directory holding `a.state` and `b.state`: renders of [`GOOD`] with seeds 1 and 2.
+fn two_states() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.ron"), GOOD).unwrap();
+    for (name, seed) in [("a", "1"), ("b", "2")] {
+        let (code, stderr) = candela_in(
+            dir.path(),
+            &[
+                "render",
+                "--quiet",
+                "--save-state",
+                "--seed",
+                seed,
+                "--out",
+                name,
+                "scene.ron",
+            ],
+        );
+        assert_eq!(code, 0, "{stderr}");
+    }
+    dir
+}
+
+#[test]
+fn merge_exposure_is_checked_before_writing() {
+    let dir = two_states();
+    let before = listing(dir.path());
+    for ev in ["nan", "-1e308", "1e308"] {
+        let (code, stderr) = candela_in(
+            dir.path(),
+            &["merge", "a.state", "b.state", "-o", "out", "--exposure", ev],
+        );
+        assert_refused(code, &stderr, &["--exposure"]);
+        assert_eq!(
+            listing(dir.path()),
+            before,
+            "output written despite the error"
+        );
+    }
+}
+
+#[test]
+fn merge_output_over_an_input_is_refused() {
+    let dir = two_states();
+    let before = listing(dir.path());
+    let original = std::fs::read(dir.path().join("a.state")).unwrap();
+    for out in ["a", "a.state", "./a.exr"] {
+        let (code, stderr) = candela_in(dir.path(), &["merge", "a.state", "b.state", "-o", out]);
+        assert_refused(code, &stderr, &["a.state", "refusing to overwrite"]);
+        assert_eq!(std::fs::read(dir.path().join("a.state")).unwrap(), original);
+        assert_eq!(
+            listing(dir.path()),
+            before,
+            "output written despite the error"
+        );
+    }
+}
+
+#[test]
+fn merge_into_a_directory_writes_merged_files_there() {
+    let dir = two_states();
+    std::fs::create_dir(dir.path().join("out")).unwrap();
+    let (code, stderr) = candela_in(dir.path(), &["merge", "a.state", "b.state", "-o", "out"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(
+        listing(&dir.path().join("out")),
+        vec!["merged.exr", "merged.png", "merged.state"]
+    );
+    let before = listing(dir.path());
+    for out in ["missing/", "missing/c", "/nonexistent/c"] {
+        let (code, stderr) = candela_in(dir.path(), &["merge", "a.state", "b.state", "-o", out]);
+        assert_refused(code, &stderr, &[out, "does not exist"]);
+        assert_eq!(
+            listing(dir.path()),
+            before,
+            "output written despite the error"
+        );
+    }
+}
+
+#[test]
+fn os_error_text_appears_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    for args in [&["render", "--quiet", d][..], &["luminaire", d]] {
+        let (code, stderr) = candela_in(dir.path(), args);
+        assert_refused(code, &stderr, &[d]);
+        assert_eq!(
+            stderr.matches("(os error").count(),
+            1,
+            "repeated cause:\n{stderr}"
+        );
+    }
+    assert!(listing(dir.path()).is_empty());
+}
+
+#[test]
+fn bench_bad_counts_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["bench", "--triangles", "18446744073709551615"],
+            "--triangles",
+        ),
+        (&["bench", "--spp", "0"], "--spp"),
+        (&["bench", "traversal", "--resolution", "0"], "--resolution"),
+        (&["bench", "traversal", "--reps", "0"], "--reps"),
+        (
+            &["bench", "traversal", "--triangles", "1000000000"],
+            "--triangles",
+        ),
+        (
+            &["bench", "scaling", "--triangles", "10000,1000000000"],
+            "--triangles",
+        ),
+        (&["bench", "scaling", "--spp", "0"], "--spp"),
+        (&["bench", "scaling", "--reps", "0"], "--reps"),
+    ];
+    for (args, flag) in cases {
+        let (code, stderr) = candela_in(dir.path(), args);
+        assert_refused(code, &stderr, &[flag]);
+        assert!(!stderr.contains("cornell-box.ron"), "{stderr}");
+    }
+    assert!(listing(dir.path()).is_empty());
 }

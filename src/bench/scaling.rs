@@ -31,7 +31,7 @@ pub struct ScalingArgs {
     /// Samples per pixel of the renders.
     #[arg(long, default_value_t = 16)]
     pub spp: u32,
-    /// Worker threads (default: all cores).
+    /// Worker threads (default: all cores; at most 16 per available core).
     #[arg(long)]
     pub threads: Option<usize>,
     /// Repetitions of every render and traversal timing (medians are reported).
@@ -121,6 +121,23 @@ fn traversal_rate(geo: &SceneGeometry, batch: &RayBatch, threads: usize, reps: u
 }
 
 pub fn run(args: &ScalingArgs) -> Result<()> {
+    if let Some(n) = args.threads {
+        super::check_threads("--threads", n)?;
+    }
+    for &n in &args.triangles {
+        super::check_triangles("--triangles", n)?;
+    }
+    super::check_triangles("--linearity-triangles", args.linearity_triangles)?;
+    super::check_positive("--spp", args.spp.into())?;
+    super::check_positive("--resolution", args.resolution.into())?;
+    let max_res = super::traversal::MAX_RESOLUTION;
+    if args.resolution > max_res {
+        anyhow::bail!(
+            "--resolution {} is too large: at most {max_res}",
+            args.resolution
+        );
+    }
+    super::check_positive("--reps", args.reps as u64)?;
     let overrides = Overrides {
         spp: Some(args.spp),
         ..Default::default()

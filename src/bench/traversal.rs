@@ -42,7 +42,7 @@ pub struct TraversalArgs {
     /// watertight mode, the guarantee candela's kernel always gives).
     #[arg(long, value_delimiter = ',', default_value = "medium,high")]
     pub embree_quality: Vec<String>,
-    /// Thread counts to time (comma separated).
+    /// Thread counts to time (comma separated; each 1 to 16 per available core).
     #[arg(long, value_delimiter = ',', default_value = "1,2")]
     pub threads: Vec<usize>,
     /// Timing repetitions; candela and Embree alternate and the medians are reported.
@@ -457,10 +457,26 @@ fn mrays(rays: usize, seconds: f64) -> f64 {
     rays as f64 / seconds / 1e6
 }
 
+/// Largest `--resolution` of `bench traversal` (its batches hold RES² rays each).
+pub const MAX_RESOLUTION: u32 = 8192;
+
 pub fn run(args: &TraversalArgs) -> Result<()> {
     if args.threads.is_empty() || args.threads.contains(&0) {
         bail!("--threads needs thread counts of at least 1, e.g. 1,2");
     }
+    for &n in &args.threads {
+        super::check_threads("--threads", n)?;
+    }
+    super::check_triangles("--triangles", args.triangles)?;
+    super::check_positive("--resolution", args.resolution.into())?;
+    if args.resolution > MAX_RESOLUTION {
+        bail!(
+            "--resolution {} is too large: at most {MAX_RESOLUTION} ({MAX_RESOLUTION}² primary rays per batch)",
+            args.resolution
+        );
+    }
+    super::check_positive("--reps", args.reps as u64)?;
+    super::check_positive("--build-reps", args.build_reps as u64)?;
     let reps = args.reps.max(1);
     let (file, source) = match &args.rays {
         Some(path) => {

@@ -41,8 +41,28 @@ pub fn default_diagram_path(file: &Path) -> PathBuf {
     PathBuf::from(format!("{stem}-polar.png"))
 }
 
-/// Run the command: returns the report text; writes the diagram.
+/// Whether `a` and `b` name the same existing file (after resolving links and `..`); paths
+/// that do not both exist are compared as given.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// Run the command: returns the report text; writes the diagram (refused if the diagram path
+/// is the input file).
 pub fn run(file: &Path, diagram: Option<&Path>) -> anyhow::Result<String> {
+    let path = diagram
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| default_diagram_path(file));
+    if same_file(&path, file) {
+        anyhow::bail!(
+            "--diagram {}: refusing to overwrite the input photometric file {} with the PNG diagram; choose another --diagram path",
+            path.display(),
+            file.display()
+        );
+    }
     let p = load(file)?;
     let s = summarise(&p);
     let mut out = String::new();
@@ -122,9 +142,6 @@ pub fn run(file: &Path, diagram: Option<&Path>) -> anyhow::Result<String> {
         "field angle (10 %): {:.1}° in C0-C180, {:.1}° in C90-C270",
         s.field[0], s.field[1]
     );
-    let path = diagram
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| default_diagram_path(file));
     let title = file
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
