@@ -51,8 +51,13 @@ fn resolve(source: &str) -> anyhow::Result<Source> {
         let t = parse_temperature(rest, "blackbody")?;
         return Ok(Source {
             description: format!(
-                "blackbody at {t} K (Planck's law, c2 = 1.4388e-2 m·K; spectral radiance in \
-                 W·m⁻²·sr⁻¹·nm⁻¹)"
+                "blackbody at {} K (Planck's law, c2 = 1.4388e-2 m·K; spectral radiance in \
+                 W·m⁻²·sr⁻¹·nm⁻¹)",
+                if t < 1e7 {
+                    format!("{t}")
+                } else {
+                    format!("{t:e}")
+                }
             ),
             table: blackbody_table(t),
             blackbody_k: Some(t),
@@ -136,6 +141,15 @@ pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow:
     if s.iter().all(|&v| v == 0.0) {
         bail!(
             "{}: the spectrum is zero everywhere in {START_NM}–{END_NM} nm",
+            src.description
+        );
+    }
+    // Values whose sums overflow f64 (a CSV of 1e308s, a blackbody at 1e300 K) would print
+    // as inf and NaN: refuse them instead.
+    let peak = s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !s.iter().all(|v| v.is_finite()) || !(peak * (END_NM - START_NM + 1) as f64).is_finite() {
+        bail!(
+            "{}: values up to {peak:e} overflow the colour sums; scale the spectrum down (only its shape matters for xy, CCT and the indices)",
             src.description
         );
     }
@@ -416,6 +430,15 @@ mod tests {
         assert!(spectrum_command(p.to_str().unwrap(), Observer::Cie1931_2, false).is_err());
         std::fs::write(&p, "400,1\n500,1\n600,1\n").unwrap();
         assert!(spectrum_command(p.to_str().unwrap(), Observer::Cie1931_2, false).is_ok());
+        // Sums that overflow f64 are refused rather than printed as inf and NaN.
+        std::fs::write(&p, "nm,v\n400,1e308\n700,1e308\n").unwrap();
+        let e = spectrum_command(p.to_str().unwrap(), Observer::Cie1931_2, true).unwrap_err();
+        assert!(e.to_string().contains("overflow"), "{e}");
+        let e = spectrum_command("blackbody:1e300K", Observer::Cie1931_2, false).unwrap_err();
+        assert!(
+            e.to_string().contains("overflow") && e.to_string().contains("1e300 K"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -324,7 +324,14 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
     if a.max_spp == Some(0) {
         bail!("--max-spp must be at least 1");
     }
-    let world = scene::load_world(scene_path, &overrides)?;
+    let world = scene::load_world_for(
+        scene_path,
+        &overrides,
+        &scene::RunMode {
+            adaptive: a.target_error.is_some(),
+            falsecolour: a.falsecolour,
+        },
+    )?;
     let scene_bytes = std::fs::read(scene_path)
         .with_context(|| format!("cannot read scene file {}", scene_path.display()))?;
     let hash = candela::state::scene_hash(&scene_bytes, &world);

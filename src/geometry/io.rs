@@ -68,6 +68,43 @@ fn validate(path: &Path, mesh: &TriangleMesh) -> Result<(), GeometryError> {
     Ok(())
 }
 
+/// The first OBJ face whose vertex reference is not a valid position index, described with
+/// its line, its face number (from 0, counting `f` lines) and the vertex count: OBJ indices
+/// are 1-based, or negative to count back from the last vertex defined so far.
+fn locate_bad_face(path: &Path) -> Option<String> {
+    let text = std::fs::read(path).ok()?;
+    let text = String::from_utf8_lossy(&text);
+    let is = |l: &str, tag: &str| {
+        l.strip_prefix(tag)
+            .is_some_and(|r| r.starts_with([' ', '\t']))
+    };
+    let total = text.lines().filter(|l| is(l.trim_start(), "v")).count();
+    let (mut seen, mut face) = (0usize, 0usize);
+    for (n, line) in text.lines().enumerate() {
+        let l = line.trim_start();
+        if is(l, "v") {
+            seen += 1;
+        } else if is(l, "f") {
+            for tok in l[1..].split_whitespace() {
+                let first = tok.split('/').next().unwrap_or("");
+                let ok = match first.parse::<i64>() {
+                    Ok(i) if i > 0 => i as u64 <= total as u64,
+                    Ok(i) if i < 0 => i.unsigned_abs() <= seen as u64,
+                    _ => false,
+                };
+                if !ok {
+                    return Some(format!(
+                        "line {}: face {face} refers to vertex {first:?}, but the file has {total} vertices ({seen} before this line); OBJ vertex indices run from 1 to {total}, or from -1 back to -{seen}",
+                        n + 1
+                    ));
+                }
+            }
+            face += 1;
+        }
+    }
+    None
+}
+
 /// Loads a Wavefront OBJ file: polygons are triangulated (fan), all objects/groups are merged
 /// into one mesh, materials and texture coordinates are ignored. Vertex normals are kept only
 /// if every object in the file has them.
@@ -89,14 +126,20 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
     let loaded = std::panic::catch_unwind(|| tobj::load_obj(path, &opts))
         .map_err(|_| parse("the OBJ parser failed on malformed input".into()))?;
     let (models, _materials) = loaded.map_err(|e| match e {
-        tobj::LoadError::FaceVertexOutOfBounds => {
-            parse("a face refers to a vertex index that does not exist (index out of range)".into())
+        tobj::LoadError::FaceVertexOutOfBounds | tobj::LoadError::FaceParseError => {
+            // tobj does not say where: find the face ourselves.
+            parse(locate_bad_face(path).unwrap_or_else(|| {
+                match e {
+                    tobj::LoadError::FaceVertexOutOfBounds => {
+                        "a face refers to a vertex index that does not exist (index out of range)"
+                            .into()
+                    }
+                    _ => "a face ('f' line) has a non-numeric or zero vertex index".into(),
+                }
+            }))
         }
         tobj::LoadError::PositionParseError => {
             parse("a vertex position ('v' line) is not three numbers".into())
-        }
-        tobj::LoadError::FaceParseError => {
-            parse("a face ('f' line) has a non-numeric or zero vertex index".into())
         }
         e => parse(e.to_string()),
     })?;

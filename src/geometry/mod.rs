@@ -55,7 +55,7 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum GeometryError {
     /// The mesh file could not be opened or read.
-    #[error("cannot read mesh file '{}': {source}. Check that the path is correct (relative paths are resolved against the current working directory) and that the file is readable.", path.display())]
+    #[error("cannot read mesh file '{}': {source}. Check that the path is correct (a scene's relative mesh paths are resolved against the scene file's directory) and that the file is readable.", path.display())]
     Io {
         path: PathBuf,
         #[source]

@@ -8,7 +8,7 @@ pub mod schema;
 
 use std::path::{Path, PathBuf};
 
-pub use build::{build, load_world, Overrides};
+pub use build::{build, build_for, load_world, load_world_for, Overrides, RunMode};
 pub use schema::SceneFile;
 
 #[derive(Debug, thiserror::Error)]
@@ -43,8 +43,10 @@ pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
     parse(&text, path)
 }
 
-/// Parse scene text; `path` is only used in messages.
+/// Parse scene text; `path` is only used in messages. A leading UTF-8 byte-order mark (as some
+/// Windows editors write) is ignored.
 pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     ron::Options::default()
         .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
         .from_str::<SceneFile>(text)

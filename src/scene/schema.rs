@@ -12,8 +12,9 @@ pub struct SceneFile {
     pub camera: CameraDesc,
     #[serde(default)]
     pub render: RenderDesc,
-    /// Materials by name; objects refer to them by name. `"black"` is predefined.
-    #[serde(default)]
+    /// Materials by name; objects refer to them by name. `"black"` is predefined (and may not
+    /// be redefined). A key given twice is an error.
+    #[serde(default, deserialize_with = "unique_material_keys")]
     pub materials: BTreeMap<String, MaterialDesc>,
     #[serde(default)]
     pub objects: Vec<ObjectDesc>,
@@ -29,6 +30,47 @@ pub struct SceneFile {
     /// Sample budget of meters and grids.
     #[serde(default)]
     pub measure: MeasureDesc,
+}
+
+fn unique_material_keys<'de, D>(d: D) -> Result<BTreeMap<String, MaterialDesc>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    unique_keys(d, "materials")
+}
+
+/// Deserialize the map `field`, refusing a key given twice (serde's maps keep the last value
+/// silently; the error raised here carries the parser's position).
+fn unique_keys<'de, D, V>(d: D, field: &'static str) -> Result<BTreeMap<String, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    V: Deserialize<'de>,
+{
+    struct Visit<V>(&'static str, std::marker::PhantomData<V>);
+    impl<'de, V: Deserialize<'de>> serde::de::Visitor<'de> for Visit<V> {
+        type Value = BTreeMap<String, V>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a map with string keys")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut map: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out = BTreeMap::new();
+            while let Some(key) = map.next_key::<String>()? {
+                if out.contains_key(&key) {
+                    return Err(serde::de::Error::custom(format!(
+                        "`{}`: the key {key:?} is given twice; each key may appear only once",
+                        self.0
+                    )));
+                }
+                let value = map.next_value()?;
+                out.insert(key, value);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_map(Visit(field, std::marker::PhantomData))
 }
 
 #[derive(Debug, Clone, Deserialize)]
