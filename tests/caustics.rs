@@ -115,8 +115,17 @@ const SPHERE_SCENE: &str = r#"(
 
 #[test]
 fn light_traced_caustic_agrees_with_path_traced_caustic() {
-    let lt = world_with(SPHERE_SCENE, Caustics::LightTracing);
-    let pt = world_with(SPHERE_SCENE, Caustics::PathTracing);
+    // Path tracing finds the caustic only through the sphere by chance: it gets 8× the
+    // samples, so that the comparison's σ is below 2 % of the caustic (measured 1.4 %).
+    let (spp_lt, spp_pt) = (1024.0f64, 8192.0f64);
+    let lt = world_with(
+        &SPHERE_SCENE.replace("spp: 256", "spp: 1024"),
+        Caustics::LightTracing,
+    );
+    let pt = world_with(
+        &SPHERE_SCENE.replace("spp: 256", "spp: 8192"),
+        Caustics::PathTracing,
+    );
     assert!(lt.caustics.is_some() && pt.caustics.is_none());
     let (a, b) = (render(&lt, 2), render(&pt, 2));
     // Compare the caustic region (the pixels whose values differ most between the two
@@ -148,13 +157,17 @@ fn light_traced_caustic_agrees_with_path_traced_caustic() {
     };
     let ((ra, rsa), (rb, rsb)) = (region(&a), region(&b));
     let s = (rsa * rsa + rsb * rsb).sqrt();
+    println!(
+        "caustic region: light tracing {ra:.4} ± {rsa:.4}, path tracing {rb:.4} ± {rsb:.4} cd/m², s/rb = {:.4}",
+        s / rb
+    );
     assert!(
-        (ra - rb).abs() <= 4.0 * s && s < 0.1 * rb,
+        (ra - rb).abs() <= 4.0 * s && s < 0.02 * rb,
         "caustic: light tracing {ra} ± {rsa} vs path tracing {rb} ± {rsb} cd/m²"
     );
-    // Light tracing is the better estimator there: a smaller standard error.
+    // Light tracing is the better estimator there: a smaller standard error per sample.
     assert!(
-        rsa < rsb,
+        rsa * spp_lt.sqrt() < rsb * spp_pt.sqrt(),
         "caustic σ: light tracing {rsa}, path tracing {rsb}"
     );
 }
