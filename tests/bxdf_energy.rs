@@ -373,33 +373,6 @@ fn furnace_white_coated_is_lossless_and_rough_materials_gain_nothing() {
 // ---------------------------------------------------------------------------------------
 // Closed forms for the analytic reflection models.
 
-/// Gauss–Legendre nodes and weights on [0, 1] (Newton iteration on Pₙ, f64). An N-point rule
-/// integrates polynomials of degree ≤ 2N − 1 exactly.
-fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
-    let mut out = Vec::with_capacity(n);
-    for i in 0..n {
-        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 0.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-            let dx = p1 / dp;
-            x -= dx;
-            if dx.abs() < 1e-16 {
-                break;
-            }
-        }
-        // Map [−1, 1] → [0, 1].
-        out.push((0.5 * (x + 1.0), 1.0 / ((1.0 - x * x) * dp * dp)));
-    }
-    out
-}
-
 /// Directional albedo a(ωo) = ∫ f(ωo, ωi) cos θi dωi over the upper hemisphere by a product
 /// rule: Gauss–Legendre in μ = cos θi (n_mu nodes) × the midpoint rule in φ (n_phi nodes).
 fn albedo_quadrature(m: &Material, wo: Vec3, lane: usize, n_mu: usize, n_phi: usize) -> f64 {

@@ -1,7 +1,9 @@
 //! The BSDF library inside the renderer: white furnaces (a lossless object in a uniform
 //! environment is invisible), and the prism scene's dispersion.
 
+mod bxdf_util;
 mod common;
+use bxdf_util::gauss_legendre_01;
 use candela::bxdf::{Frame, Material};
 use candela::scene::{load_world, Overrides};
 use candela::spectrum::SampledWavelengths;
@@ -42,31 +44,6 @@ fn white_furnace_lossless_objects_are_invisible() {
         println!("{m:45} mean Y = {:.5} ± {:.5}", mean[1], se);
         assert_every_pixel(&film, 1.0, 5.0);
     }
-}
-
-/// Gauss–Legendre nodes and weights on [0, 1] (Newton iteration on Pₙ, f64).
-fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 0.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            (0.5 * (x + 1.0), 1.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
 }
 
 /// The luminance-weighted directional albedo of an isotropic opaque material at incidence

@@ -1,6 +1,7 @@
 //! Bad input ends with one clear message (file, line:column or field), exit code 1 (not a
 //! panic's 101), and no output file.
 
+mod common;
 use std::path::Path;
 use std::process::Command;
 
@@ -188,15 +189,8 @@ fn out_file_name_is_respected() {
 
 /// Run `candela ARGS` in `dir`; returns (exit code, stderr).
 fn candela_in(dir: &Path, args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let (code, _, stderr) = common::cli(args, dir);
+    (code, stderr)
 }
 
 /// The sorted names of the files in `dir`.

@@ -1,8 +1,9 @@
 //! False-colour maps agree with the EXR they came from: legend ticks are the step boundaries,
 //! and every pixel is painted with the colour of the step its value lies in.
 
+mod common;
+use common::cli;
 use std::path::Path;
-use std::process::Command;
 
 use candela::output::{self, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR};
 use candela::report::falsecolour::{write_falsecolour, FalsecolourSettings, LegendInfo, Scale};
@@ -225,19 +226,6 @@ fn imperial_luminance_ticks_are_footlamberts() {
     for x in 0..50 {
         assert_eq!(map_pixel(&img, &info, x, 1), info.step_colours[x / 10]);
     }
-}
-
-fn cli(args: &[&str], dir: &Path) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
 }
 
 fn pngs(dir: &Path) -> Vec<String> {

@@ -1,8 +1,9 @@
 //! `candela probe` agrees with the EXR it reads: means, 95 % intervals (±1.96·SE), disc
 //! averaging, chromaticity, JSON and imperial units; bad input gives exit 1 naming the file.
 
+mod common;
+use common::cli;
 use std::path::Path;
-use std::process::Command;
 
 use candela::output::{self, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR};
 use candela::report::probe::{probe, IlluminanceProbe};
@@ -244,19 +245,6 @@ fn disc_average() {
     assert!(r
         .to_text("p.exr")
         .contains("undefined: pixel sees no surface"));
-}
-
-fn cli(args: &[&str], dir: &Path) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
 }
 
 #[test]

@@ -178,3 +178,18 @@ pub fn assert_estimate_near(mean: f64, stderr: f64, expected: f64, max_rel_se: f
         "{label}: {mean} ± {stderr}, expected {expected}"
     );
 }
+
+/// Runs the `candela` binary with `args` in `dir`: (exit code, stdout, stderr); the exit code is
+/// −1 if it was killed by a signal.
+pub fn cli(args: &[&str], dir: &Path) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_candela"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
