@@ -58,26 +58,24 @@ fn luminance_albedo(m: &Material, mu_o: f64, n_mu: usize, n_phi: usize, dl: usiz
     let wo = Vec3::new((1.0 - mu_o * mu_o).max(0.0).sqrt() as f32, 0.0, mu_o as f32);
     // Composite rule in cos θi, graded toward grazing: near grazing incidence the lobe
     // concentrates at grazing ωi.
-    let edges = [0.0, 0.005, 0.02, 0.06, 0.15, 0.35, 0.65, 1.0];
-    let gl: Vec<(f64, f64)> = edges
-        .windows(2)
-        .flat_map(|e| {
-            gauss_legendre_01(n_mu)
-                .into_iter()
-                .map(move |(x, w)| (e[0] + (e[1] - e[0]) * x, (e[1] - e[0]) * w))
-        })
-        .collect();
+    // An n-point Gauss–Legendre rule on each interval between consecutive edges.
+    let composite = |edges: &[f64], n: usize| -> Vec<(f64, f64)> {
+        let gl = gauss_legendre_01(n);
+        edges
+            .windows(2)
+            .flat_map(|e| {
+                gl.iter()
+                    .map(|&(x, w)| (e[0] + (e[1] - e[0]) * x, (e[1] - e[0]) * w))
+            })
+            .collect()
+    };
+    let gl = composite(&[0.0, 0.005, 0.02, 0.06, 0.15, 0.35, 0.65, 1.0], n_mu);
     // In φ (the reflection lobe lies around φ = π, narrowing toward grazing), likewise.
     let pi = std::f64::consts::PI;
-    let phi_edges = [0.0, 0.5 * pi, 0.75 * pi, 0.875 * pi, 0.95 * pi, pi];
-    let gphi: Vec<(f64, f64)> = phi_edges
-        .windows(2)
-        .flat_map(|e| {
-            gauss_legendre_01(n_phi)
-                .into_iter()
-                .map(move |(x, w)| (e[0] + (e[1] - e[0]) * x, (e[1] - e[0]) * w))
-        })
-        .collect();
+    let gphi = composite(
+        &[0.0, 0.5 * pi, 0.75 * pi, 0.875 * pi, 0.95 * pi, pi],
+        n_phi,
+    );
     let dirs: Vec<(Vec3, f64)> = gl
         .iter()
         .flat_map(|&(mu, w)| {
