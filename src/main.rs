@@ -420,6 +420,8 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
         candela::state::RenderState::new(scene_path, hash, &world, film.clone())
             .save(&state_path)?;
         write_exr(scene_path, &world, film, &exr_path)?;
+        // The PNG too, so that the image pair on disk is always of the same estimate.
+        write_png(film, &png_path, exposure)?;
         Ok(())
     };
     let (result, reason) = candela::render::render_progressive(
