@@ -144,19 +144,34 @@ pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow:
             src.description
         );
     }
-    // Values whose sums overflow f64 (a CSV of 1e308s, a blackbody at 1e300 K) would print
-    // as inf and NaN: refuse them instead.
+    // Everything but the absolute XYZ is independent of the spectrum's scale, so it is computed
+    // from the spectrum divided by its peak: values near the ends of the f64 range (a CSV of
+    // 1e305s or 1e-315s) then neither overflow nor lose precision in subnormals. A reflectance
+    // keeps its scale (it is meaningful).
     let peak = s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if !s.iter().all(|v| v.is_finite()) || !(peak * (END_NM - START_NM + 1) as f64).is_finite() {
+    if !peak.is_finite() {
         bail!(
-            "{}: values up to {peak:e} overflow the colour sums; scale the spectrum down (only its shape matters for xy, CCT and the indices)",
+            "{}: its values overflow 64-bit floats (not finite)",
             src.description
         );
     }
+    let xyz_abs = sd_to_xyz_absolute(s, observer);
+    if !xyz_abs.iter().all(|v| v.is_finite()) {
+        bail!(
+            "{}: values up to {peak:e} overflow the absolute XYZ (683·Σ S x̄ Δλ) in 64-bit floats; scale the spectrum down (only its shape matters for xy, CCT and the indices)",
+            src.description
+        );
+    }
+    let scaled;
+    let s = if src.reflectance {
+        s
+    } else {
+        scaled = s.map(|v| v / peak);
+        &scaled
+    };
     let o2 = Observer::Cie1931_2;
     let xyz = sd_to_xyz_emissive(s, observer);
     let xyz_n = xyz.map(|v| v * 100.0 / xyz[1]);
-    let xyz_abs = sd_to_xyz_absolute(s, observer);
     let xy = xyz_to_xy(xyz);
     let upvp = xyz_to_upvp(xyz);
     let uv = xyz_to_uv1960(xyz);
@@ -182,6 +197,37 @@ pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow:
         (xyz_o, lab, lin, lin.map(srgb_encode))
     });
 
+    // Where a result is outside its method's domain it is still printed (it is what
+    // colour-science computes too), with a note saying why it is not meaningful.
+    let mut notes: Vec<String> = Vec::new();
+    // (One step of the table's 1.001 spacing beyond its ends is still interpolation noise.)
+    if !(999.0..=100_100.0).contains(&ohno[0]) {
+        notes.push(format!(
+            "CCT (Ohno 2013) {:.1} K lies outside the 1000–100 000 K Planckian table: it is extrapolated and not meaningful",
+            ohno[0]
+        ));
+    }
+    if ohno[1].abs() > 0.05 {
+        notes.push(format!(
+            "Duv {:+.4}: the chromaticity is far from the Planckian locus (|Duv| > 0.05), where CCT is not defined (CIE 015)",
+            ohno[1]
+        ));
+    }
+    if rob[0] <= ROBERTSON_MIN_K {
+        notes.push(format!(
+            "CCT (Robertson 1968) is at its table's lower limit ({ROBERTSON_MIN_K:.0} K, 600 mired); the source's CCT is lower"
+        ));
+    }
+    if let Some(c) = &cri {
+        if xyz2[2] <= 1e-9 * xyz2[1] {
+            notes.push("CRI: the source has no power where z̄ > 0 (Z ≈ 0), so CIE 13.3's chromatic adaptation is undefined; Ra and Ri are not meaningful".into());
+        } else if c.cct_k <= ROBERTSON_MIN_K {
+            notes.push(format!(
+                "CRI: the reference illuminant is taken at the Robertson table's limit {ROBERTSON_MIN_K:.0} K although the source's CCT is lower, so Ra and Ri are not meaningful"
+            ));
+        }
+    }
+
     if json {
         let mut j = json!({
             "source": source,
@@ -201,6 +247,7 @@ pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow:
             "sp_ratio": sp,
             "srgb_linear": srgb_lin,
             "srgb_encoded": srgb_enc,
+            "notes": notes,
         });
         if let Some(e) = bb_eff {
             j["blackbody_luminous_efficacy_lm_per_w"] = json!(e);
@@ -307,8 +354,14 @@ pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow:
             ),
         );
     }
+    for n in &notes {
+        line("note", n.clone());
+    }
     Ok(out)
 }
+
+/// Lowest CCT of the Robertson (1968) table: 600 mired.
+const ROBERTSON_MIN_K: f64 = 1e6 / 600.0 + 1e-6;
 
 /// Parses the `--observer` value: "1931" / "2" / "cie1931" → CIE 1931 2°, "1964" / "10" /
 /// "cie1964" → CIE 1964 10°.
@@ -430,14 +483,71 @@ mod tests {
         assert!(spectrum_command(p.to_str().unwrap(), Observer::Cie1931_2, false).is_err());
         std::fs::write(&p, "400,1\n500,1\n600,1\n").unwrap();
         assert!(spectrum_command(p.to_str().unwrap(), Observer::Cie1931_2, false).is_ok());
-        // Sums that overflow f64 are refused rather than printed as inf and NaN.
+        // Sums that overflow f64 are refused rather than printed as inf and NaN; the scale-free
+        // results of huge and tiny spectra are those of the same shape at a normal scale.
         std::fs::write(&p, "nm,v\n400,1e308\n700,1e308\n").unwrap();
         let e = spectrum_command(p.to_str().unwrap(), Observer::Cie1931_2, true).unwrap_err();
         assert!(e.to_string().contains("overflow"), "{e}");
+        let flat = |v: &str| {
+            std::fs::write(&p, format!("nm,v\n360,{v}\n830,{v}\n")).unwrap();
+            let j = spectrum_command(p.to_str().unwrap(), Observer::Cie1931_2, true);
+            j.map(|j| serde_json::from_str::<serde_json::Value>(&j).unwrap())
+        };
+        let one = flat("1").unwrap();
+        for v in ["1e-315", "1e300"] {
+            let j = flat(v).unwrap();
+            for key in [
+                "xy",
+                "cct_k",
+                "duv",
+                "sp_ratio",
+                "luminous_efficacy_lm_per_w",
+            ] {
+                assert_eq!(j[key], one[key], "{v}: {key}");
+            }
+            assert_eq!(j["cri"]["ra"], one["cri"]["ra"], "{v}: Ra");
+        }
+        assert!(flat("1e305").unwrap_err().to_string().contains("overflow"));
         let e = spectrum_command("blackbody:1e300K", Observer::Cie1931_2, false).unwrap_err();
         assert!(
             e.to_string().contains("overflow") && e.to_string().contains("1e300 K"),
             "{e}"
+        );
+    }
+
+    #[test]
+    fn notes_flag_values_outside_their_methods_domain() {
+        let notes = |src: &str| -> Vec<String> {
+            let j = spectrum_command(src, Observer::Cie1931_2, true).unwrap();
+            let v: serde_json::Value = serde_json::from_str(&j).unwrap();
+            v["notes"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|n| n.as_str().unwrap().to_string())
+                .collect()
+        };
+        assert!(notes("blackbody:2856K").is_empty());
+        assert!(notes("D65").is_empty());
+        let cool = notes("blackbody:1200K");
+        assert!(cool.iter().any(|n| n.contains("Robertson")), "{cool:?}");
+        assert!(cool.iter().any(|n| n.starts_with("CRI")), "{cool:?}");
+        assert!(notes("blackbody:150000K")
+            .iter()
+            .any(|n| n.contains("outside the 1000–100 000 K")));
+        // A deep-red line: no power where z̄ > 0 (and a CCT far below the table).
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("red.csv");
+        std::fs::write(&p, "nm,v\n688,0\n690,1\n692,0\n").unwrap();
+        let red = notes(p.to_str().unwrap());
+        assert!(red.iter().any(|n| n.contains("Z ≈ 0")), "{red:?}");
+        assert!(red.iter().any(|n| n.contains("extrapolated")), "{red:?}");
+        // A green line lies far above the Planckian locus.
+        std::fs::write(&p, "nm,v\n528,0\n530,1\n532,0\n").unwrap();
+        let green = notes(p.to_str().unwrap());
+        assert!(
+            green.iter().any(|n| n.contains("|Duv| > 0.05")),
+            "{green:?}"
         );
     }
 

@@ -243,7 +243,7 @@ pub const UNITS: &[Unit] = &[
         symbol: "L",
         quantity: Quantity::Luminance,
         si: 1.0e4 / std::f64::consts::PI,
-        aliases: &["lambert", "lamberts", "la"],
+        aliases: &["lambert", "lamberts", "la", "l"],
     },
     Unit {
         name: "apostilb",
@@ -308,6 +308,12 @@ pub enum UnitError {
     },
     #[error("value {0} is not a finite number")]
     NotFinite(f64),
+    #[error("{value} {from} is beyond the range of a 64-bit float in {to}")]
+    Overflow {
+        value: f64,
+        from: String,
+        to: String,
+    },
 }
 
 fn known_units() -> String {
@@ -356,7 +362,18 @@ pub fn convert(value: f64, from: &str, to: &str) -> Result<f64, UnitError> {
             hint,
         });
     }
-    Ok(value * f.si / t.si)
+    if std::ptr::eq(f, t) {
+        return Ok(value);
+    }
+    let v = value * f.si / t.si;
+    if !v.is_finite() {
+        return Err(UnitError::Overflow {
+            value,
+            from: f.name.to_string(),
+            to: t.name.to_string(),
+        });
+    }
+    Ok(v)
 }
 
 #[cfg(test)]
@@ -419,6 +436,20 @@ mod tests {
         assert!((convert(1.0, "fL", "nit").unwrap() - 3.4262590996353905).abs() < 1e-12);
         assert!((convert(1.0, "stilb", "nit").unwrap() - 1e4).abs() < 1e-9);
         assert!((convert(1.0, "lambert", "cd/m2").unwrap() - 3183.098861837907).abs() < 1e-9);
+        // Every unit's listed symbol is accepted (e.g. L for lambert).
+        for u in UNITS {
+            assert!(
+                std::ptr::eq(parse_unit(u.symbol).unwrap(), u),
+                "symbol {}",
+                u.symbol
+            );
+        }
+        // A unit to itself is exact; a result beyond f64 is an error, not inf.
+        assert_eq!(convert(3.14159, "fc", "fc").unwrap(), 3.14159);
+        assert!(matches!(
+            convert(1e308, "fc", "lux"),
+            Err(UnitError::Overflow { .. })
+        ));
         assert!((convert(std::f64::consts::PI, "apostilb", "nit").unwrap() - 1.0).abs() < 1e-15);
         assert!((convert(1.0, "lm·h", "talbot").unwrap() - 3600.0).abs() < 1e-12);
         assert_eq!(convert(5.0, "lumen", "lm").unwrap(), 5.0);
