@@ -432,6 +432,9 @@ pub fn transmittance_counted(
 /// With `caustics_by_light_tracing` (the image's per-pixel illuminance when the world traces
 /// caustics from the lights), the paths whose scattering next to the light is specular are
 /// left out: light tracing estimates them (see [`crate::caustics`]).
+///
+/// With `max_depth` 0 no path may scatter, the receiver included, so the irradiance is 0 (as
+/// the luminance of a Lambertian surface is then): direct illuminance alone is `max_depth` 1.
 pub fn irradiance(
     world: &World,
     at: &RayStart,
@@ -443,6 +446,11 @@ pub fn irradiance(
 ) -> SampledSpectrum {
     use std::f32::consts::{FRAC_1_PI, PI};
     let mut e = SampledSpectrum::ZERO;
+    if world.settings.max_depth == 0 {
+        // (Light sampling alone would also be wrong here: its MIS weight assumes the cosine
+        // strategy below, which a depth of 0 rules out.)
+        return e;
+    }
     let u_light = sampler.get1d();
     let u_prim = sampler.get1d();
     let u_pt = sampler.get2d();
@@ -464,7 +472,7 @@ pub fn irradiance(
             }
         }
     }
-    if world.settings.max_depth >= 1 {
+    {
         let local = crate::bxdf::sample_cosine_hemisphere(sampler.get2d());
         if local.z > 0.0 {
             let wi = Frame::from_normal(n).to_world(local);

@@ -355,3 +355,29 @@ fn distant_and_environment_amounts() {
     check(&m[1], PI * 3000.0, "environment, E on a slanted receiver");
     check(&m[2], 3000.0, "environment, luminance");
 }
+
+/// Illuminance 2 m below a one-sided disc of luminance L = 100 cd/m² and radius 0.5 m, on its
+/// axis: E = πL·R²/(R² + h²) (closed-forms.md §2.3). Direct illuminance is `max_depth` 1 (the
+/// receiver is the path's one scattering event); at `max_depth` 0 nothing may scatter and the
+/// meter reads 0. (Before, depth 0 kept light sampling with its MIS weight but dropped the
+/// cosine-sampled half, and read 3 % low.)
+#[test]
+fn direct_illuminance_is_max_depth_one() {
+    let (l, r, h) = (100.0, 0.5, 2.0);
+    let expected = PI * l * r * r / (r * r + h * h);
+    let scene = |depth: u32| {
+        world(&format!(
+            r#"(
+            camera: (position: (0, -50, 0), look_at: (0, 0, 0), up: (0, 0, 1), vfov_deg: 1, resolution: (1, 1)),
+            render: (spp: 1, max_depth: {depth}),
+            objects: [(shape: Disk(center: (0, 0, 0), normal: (0, 0, -1), radius: {r}), material: "black",
+                       emission: (spectrum: Named("D65"), amount: Luminance({l})))],
+            meters: [Illuminance(name: "below", position: (0, 0, -{h}), normal: (0, 0, 1))],
+            measure: (samples: 65536),
+        )"#
+        ))
+    };
+    check(&measure_all(&scene(1)).meters[0], expected, "depth 1");
+    let e0 = measure_all(&scene(0)).meters[0];
+    assert_eq!((e0.mean, e0.stderr), (0.0, 0.0), "depth 0");
+}
