@@ -129,13 +129,13 @@ struct RenderOpts {
     /// With --target-error: pixels darker than this luminance (cd/m²) need not meet it (default: 0.1 % of the image's mean luminance).
     #[arg(long)]
     target_floor: Option<f64>,
-    /// Upper bound of samples per pixel (default: the scene's spp, or 65536 with --target-error).
+    /// Upper bound of samples per pixel (default: --spp if given, else the scene's spp, or 65536 with --target-error; with --target-error it counts the decision buffer's samples too).
     #[arg(long)]
     max_spp: Option<u32>,
     /// Stop after this long (e.g. `90s`, `10m`, `2h`), at the end of the pass in progress.
     #[arg(long, value_parser = humantime::parse_duration)]
     max_time: Option<std::time::Duration>,
-    /// Write a checkpoint (NAME.state and NAME.exr) this often (e.g. `60s`; `0s` disables).
+    /// Write a checkpoint (NAME.state, NAME.exr and NAME.png) this often (e.g. `60s`; `0s` disables).
     #[arg(long, value_parser = humantime::parse_duration, default_value = "60s")]
     checkpoint_interval: std::time::Duration,
     /// Continue from NAME.state (refused if the scene or its settings changed).
@@ -230,15 +230,6 @@ fn check_exposure(exposure: Option<f64>) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Whether `a` and `b` name the same existing file (after resolving links and `..`); paths
-/// that do not both exist are compared as given.
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => a == b,
-    }
 }
 
 /// Where to write: (`stem`, `stem.exr`, `stem.png`).
@@ -723,7 +714,7 @@ fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()
         }
     }
     for output in [&exr_path, &png_path, &state_path] {
-        if let Some(input) = states.iter().find(|s| same_file(output, s)) {
+        if let Some(input) = states.iter().find(|s| output::same_file(output, s)) {
             bail!(
                 "-o {}: refusing to overwrite the input state file {} with the merged {}; choose another output name",
                 out.display(),

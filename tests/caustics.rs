@@ -115,6 +115,8 @@ const SPHERE_SCENE: &str = r#"(
 
 #[test]
 fn light_traced_caustic_agrees_with_path_traced_caustic() {
+    // The sample counts below (and the per-sample error comparison) rely on this text.
+    assert!(SPHERE_SCENE.contains("spp: 256"));
     // Path tracing finds the caustic only through the sphere by chance: it gets 8× the
     // samples, so that the comparison's σ is below 2 % of the caustic (measured 1.4 %).
     let (spp_lt, spp_pt) = (1024.0f64, 8192.0f64);

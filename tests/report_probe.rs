@@ -156,6 +156,25 @@ fn one_illuminance_sample_has_an_unknown_interval() {
         IlluminanceProbe::Defined { estimate, .. } => assert_eq!(estimate.stderr, None),
         ref other => panic!("{other:?}"),
     }
+    // An adaptive render's mean spp can be high while a pixel stopped with one E sample: its
+    // stderr.E is 0 with only some samples on a surface, which is taken as unknown too.
+    let mut adaptive = layers.clone();
+    adaptive.attributes.retain(|(n, _)| n != "spp");
+    adaptive.attributes.push(("spp".into(), "400.00".into()));
+    for (name, v) in adaptive.channels.iter_mut() {
+        match name.as_str() {
+            CHANNEL_E_MASK => v[3 * W + 4] = 0.5,
+            CHANNEL_E_STDERR => v[3 * W + 4] = 0.0,
+            _ => {}
+        }
+    }
+    match probe(&adaptive, 4, 3, None, UnitSystem::Si)
+        .unwrap()
+        .illuminance
+    {
+        IlluminanceProbe::Defined { estimate, .. } => assert_eq!(estimate.stderr, None),
+        ref other => panic!("{other:?}"),
+    }
     // Its neighbour, with all 4 samples on a surface, keeps its interval.
     match probe(&layers, 5, 3, None, UnitSystem::Si)
         .unwrap()

@@ -461,7 +461,7 @@ fn mrays(rays: usize, seconds: f64) -> f64 {
 pub const MAX_RESOLUTION: u32 = 8192;
 
 pub fn run(args: &TraversalArgs) -> Result<()> {
-    if args.threads.is_empty() || args.threads.contains(&0) {
+    if args.threads.is_empty() {
         bail!("--threads needs thread counts of at least 1, e.g. 1,2");
     }
     for &n in &args.threads {
@@ -477,7 +477,7 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
     }
     super::check_positive("--reps", args.reps as u64)?;
     super::check_positive("--build-reps", args.build_reps as u64)?;
-    let reps = args.reps.max(1);
+    let reps = args.reps;
     let (file, source) = match &args.rays {
         Some(path) => {
             let t0 = Instant::now();

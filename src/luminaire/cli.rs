@@ -41,22 +41,13 @@ pub fn default_diagram_path(file: &Path) -> PathBuf {
     PathBuf::from(format!("{stem}-polar.png"))
 }
 
-/// Whether `a` and `b` name the same existing file (after resolving links and `..`); paths
-/// that do not both exist are compared as given.
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => a == b,
-    }
-}
-
 /// Run the command: returns the report text; writes the diagram (refused if the diagram path
 /// is the input file).
 pub fn run(file: &Path, diagram: Option<&Path>) -> anyhow::Result<String> {
     let path = diagram
         .map(Path::to_path_buf)
         .unwrap_or_else(|| default_diagram_path(file));
-    if same_file(&path, file) {
+    if crate::output::same_file(&path, file) {
         anyhow::bail!(
             "--diagram {}: refusing to overwrite the input photometric file {} with the PNG diagram; choose another --diagram path",
             path.display(),

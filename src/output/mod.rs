@@ -137,10 +137,23 @@ fn in_flight() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
 
 /// Deletes the temporary files of the atomic writes in progress. For a process about to end
 /// without unwinding (`std::process::exit`, e.g. on a second Ctrl-C): their targets are left
-/// as they were, and no temporary file is left beside them.
+/// as they were, and no temporary file is left beside them. The registry stays locked, so
+/// that no other thread can start (or finish) an atomic write before the exit: such a write
+/// waits for a lock that is never released.
 pub fn remove_temporary_files() {
-    for path in in_flight().drain(..) {
+    let mut files = in_flight();
+    for path in files.drain(..) {
         let _ = fs::remove_file(path);
+    }
+    std::mem::forget(files);
+}
+
+/// Whether `a` and `b` name the same existing file (after resolving links and `..`); paths
+/// that do not both exist are compared as given.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
     }
 }
 
@@ -151,8 +164,8 @@ struct TempGuard {
 }
 
 impl TempGuard {
+    /// Takes charge of `path`, which [`create_temp_beside`] registered before creating it.
     fn new(path: PathBuf) -> Self {
-        in_flight().push(path.clone());
         TempGuard { path: Some(path) }
     }
 
@@ -197,10 +210,17 @@ fn create_temp_beside(target: &Path) -> Result<(PathBuf, File), OutputError> {
         name.push(file_name);
         name.push(format!(".{}.{n}.{nanos:08x}.tmp", std::process::id()));
         let temp = dir.join(name);
+        // Registered before it exists, so that a forced exit in between still deletes it.
+        in_flight().push(temp.clone());
         match OpenOptions::new().write(true).create_new(true).open(&temp) {
             Ok(file) => return Ok((temp, file)),
-            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(io_err(e)),
+            Err(e) => {
+                in_flight().retain(|p| *p != temp);
+                if e.kind() == io::ErrorKind::AlreadyExists {
+                    continue;
+                }
+                return Err(io_err(e));
+            }
         }
     }
     Err(io_err(io::Error::new(

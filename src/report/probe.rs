@@ -225,10 +225,16 @@ pub fn probe(
             let mask_mean = mask.map(|m| mean_of(m, &idx));
             // A pixel's illuminance samples are its samples that saw a receiving surface,
             // mask.E × spp of them: with fewer than 2 its E has no sample variance either.
-            let too_few_e = match (spp, mask) {
-                (Some(spp), Some(m)) => defined.iter().any(|&i| m[i] as f64 * spp < 1.5),
-                _ => false,
-            };
+            // In an adaptive render pixels stop at different counts, so the mean spp can hide
+            // a pixel with 0 or 1 illuminance samples; its stderr.E is then 0 while only some
+            // of its samples saw a surface (0 < mask < 1), which a real estimate with a
+            // sample variance practically never gives.
+            let e_se = layers.channel(CHANNEL_E_STDERR);
+            let too_few_e = defined.iter().any(|&i| {
+                let m = mask.map_or(1.0, |m| m[i]);
+                spp.is_some_and(|spp| m as f64 * spp < 1.5)
+                    || (e_se.is_some_and(|se| se[i] == 0.0) && m > 0.0 && m < 1.0)
+            });
             if defined.is_empty() {
                 IlluminanceProbe::Undefined { mask_mean }
             } else {

@@ -306,12 +306,17 @@ fn mesh_err(ctx: &Ctx, field: &str, rel: &str, e: geometry::GeometryError) -> Sc
         geometry::GeometryError::Io { path, source } => ctx.err(
             field,
             format!(
-                "cannot read mesh file '{}': {source}. Check that the path is correct ({rel:?} is resolved against the scene file's directory{}) and that the file is readable.",
+                "cannot read mesh file '{}': {source}. Check that the path is correct{} and that the file is readable.",
                 path.display(),
-                if ctx.dir.as_os_str().is_empty() {
+                if !Path::new(rel).is_relative() {
                     String::new()
+                } else if ctx.dir.as_os_str().is_empty() {
+                    format!(" ({rel:?} is resolved against the scene file's directory)")
                 } else {
-                    format!(", {}", ctx.dir.display())
+                    format!(
+                        " ({rel:?} is resolved against the scene file's directory, {})",
+                        ctx.dir.display()
+                    )
                 }
             ),
         ),
@@ -849,7 +854,7 @@ fn build_meters(
             return Err(ctx.err(
                 format!("{field}.name"),
                 format!(
-                    "grids[{j}] {other:?} and grids[{i}] {:?} would both be written to {} (and .png): grid names must still differ when every character other than a letter or digit becomes '-' and letters are lower-cased",
+                    "grids[{j}] {other:?} and grids[{i}] {:?} would both be written to {} (and .png): grid names must still differ when letters are lower-cased, every character other than an ASCII letter or digit becomes '-', leading and trailing '-' are dropped, and an empty result becomes \"grid\"",
                     g.name,
                     file.display()
                 ),
