@@ -170,12 +170,7 @@ fn white_furnace_rough_conductor_shows_its_directional_albedo() {
     }
     let film = render(&w, 2);
     let expected_ray = |o: Vec3, d: Vec3| -> f64 {
-        let (o, d) = (o.as_dvec3(), d.as_dvec3().normalize());
-        let b2 = o.cross(d).length_squared();
-        if o.dot(d) >= 0.0 || b2 >= 1.0 {
-            return 1.0;
-        }
-        interp((1.0 - b2).sqrt().acos().to_degrees())
+        unit_sphere_cos(o, d).map_or(1.0, |c| interp(c.acos().to_degrees()))
     };
     let (mean, se) = image_mean(&film);
     let e_mean = (0..film.height)
@@ -240,12 +235,10 @@ fn glass_sphere_truncated_furnace() {
         ));
         let film = render(&w, 2);
         let expected_ray = |o: Vec3, d: Vec3| -> f64 {
-            let (o, d) = (o.as_dvec3(), d.as_dvec3().normalize());
-            let b2 = o.cross(d).length_squared();
-            if o.dot(d) >= 0.0 || b2 >= 1.0 {
+            let Some(cos) = unit_sphere_cos(o, d) else {
                 return 1.0;
-            }
-            let r = fresnel_unpolarised((1.0 - b2).sqrt(), 1.5);
+            };
+            let r = fresnel_unpolarised(cos, 1.5);
             let t = 1.0 - r;
             r + (0..depth as i32 - 1)
                 .map(|j| t * t * r.powi(j))
@@ -395,4 +388,12 @@ fn rough_materials_under_an_area_light_match_quadrature() {
         );
         assert!(se < 0.02 * expected);
     }
+}
+
+/// The cosine of incidence where the ray (o, d) enters the unit sphere at the origin, or `None`
+/// if it misses it (it then sees the environment).
+fn unit_sphere_cos(o: Vec3, d: Vec3) -> Option<f64> {
+    let (o, d) = (o.as_dvec3(), d.as_dvec3().normalize());
+    let b2 = o.cross(d).length_squared();
+    (o.dot(d) < 0.0 && b2 < 1.0).then(|| (1.0 - b2).sqrt())
 }
