@@ -66,6 +66,16 @@ fn mb(bytes: Option<u64>) -> String {
     bytes.map_or("n/a".into(), |b| format!("{:.0}", b as f64 / 1e6))
 }
 
+/// A CPU-time based figure for the tables: "n/a" where the run was too short for the CPU
+/// clock (0 ns, so the figure is 0 or infinite).
+fn cell(x: f64, decimals: usize) -> String {
+    if x.is_finite() && x > 0.0 {
+        format!("{x:.decimals$}")
+    } else {
+        "n/a".into()
+    }
+}
+
 /// CPU time of the whole process (all threads, user + system) in seconds, from /proc/self/stat
 /// (Linux; 10 ms resolution), if known.
 pub fn process_cpu_seconds() -> Option<f64> {
@@ -194,16 +204,16 @@ pub fn run(args: &ScalingArgs) -> Result<()> {
         let c = render_cost(&world, args.threads, reps)?;
         let mem = memory_status();
         println!(
-            "| {} | {:.3} | {:.1} | {} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.3} | {:.3} | {:.2} |",
+            "| {} | {:.3} | {:.1} | {} | {} | {} | {} | {:.0} | {} | {:.3} | {:.3} | {:.2} |",
             n_tris,
             build_s,
             bytes_per_tri,
             mb(mem.map(|m| m.0)),
             mb(mem.map(|m| m.1)),
-            primary,
-            diffuse,
+            cell(primary, 2),
+            cell(diffuse, 2),
             c.wall_ns,
-            c.cpu_ns,
+            cell(c.cpu_ns, 0),
             1e3 / c.wall_ns,
             1e3 / c.wall_ns * c.rays_per_sample,
             c.rays_per_sample,
@@ -238,11 +248,11 @@ pub fn run(args: &ScalingArgs) -> Result<()> {
             .map_or(f64::NAN, |r| r.2.cpu_ns);
         for (res, spp, c) in rows {
             println!(
-                "| {res}×{res} | {spp} | {} | {:.0} | {:.0} | {:.2} |",
+                "| {res}×{res} | {spp} | {} | {:.0} | {} | {} |",
                 c.samples,
                 c.wall_ns,
-                c.cpu_ns,
-                c.cpu_ns / base
+                cell(c.cpu_ns, 0),
+                cell(c.cpu_ns / base, 2)
             );
         }
     }

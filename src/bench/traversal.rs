@@ -457,6 +457,16 @@ fn mrays(rays: usize, seconds: f64) -> f64 {
     rays as f64 / seconds / 1e6
 }
 
+/// A rate or ratio for the tables: "n/a" where a time was too short for the clock (0 s, so
+/// the value is infinite or 0).
+fn cell(x: f64) -> String {
+    if x.is_finite() && x > 0.0 {
+        format!("{x:.2}")
+    } else {
+        "n/a".into()
+    }
+}
+
 /// Largest `--resolution` of `bench traversal` (its batches hold RES² rays each).
 pub const MAX_RESOLUTION: u32 = 8192;
 
@@ -603,18 +613,18 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
             for (k, &threads) in args.threads.iter().enumerate() {
                 let c = median(&mut candela_t[b][k].iter().map(metric).collect::<Vec<_>>());
                 let mut row = format!(
-                    "| {} | {} | {} | {threads} | {:.2} |",
+                    "| {} | {} | {} | {threads} | {} |",
                     batch.name,
                     match batch.kind {
                         RayKind::Closest => "closest hit",
                         RayKind::Occluded => "any hit",
                     },
                     batch.rays.len(),
-                    mrays(batch.rays.len(), c)
+                    cell(mrays(batch.rays.len(), c))
                 );
                 for times in &embree_t[b][k] {
                     let s = median(&mut times.iter().map(metric).collect::<Vec<_>>());
-                    row += &format!(" {:.2} | {:.2} |", mrays(batch.rays.len(), s), c / s);
+                    row += &format!(" {} | {} |", cell(mrays(batch.rays.len(), s)), cell(c / s));
                 }
                 println!("{row}");
             }
@@ -640,13 +650,13 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
                         .collect::<Vec<_>>(),
                 );
                 let mut row = format!(
-                    "| {} | {threads} | {:.2} |",
+                    "| {} | {threads} | {} |",
                     batch.name,
-                    mrays(batch.rays.len(), c)
+                    cell(mrays(batch.rays.len(), c))
                 );
                 for times in &embree_t[b][k] {
                     let s = median(&mut times.iter().map(|t| t.cpu).collect::<Vec<_>>());
-                    row += &format!(" {:.2} |", c / s);
+                    row += &format!(" {} |", cell(c / s));
                 }
                 println!("{row}");
             }
