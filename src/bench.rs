@@ -79,6 +79,31 @@ pub fn check_triangles(flag: &str, n: usize) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Largest `--resolution` of the generated benchmarks (`bench traversal` holds RES² rays per
+/// batch).
+pub const MAX_RESOLUTION: u32 = 8192;
+
+/// Refuses a `--resolution` of 0 or above [`MAX_RESOLUTION`].
+pub fn check_resolution(res: u32) -> anyhow::Result<()> {
+    check_positive("--resolution", res.into())?;
+    if res > MAX_RESOLUTION {
+        anyhow::bail!(
+            "--resolution {res} is too large: at most {MAX_RESOLUTION} ({MAX_RESOLUTION}² primary rays per batch)"
+        );
+    }
+    Ok(())
+}
+
+/// A figure for the benchmark tables with `decimals` decimals, or "n/a" where a run was too
+/// short for the clock (0 s or 0 ns, so the figure is 0 or infinite).
+pub fn cell(x: f64, decimals: usize) -> String {
+    if x.is_finite() && x > 0.0 {
+        format!("{x:.decimals$}")
+    } else {
+        "n/a".into()
+    }
+}
+
 /// Refuses 0 for a count option (`flag`) that needs at least 1.
 pub fn check_positive(flag: &str, n: u64) -> anyhow::Result<()> {
     if n == 0 {

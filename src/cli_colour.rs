@@ -138,9 +138,9 @@ fn observer_name(o: Observer) -> &'static str {
 pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow::Result<String> {
     let src = resolve(source)?;
     let s = &src.table;
-    if s.iter().all(|&v| v == 0.0) {
+    if !s.iter().all(|v| v.is_finite()) {
         bail!(
-            "{}: the spectrum is zero everywhere in {START_NM}–{END_NM} nm",
+            "{}: its values overflow 64-bit floats (not finite)",
             src.description
         );
     }
@@ -149,9 +149,9 @@ pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow:
     // 1e305s or 1e-315s) then neither overflow nor lose precision in subnormals. A reflectance
     // keeps its scale (it is meaningful).
     let peak = s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if !peak.is_finite() {
+    if peak == 0.0 {
         bail!(
-            "{}: its values overflow 64-bit floats (not finite)",
+            "{}: the spectrum is zero everywhere in {START_NM}–{END_NM} nm",
             src.description
         );
     }

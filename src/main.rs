@@ -232,25 +232,38 @@ fn check_exposure(exposure: Option<f64>) -> Result<()> {
     Ok(())
 }
 
-/// Where to write: (`stem`, `stem.exr`, `stem.png`).
+/// Where to write: (`stem`, `stem.exr`, `stem.png`), the stem named after the scene.
 fn output_paths(scene: &Path, out: Option<&Path>) -> (PathBuf, PathBuf, PathBuf) {
     let name = scene
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "render".into());
-    let stem = match out {
-        None => PathBuf::from(&name),
-        Some(p) if p.is_dir() || p.as_os_str().to_string_lossy().ends_with('/') => p.join(&name),
+    let stem = output_stem(out, &name, &["exr", "png"]);
+    let (exr, png) = (with_suffix(&stem, ".exr"), with_suffix(&stem, ".png"));
+    (stem, exr, png)
+}
+
+/// The output stem of `--out` / `-o`: `name` if none is given; `DIR/name` for an existing
+/// directory (or a path ending in `/`); otherwise the path, with one of `extensions` removed.
+fn output_stem(out: Option<&Path>, name: &str, extensions: &[&str]) -> PathBuf {
+    match out {
+        None => PathBuf::from(name),
+        Some(p) if p.is_dir() || p.as_os_str().to_string_lossy().ends_with('/') => p.join(name),
         Some(p) => match p.extension().and_then(|e| e.to_str()) {
-            Some("exr") | Some("png") => p.with_extension(""),
+            Some(e) if extensions.contains(&e) => p.with_extension(""),
             _ => p.to_path_buf(),
         },
-    };
-    let mut exr = stem.clone().into_os_string();
-    exr.push(".exr");
-    let mut png = stem.clone().into_os_string();
-    png.push(".png");
-    (stem, exr.into(), png.into())
+    }
+}
+
+/// Refuses outputs at `stem` whose directory does not exist.
+fn check_output_dir(stem: &Path) -> Result<()> {
+    if let Some(dir) = stem.parent() {
+        if !dir.as_os_str().is_empty() && !dir.is_dir() {
+            bail!("output directory {} does not exist", dir.display());
+        }
+    }
+    Ok(())
 }
 
 /// `1%`, `0.5 %` or `0.01` → 0.01.
@@ -327,11 +340,7 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
         .with_context(|| format!("cannot read scene file {}", scene_path.display()))?;
     let hash = candela::state::scene_hash(&scene_bytes, &world);
     let (stem, exr_path, png_path) = output_paths(scene_path, out);
-    if let Some(dir) = exr_path.parent() {
-        if !dir.as_os_str().is_empty() && !dir.is_dir() {
-            bail!("output directory {} does not exist", dir.display());
-        }
-    }
+    check_output_dir(&stem)?;
     let state_path = with_suffix(&stem, ".state");
     let (w, h) = (world.camera.width, world.camera.height);
     let target = a.target_error.map(|relative| candela::render::TargetError {
@@ -685,34 +694,14 @@ fn write_png(film: &candela::film::Film, png_path: &Path, exposure: Option<f64>)
     Ok(())
 }
 
-/// The output stem of `merge -o OUT`: like `render --out`, an existing directory (or a path
-/// ending in `/`) is the output directory, and the files are named `merged.*` there; otherwise
-/// OUT, with a `.exr`, `.png` or `.state` extension removed.
-fn merge_stem(out: &Path) -> PathBuf {
-    if out.is_dir() || out.as_os_str().to_string_lossy().ends_with('/') {
-        return out.join("merged");
-    }
-    match out.extension().and_then(|e| e.to_str()) {
-        Some("exr") | Some("png") | Some("state") => out.with_extension(""),
-        _ => out.to_path_buf(),
-    }
-}
-
 fn cmd_merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()> {
     check_exposure(exposure)?;
-    let stem = merge_stem(out);
+    // Like `render --out`, a directory gets files named `merged.*`.
+    let stem = output_stem(Some(out), "merged", &["exr", "png", "state"]);
     let exr_path = with_suffix(&stem, ".exr");
     let png_path = with_suffix(&stem, ".png");
     let state_path = with_suffix(&stem, ".state");
-    if let Some(dir) = exr_path.parent() {
-        if !dir.as_os_str().is_empty() && !dir.is_dir() {
-            bail!(
-                "-o {}: output directory {} does not exist",
-                out.display(),
-                dir.display()
-            );
-        }
-    }
+    check_output_dir(&stem).with_context(|| format!("-o {}", out.display()))?;
     for output in [&exr_path, &png_path, &state_path] {
         if let Some(input) = states.iter().find(|s| output::same_file(output, s)) {
             bail!(

@@ -274,22 +274,7 @@ fn render_exposure_out_of_range_is_refused() {
 fn two_states() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("scene.ron"), GOOD).unwrap();
-    for (name, seed) in [("a", "1"), ("b", "2")] {
-        let (code, stderr) = candela_in(
-            dir.path(),
-            &[
-                "render",
-                "--quiet",
-                "--save-state",
-                "--seed",
-                seed,
-                "--out",
-                name,
-                "scene.ron",
-            ],
-        );
-        assert_eq!(code, 0, "{stderr}");
-    }
+    common::render_states(dir.path(), "scene.ron", &[("a", "1"), ("b", "2")]);
     dir
 }
 

@@ -1,6 +1,7 @@
 //! `candela render` killed mid-way (SIGINT) writes a checkpoint; `--resume` finishes it to the
 //! same image as an uninterrupted render; a changed scene is refused; `merge` combines seeds.
 
+mod common;
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
@@ -175,22 +176,7 @@ fn merge_combines_two_seeds() {
         SCENE.replace("spp: 512", "spp: 8"),
     )
     .unwrap();
-    for seed in ["1", "2"] {
-        let o = candela(
-            dir.path(),
-            &[
-                "render",
-                "--quiet",
-                "--save-state",
-                "--seed",
-                seed,
-                "--out",
-                &format!("r{seed}"),
-                "s.ron",
-            ],
-        );
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    }
+    common::render_states(dir.path(), "s.ron", &[("r1", "1"), ("r2", "2")]);
     let o = candela(dir.path(), &["merge", "r1.state", "r2.state", "-o", "m"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let (a, b, m) = (

@@ -66,16 +66,6 @@ fn mb(bytes: Option<u64>) -> String {
     bytes.map_or("n/a".into(), |b| format!("{:.0}", b as f64 / 1e6))
 }
 
-/// A CPU-time based figure for the tables: "n/a" where the run was too short for the CPU
-/// clock (0 ns, so the figure is 0 or infinite).
-fn cell(x: f64, decimals: usize) -> String {
-    if x.is_finite() && x > 0.0 {
-        format!("{x:.decimals$}")
-    } else {
-        "n/a".into()
-    }
-}
-
 /// CPU time of the whole process (all threads, user + system) in seconds, from /proc/self/stat
 /// (Linux; 10 ms resolution), if known.
 pub fn process_cpu_seconds() -> Option<f64> {
@@ -139,14 +129,7 @@ pub fn run(args: &ScalingArgs) -> Result<()> {
     }
     super::check_triangles("--linearity-triangles", args.linearity_triangles)?;
     super::check_positive("--spp", args.spp.into())?;
-    super::check_positive("--resolution", args.resolution.into())?;
-    let max_res = super::traversal::MAX_RESOLUTION;
-    if args.resolution > max_res {
-        anyhow::bail!(
-            "--resolution {} is too large: at most {max_res}",
-            args.resolution
-        );
-    }
+    super::check_resolution(args.resolution)?;
     super::check_positive("--reps", args.reps as u64)?;
     let overrides = Overrides {
         spp: Some(args.spp),
@@ -210,10 +193,10 @@ pub fn run(args: &ScalingArgs) -> Result<()> {
             bytes_per_tri,
             mb(mem.map(|m| m.0)),
             mb(mem.map(|m| m.1)),
-            cell(primary, 2),
-            cell(diffuse, 2),
+            super::cell(primary, 2),
+            super::cell(diffuse, 2),
             c.wall_ns,
-            cell(c.cpu_ns, 0),
+            super::cell(c.cpu_ns, 0),
             1e3 / c.wall_ns,
             1e3 / c.wall_ns * c.rays_per_sample,
             c.rays_per_sample,
@@ -251,8 +234,8 @@ pub fn run(args: &ScalingArgs) -> Result<()> {
                 "| {res}×{res} | {spp} | {} | {:.0} | {} | {} |",
                 c.samples,
                 c.wall_ns,
-                cell(c.cpu_ns, 0),
-                cell(c.cpu_ns / base, 2)
+                super::cell(c.cpu_ns, 0),
+                super::cell(c.cpu_ns / base, 2)
             );
         }
     }

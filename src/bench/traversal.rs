@@ -457,19 +457,6 @@ fn mrays(rays: usize, seconds: f64) -> f64 {
     rays as f64 / seconds / 1e6
 }
 
-/// A rate or ratio for the tables: "n/a" where a time was too short for the clock (0 s, so
-/// the value is infinite or 0).
-fn cell(x: f64) -> String {
-    if x.is_finite() && x > 0.0 {
-        format!("{x:.2}")
-    } else {
-        "n/a".into()
-    }
-}
-
-/// Largest `--resolution` of `bench traversal` (its batches hold RES² rays each).
-pub const MAX_RESOLUTION: u32 = 8192;
-
 pub fn run(args: &TraversalArgs) -> Result<()> {
     if args.threads.is_empty() {
         bail!("--threads needs thread counts of at least 1, e.g. 1,2");
@@ -478,13 +465,7 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
         super::check_threads("--threads", n)?;
     }
     super::check_triangles("--triangles", args.triangles)?;
-    super::check_positive("--resolution", args.resolution.into())?;
-    if args.resolution > MAX_RESOLUTION {
-        bail!(
-            "--resolution {} is too large: at most {MAX_RESOLUTION} ({MAX_RESOLUTION}² primary rays per batch)",
-            args.resolution
-        );
-    }
+    super::check_resolution(args.resolution)?;
     super::check_positive("--reps", args.reps as u64)?;
     super::check_positive("--build-reps", args.build_reps as u64)?;
     let reps = args.reps;
@@ -620,11 +601,15 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
                         RayKind::Occluded => "any hit",
                     },
                     batch.rays.len(),
-                    cell(mrays(batch.rays.len(), c))
+                    super::cell(mrays(batch.rays.len(), c), 2)
                 );
                 for times in &embree_t[b][k] {
                     let s = median(&mut times.iter().map(metric).collect::<Vec<_>>());
-                    row += &format!(" {} | {} |", cell(mrays(batch.rays.len(), s)), cell(c / s));
+                    row += &format!(
+                        " {} | {} |",
+                        super::cell(mrays(batch.rays.len(), s), 2),
+                        super::cell(c / s, 2)
+                    );
                 }
                 println!("{row}");
             }
@@ -652,11 +637,11 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
                 let mut row = format!(
                     "| {} | {threads} | {} |",
                     batch.name,
-                    cell(mrays(batch.rays.len(), c))
+                    super::cell(mrays(batch.rays.len(), c), 2)
                 );
                 for times in &embree_t[b][k] {
                     let s = median(&mut times.iter().map(|t| t.cpu).collect::<Vec<_>>());
-                    row += &format!(" {} |", cell(c / s));
+                    row += &format!(" {} |", super::cell(c / s, 2));
                 }
                 println!("{row}");
             }

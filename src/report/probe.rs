@@ -199,11 +199,13 @@ pub fn probe(
         .attribute("spp")
         .and_then(|v| v.trim().parse::<f64>().ok());
     let too_few_samples = spp.is_some_and(|spp| spp < 2.0);
-    let error_channel = |name: &str| layers.channel(name).filter(|_| !too_few_samples);
     let lq = Quantity::Luminance;
     let luminance = Estimate {
         mean: units.from_si(lq, mean_of(lum, &idx)),
-        stderr: error_channel(CHANNEL_Y_STDERR).map(|c| units.from_si(lq, se_of(c, &idx))),
+        stderr: layers
+            .channel(CHANNEL_Y_STDERR)
+            .filter(|_| !too_few_samples)
+            .map(|c| units.from_si(lq, se_of(c, &idx))),
     };
 
     let eq = Quantity::Illuminance;
@@ -241,8 +243,8 @@ pub fn probe(
                 IlluminanceProbe::Defined {
                     estimate: Estimate {
                         mean: units.from_si(eq, mean_of(e, &defined)),
-                        stderr: error_channel(CHANNEL_E_STDERR)
-                            .filter(|_| !too_few_e)
+                        stderr: e_se
+                            .filter(|_| !too_few_samples && !too_few_e)
                             .map(|c| units.from_si(eq, se_of(c, &defined))),
                     },
                     pixels: defined.len(),

@@ -193,3 +193,22 @@ pub fn cli(args: &[&str], dir: &Path) -> (i32, String, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// Renders the scene file `scene` (in `dir`) once per (name, seed) with `--save-state`, writing
+/// NAME.exr, NAME.png and NAME.state there; panics if a render fails.
+pub fn render_states(dir: &Path, scene: &str, runs: &[(&str, &str)]) {
+    for (name, seed) in runs {
+        let args = [
+            "render",
+            "--quiet",
+            "--save-state",
+            "--seed",
+            seed,
+            "--out",
+            name,
+            scene,
+        ];
+        let (code, _, stderr) = cli(&args, dir);
+        assert_eq!(code, 0, "{stderr}");
+    }
+}
