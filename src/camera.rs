@@ -253,7 +253,7 @@ impl Camera {
         if self.lens_radius <= 0.0 {
             return self.position;
         }
-        let d = concentric_disk(u_lens) * self.lens_radius;
+        let d = crate::sampling::concentric_disk(u_lens) * self.lens_radius;
         self.position + d.x * self.right + d.y * self.up
     }
 
@@ -296,23 +296,6 @@ impl Camera {
             importance: 1.0 / (a_pix * dist * dist * cos * cos * cos),
         })
     }
-}
-
-/// Shirley–Chiu concentric map from [0,1)² to the unit disk.
-pub fn concentric_disk(u: Vec2) -> Vec2 {
-    let o = 2.0 * u - Vec2::ONE;
-    if o.x == 0.0 && o.y == 0.0 {
-        return Vec2::ZERO;
-    }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, std::f32::consts::FRAC_PI_4 * (o.y / o.x))
-    } else {
-        (
-            o.y,
-            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (o.x / o.y),
-        )
-    };
-    r * Vec2::new(theta.cos(), theta.sin())
 }
 
 #[cfg(test)]

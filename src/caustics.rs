@@ -51,8 +51,9 @@ use crate::geometry::SceneGeometry;
 use crate::integrator::{
     choose_pane_lobe, transmittance_counted, PaneLobe, RayStats, MAX_STRAIGHT_THROUGH,
 };
-use crate::light::{pick_from_cdf, Light};
-use crate::sampler::Sampler;
+use crate::light::Light;
+use crate::sampling::Sampler;
+use crate::sampling::{choose_by_weight, pick_from_cdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
 use glam::{Vec2, Vec3};
@@ -154,7 +155,7 @@ impl CausticLights {
         if chosen.is_empty() {
             return None;
         }
-        let cdf = crate::light::cdf_from_weights(&powers);
+        let cdf = crate::sampling::cdf_from_weights(&powers);
         let mut handled = vec![false; lights.len()];
         for &i in &chosen {
             handled[i as usize] = true;
@@ -192,7 +193,8 @@ impl CausticLights {
         );
         let (c, r) = self.targets[chosen];
         let (t, b) = dir.any_orthonormal_pair();
-        let (rad, phi) = (r * u.x.sqrt(), 2.0 * PI * u.y);
+        let (s, phi) = crate::sampling::uniform_disk_polar(u);
+        let rad = r * s;
         let p = c + rad * (phi.cos() * t + phi.sin() * b);
         let count = 1 + self
             .targets
@@ -246,7 +248,7 @@ impl CausticLights {
         }
         if total >= 4.0 * PI {
             return Some((
-                crate::light::sample_uniform_sphere(u),
+                crate::sampling::uniform_sphere(u),
                 (1.0 / (4.0 * PI)) as f32,
             ));
         }
@@ -254,10 +256,7 @@ impl CausticLights {
         let chosen = choose_by_weight(cones.iter().map(|c| 2.0 * PI * c.2), uc as f64 * total);
         let (axis, _, omc) = cones[chosen];
         // Uniform within the cone: 1 − cos θ uniform in [0, 1 − cos θmax].
-        let omc_t = u.x as f64 * omc;
-        let cos_t = 1.0 - omc_t;
-        let sin_t = (omc_t * (2.0 - omc_t)).max(0.0).sqrt();
-        let phi = 2.0 * PI * u.y as f64;
+        let (cos_t, sin_t, phi) = crate::sampling::uniform_cone(u.x as f64, u.y as f64, omc);
         let (t, b) = axis.any_orthonormal_pair();
         let dir = (sin_t * phi.cos() * t + sin_t * phi.sin() * b + cos_t * axis).normalize();
         // Inside cone k: the whole sphere, or on the axis' side within sin²θ ≤ sin²θmax.
@@ -279,18 +278,6 @@ impl CausticLights {
     pub fn handles(&self, light: usize) -> bool {
         self.handled.get(light).copied().unwrap_or(false)
     }
-}
-
-/// The index k whose interval [Σ_{j<k} w_j, Σ_{j≤k} w_j) contains `x` (the last on round-off).
-fn choose_by_weight(weights: impl ExactSizeIterator<Item = f64>, mut x: f64) -> usize {
-    let last = weights.len().saturating_sub(1);
-    for (k, w) in weights.enumerate() {
-        if x < w {
-            return k;
-        }
-        x -= w;
-    }
-    last
 }
 
 /// One camera connection of a light path: its film position and its contribution (absolute
@@ -619,7 +606,7 @@ pub fn trace_light_path(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::sample_uniform_sphere;
+    use crate::sampling::uniform_sphere;
 
     fn lights_with_targets(targets: Vec<(Vec3, f32)>) -> CausticLights {
         CausticLights {
@@ -653,7 +640,7 @@ mod tests {
         let (mut est, mut est2) = (0.0f64, 0.0f64);
         let mut rng = 0x1234_5678_u64;
         let mut u = || {
-            rng = crate::sampler::mix64(rng.wrapping_add(0x9e37_79b9_7f4a_7c15));
+            rng = crate::sampling::mix64(rng.wrapping_add(0x9e37_79b9_7f4a_7c15));
             (rng >> 40) as f32 / (1u64 << 24) as f32
         };
         for _ in 0..n {
@@ -671,7 +658,7 @@ mod tests {
             let mut inside_cells = 0usize;
             for i in 0..m {
                 for j in 0..m {
-                    let d = sample_uniform_sphere(Vec2::new(
+                    let d = uniform_sphere(Vec2::new(
                         (i as f32 + 0.5) / m as f32,
                         (j as f32 + 0.5) / m as f32,
                     ));

@@ -6,7 +6,7 @@
 
 use crate::bxdf::Frame;
 use crate::geometry::{offset_ray_origin, point_error_bound, shadow_ray_between, Hit};
-use crate::sampler::Sampler;
+use crate::sampling::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
 use glam::Vec3;
@@ -444,7 +444,7 @@ pub fn irradiance(
     sampler: &mut Sampler,
     stats: &mut RayStats,
 ) -> SampledSpectrum {
-    use std::f32::consts::{FRAC_1_PI, PI};
+    use std::f32::consts::PI;
     let mut e = SampledSpectrum::ZERO;
     if world.settings.max_depth == 0 {
         // (Light sampling alone would also be wrong here: its MIS weight assumes the cosine
@@ -465,7 +465,7 @@ pub fn irradiance(
                     let w = if ls.delta {
                         1.0
                     } else {
-                        power_heuristic(pdf, cos * FRAC_1_PI)
+                        power_heuristic(pdf, crate::sampling::cosine_hemisphere_pdf(cos))
                     };
                     e += tr * ls.li * (cos * w / pdf);
                 }
@@ -473,14 +473,14 @@ pub fn irradiance(
         }
     }
     {
-        let local = crate::bxdf::sample_cosine_hemisphere(sampler.get2d());
+        let local = crate::sampling::cosine_hemisphere(sampler.get2d());
         if local.z > 0.0 {
             let wi = Frame::from_normal(n).to_world(local);
             let origin = offset_ray_origin(at.p, at.error, at.ng, wi);
             stats.bounce_rays += 1;
             let start = PathStart {
                 specular: false,
-                pdf: local.z * FRAC_1_PI,
+                pdf: crate::sampling::cosine_hemisphere_pdf(local.z),
                 p: at.p,
                 depth: 1,
                 caustics_by_light_tracing,

@@ -22,7 +22,7 @@ pub mod output;
 pub mod photometry;
 pub mod render;
 pub mod report;
-pub mod sampler;
+pub mod sampling;
 pub mod scene;
 pub mod spectrum;
 pub mod state;

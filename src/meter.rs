@@ -6,7 +6,7 @@
 
 use crate::film::{radiance_to_xyz, standard_error};
 use crate::integrator::{irradiance, trace, PathStart, RayStart, RayStats};
-use crate::sampler::{mix64, Sampler};
+use crate::sampling::{mix64, Sampler};
 use crate::spectrum::SampledWavelengths;
 use crate::world::World;
 use glam::Vec3;

@@ -8,6 +8,7 @@
 
 use crate::colour::planck::{C1, C2};
 use crate::colour::tables::{photopic_v, scotopic_v, LEN};
+use crate::spectrum::DenseSpectrum;
 
 /// Maximum luminous efficacy for photopic vision, lm/W (CIE; colour-science
 /// `CONSTANT_K_M`).
@@ -376,6 +377,23 @@ pub fn convert(value: f64, from: &str, to: &str) -> Result<f64, UnitError> {
     Ok(v)
 }
 
+/// K_m ∫ S(λ) V(λ) dλ over 360–830 nm at 1 nm, computed by the colour library
+/// ([`luminance`]), i.e. the photometric amount one unit of the radiometric
+/// spectrum `s` carries (lm per W, cd per W·sr⁻¹, …).
+pub fn luminous_integral(s: &DenseSpectrum) -> f64 {
+    luminance(&s.to_f64_array())
+}
+
+/// Factor that scales spectrum `s` so that it carries `amount` photometric units:
+/// `amount / (K_m ∫ S V dλ)`. Errors if the spectrum has no visible content.
+pub fn photometric_scale(s: &DenseSpectrum, amount: f64) -> Result<f32, String> {
+    let k = luminous_integral(s);
+    if k.is_nan() || k <= 0.0 || !k.is_finite() {
+        return Err("the spectrum has no luminous content (K_m ∫ S V dλ = 0), so a photometric amount cannot be assigned to it".into());
+    }
+    Ok((amount / k) as f32)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -465,5 +483,14 @@ mod tests {
             convert(1.0, "cd", "lm"),
             Err(UnitError::Dimension { .. })
         ));
+    }
+
+    #[test]
+    fn photometric_scale_gives_the_amount() {
+        let s = DenseSpectrum::constant(1.0);
+        let k = photometric_scale(&s, 1000.0).unwrap();
+        let scaled = s.scaled(k);
+        assert!((luminous_integral(&scaled) - 1000.0).abs() < 1e-3);
+        assert!(photometric_scale(&DenseSpectrum::constant(0.0), 1.0).is_err());
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::film::{radiance_to_xyz, Film, PixelSums};
 use crate::integrator::{trace, PathStart, RayStats};
-use crate::sampler::Sampler;
+use crate::sampling::Sampler;
 use crate::spectrum::SampledWavelengths;
 use crate::world::World;
 use rayon::prelude::*;

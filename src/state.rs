@@ -7,7 +7,7 @@
 
 use crate::film::Film;
 use crate::output::write_atomic;
-use crate::sampler::mix64;
+use crate::sampling::mix64;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
 use std::path::Path;

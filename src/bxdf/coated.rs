@@ -16,7 +16,7 @@
 use super::conductor::{flip_up, sample_microfacet_reflection};
 use super::fresnel::{fr_dielectric, reflect};
 use super::microfacet::Microfacet;
-use super::{same_hemisphere, sample_cosine_hemisphere, BsdfSample};
+use super::{same_hemisphere, BsdfSample};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
@@ -229,7 +229,7 @@ impl Coated {
                 specular: false,
             });
         }
-        let mut wi = sample_cosine_hemisphere(u);
+        let mut wi = crate::sampling::cosine_hemisphere(u);
         if wo.z < 0.0 {
             wi.z = -wi.z;
         }

@@ -1,7 +1,7 @@
 //! Lambertian diffuse reflection: f = ρ(λ)/π, sampled with the cosine-weighted hemisphere.
 //! Two-sided: it reflects on whichever side `wo` is.
 
-use super::{same_hemisphere, sample_cosine_hemisphere, BsdfSample};
+use super::{same_hemisphere, BsdfSample};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
@@ -20,11 +20,11 @@ impl Diffuse {
         self.reflectance.sample(wl) * FRAC_1_PI
     }
     pub fn sample(&self, wo: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<BsdfSample> {
-        let mut wi = sample_cosine_hemisphere(u);
+        let mut wi = crate::sampling::cosine_hemisphere(u);
         if wo.z < 0.0 {
             wi.z = -wi.z;
         }
-        let pdf = wi.z.abs() * FRAC_1_PI;
+        let pdf = crate::sampling::cosine_hemisphere_pdf(wi.z.abs());
         if pdf <= 0.0 {
             return None;
         }
@@ -39,6 +39,6 @@ impl Diffuse {
         if !same_hemisphere(wo, wi) {
             return 0.0;
         }
-        wi.z.abs() * FRAC_1_PI
+        crate::sampling::cosine_hemisphere_pdf(wi.z.abs())
     }
 }

@@ -228,13 +228,6 @@ impl Frame {
     }
 }
 
-/// Cosine-weighted direction on the +z hemisphere (Malley's method); pdf = cos θ / π.
-pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = crate::camera::concentric_disk(u);
-    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
-    Vec3::new(d.x, d.y, z)
-}
-
 #[inline]
 pub fn same_hemisphere(a: Vec3, b: Vec3) -> bool {
     a.z * b.z > 0.0

@@ -4,7 +4,7 @@
 //! A = 1 − σ²/(2(σ² + 0.33)), B = 0.45 σ²/(σ² + 0.09), σ the facet slope deviation (radians).
 //! Sampled with the cosine-weighted hemisphere. Two-sided like [`super::Diffuse`].
 
-use super::{same_hemisphere, sample_cosine_hemisphere, BsdfSample};
+use super::{same_hemisphere, BsdfSample};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
@@ -53,11 +53,11 @@ impl OrenNayar {
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<BsdfSample> {
-        let mut wi = sample_cosine_hemisphere(u);
+        let mut wi = crate::sampling::cosine_hemisphere(u);
         if wo.z < 0.0 {
             wi.z = -wi.z;
         }
-        let pdf = wi.z.abs() * FRAC_1_PI;
+        let pdf = crate::sampling::cosine_hemisphere_pdf(wi.z.abs());
         if pdf <= 0.0 {
             return None;
         }
@@ -73,6 +73,6 @@ impl OrenNayar {
         if !same_hemisphere(wo, wi) {
             return 0.0;
         }
-        wi.z.abs() * FRAC_1_PI
+        crate::sampling::cosine_hemisphere_pdf(wi.z.abs())
     }
 }

@@ -5,7 +5,7 @@
 //! choosing the lobe in proportion to the mean k_d and k_s, then cosine-weighted or
 //! cosⁿ-around-the-mirror-direction. Two-sided.
 
-use super::{same_hemisphere, sample_cosine_hemisphere, BsdfSample, Frame};
+use super::{same_hemisphere, BsdfSample, Frame};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
@@ -78,7 +78,7 @@ impl Phong {
             let local = Vec3::new(sin_a * phi.cos(), sin_a * phi.sin(), cos_a);
             Frame::from_normal(Self::mirror(wo).normalize()).to_world(local)
         } else {
-            let mut wi = sample_cosine_hemisphere(u);
+            let mut wi = crate::sampling::cosine_hemisphere(u);
             if wo.z < 0.0 {
                 wi.z = -wi.z;
             }

@@ -487,24 +487,13 @@ impl Prim {
         let (u0, u1) = (u.x as f64, u.y as f64);
         match *self {
             Prim::Triangle([p0, p1, p2]) => {
-                // Heitz 2019, "A Low-Distortion Map Between Triangle and Square".
-                let (b0, b1) = if u0 < u1 {
-                    let b0 = u0 / 2.0;
-                    (b0, u1 - b0)
-                } else {
-                    let b1 = u1 / 2.0;
-                    (u0 - b1, b1)
-                };
-                let b2 = 1.0 - b0 - b1;
+                let (b0, b1, b2) = crate::sampling::uniform_triangle(u0, u1);
                 let p = b0 * p0.as_dvec3() + b1 * p1.as_dvec3() + b2 * p2.as_dvec3();
                 let p = p.as_vec3();
                 (p, self.normal_at(p))
             }
             Prim::Sphere { center, radius } => {
-                let z = 1.0 - 2.0 * u0;
-                let rr = (1.0 - z * z).max(0.0).sqrt();
-                let phi = std::f64::consts::TAU * u1;
-                let n = DVec3::new(rr * phi.cos(), rr * phi.sin(), z);
+                let n = crate::sampling::uniform_sphere_f64(u0, u1);
                 let p = center.as_dvec3() + n * radius as f64;
                 (p.as_vec3(), n.as_vec3())
             }
@@ -522,18 +511,7 @@ impl Prim {
                 normal,
                 radius,
             } => {
-                // Shirley–Chiu concentric mapping.
-                let (a, b) = (2.0 * u0 - 1.0, 2.0 * u1 - 1.0);
-                let (r, phi) = if a == 0.0 && b == 0.0 {
-                    (0.0, 0.0)
-                } else if a.abs() > b.abs() {
-                    (a, std::f64::consts::FRAC_PI_4 * (b / a))
-                } else {
-                    (
-                        b,
-                        std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (a / b),
-                    )
-                };
+                let (r, phi) = crate::sampling::concentric_disk_polar(u0, u1);
                 let n = normal.as_dvec3().normalize();
                 let (tu, tv) = basis(n);
                 let rad = radius as f64 * r;

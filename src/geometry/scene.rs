@@ -1196,7 +1196,7 @@ impl SceneGeometry {
                 let n = -(sin_alpha * phi.cos() * tx + sin_alpha * phi.sin() * ty + cos_alpha * wz);
                 let n = n.normalize();
                 let p = c + n * radius as f64;
-                let pdf = 1.0 / (std::f64::consts::TAU * one_minus_cos_max);
+                let pdf = crate::sampling::uniform_cone_pdf(one_minus_cos_max);
                 let pdf = pdf as f32;
                 if !(pdf.is_finite() && pdf > 0.0) {
                     return None;
@@ -1239,7 +1239,7 @@ impl SceneGeometry {
         let pr = self.prim(prim);
         if let Prim::Sphere { center, radius } = pr {
             if let Some((_, one_minus_cos_max)) = Self::sphere_cone(center, radius, reference) {
-                let pdf = (1.0 / (std::f64::consts::TAU * one_minus_cos_max)) as f32;
+                let pdf = crate::sampling::uniform_cone_pdf(one_minus_cos_max) as f32;
                 return if pdf.is_finite() { pdf } else { 0.0 };
             }
         }

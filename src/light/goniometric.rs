@@ -13,8 +13,8 @@
 //! table cell ([`crate::luminaire::Distribution::sample`]); the light sampler chooses between
 //! lights by their integrated lumens.
 
-use super::luminous_integral;
 use crate::luminaire::Distribution;
+use crate::photometry::luminous_integral;
 use crate::spectrum::DenseSpectrum;
 use glam::{Mat3, Vec2, Vec3};
 use std::sync::Arc;
@@ -81,7 +81,8 @@ pub fn build(
         }
         k *= target / table_lm;
     }
-    let scale = super::photometric_scale(&spectrum, k).map_err(|m| (".spectrum".to_string(), m))?;
+    let scale = crate::photometry::photometric_scale(&spectrum, k)
+        .map_err(|m| (".spectrum".to_string(), m))?;
     let r = rotate_deg;
     let q = glam::Quat::from_rotation_z(r.z.to_radians())
         * glam::Quat::from_rotation_y(r.y.to_radians())

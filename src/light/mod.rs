@@ -1,5 +1,5 @@
 //! Light sources, in radiometric units (the scene loader converts the user's photometric
-//! amounts: see [`photometric_scale`]).
+//! amounts: see [`crate::photometry::photometric_scale`]).
 //!
 //! | light | stored spectrum | unit |
 //! |---|---|---|
@@ -12,28 +12,12 @@ pub mod sampler;
 
 use crate::bxdf::Frame;
 use crate::geometry::{Hit, SceneGeometry};
+use crate::photometry::luminous_integral;
+use crate::sampling::{pick_from_cdf, uniform_sphere, UNIFORM_SPHERE_PDF};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{DVec3, Vec2, Vec3};
-use std::f32::consts::PI;
 
 pub use sampler::LightSampler;
-
-/// K_m ∫ S(λ) V(λ) dλ over 360–830 nm at 1 nm, computed by the colour library
-/// ([`crate::photometry::luminance`]), i.e. the photometric amount one unit of the radiometric
-/// spectrum `s` carries (lm per W, cd per W·sr⁻¹, …).
-pub fn luminous_integral(s: &DenseSpectrum) -> f64 {
-    crate::photometry::luminance(&s.to_f64_array())
-}
-
-/// Factor that scales spectrum `s` so that it carries `amount` photometric units:
-/// `amount / (K_m ∫ S V dλ)`. Errors if the spectrum has no visible content.
-pub fn photometric_scale(s: &DenseSpectrum, amount: f64) -> Result<f32, String> {
-    let k = luminous_integral(s);
-    if k.is_nan() || k <= 0.0 || !k.is_finite() {
-        return Err("the spectrum has no luminous content (K_m ∫ S V dλ = 0), so a photometric amount cannot be assigned to it".into());
-    }
-    Ok((amount / k) as f32)
-}
 
 #[derive(Clone, Debug)]
 pub enum Light {
@@ -548,7 +532,7 @@ impl Light {
             }),
             Light::Environment { radiance, portals } => {
                 let (wi, pdf) = if portals.is_empty() {
-                    (sample_uniform_sphere(u), 1.0 / (4.0 * PI))
+                    (uniform_sphere(u), UNIFORM_SPHERE_PDF)
                 } else {
                     portals.sample(p, uc, u)?
                 };
@@ -643,7 +627,7 @@ impl Light {
     /// for an environment light (zero for the others).
     pub fn pdf_li_escape(&self, p: Vec3, wi: Vec3) -> f32 {
         match self {
-            Light::Environment { portals, .. } if portals.is_empty() => 1.0 / (4.0 * PI),
+            Light::Environment { portals, .. } if portals.is_empty() => UNIFORM_SPHERE_PDF,
             Light::Environment { portals, .. } => portals.pdf(p, wi),
             _ => 0.0,
         }
@@ -682,44 +666,12 @@ pub(crate) fn toward(position: Vec3, p: Vec3) -> Option<(Vec3, f32, f32)> {
     Some((d / dist, dist, dist2))
 }
 
-/// The cumulative distribution (last entry exactly 1) of non-negative weights with a positive,
-/// finite sum, accumulated in f64.
-pub fn cdf_from_weights(weights: &[f64]) -> Vec<f32> {
-    let total: f64 = weights.iter().sum();
-    let mut acc = 0.0;
-    let mut cdf: Vec<f32> = weights
-        .iter()
-        .map(|w| {
-            acc += w / total;
-            acc as f32
-        })
-        .collect();
-    if let Some(last) = cdf.last_mut() {
-        *last = 1.0;
-    }
-    cdf
-}
-
-/// Choose an index from a cumulative distribution (last entry 1); returns it and its probability.
-pub fn pick_from_cdf(cdf: &[f32], u: f32) -> (usize, f32) {
-    let k = cdf.partition_point(|&c| c <= u).min(cdf.len() - 1);
-    let lo = if k == 0 { 0.0 } else { cdf[k - 1] };
-    (k, cdf[k] - lo)
-}
-
 pub fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
     if a == b {
         return if x < a { 0.0 } else { 1.0 };
     }
     let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
-}
-
-pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
-    let z = 1.0 - 2.0 * u.x;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
 #[cfg(test)]
@@ -752,8 +704,8 @@ mod tests {
         let mut next = || rng.f32();
         let (mut sum, mut sum2) = (0.0f64, 0.0f64);
         for _ in 0..n {
-            let w = sample_uniform_sphere(Vec2::new(next(), next()));
-            let f = (portals.pdf(p, w) * 4.0 * PI) as f64;
+            let w = uniform_sphere(Vec2::new(next(), next()));
+            let f = (portals.pdf(p, w) * 4.0 * std::f32::consts::PI) as f64;
             sum += f;
             sum2 += f * f;
         }
@@ -961,22 +913,5 @@ mod tests {
             let z = (chi2 - dof) / (2.0 * dof).sqrt();
             assert!(z < 5.0, "{label}: χ² = {chi2} for {dof} degrees of freedom");
         }
-    }
-
-    #[test]
-    fn cdf_pick() {
-        let cdf = [0.25, 0.5, 1.0];
-        assert_eq!(pick_from_cdf(&cdf, 0.1), (0, 0.25));
-        assert_eq!(pick_from_cdf(&cdf, 0.3), (1, 0.25));
-        assert_eq!(pick_from_cdf(&cdf, 0.99), (2, 0.5));
-    }
-
-    #[test]
-    fn photometric_scale_gives_the_amount() {
-        let s = DenseSpectrum::constant(1.0);
-        let k = photometric_scale(&s, 1000.0).unwrap();
-        let scaled = s.scaled(k);
-        assert!((luminous_integral(&scaled) - 1000.0).abs() < 1e-3);
-        assert!(photometric_scale(&DenseSpectrum::constant(0.0), 1.0).is_err());
     }
 }

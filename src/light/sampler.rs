@@ -39,7 +39,7 @@ impl LightSampler {
         if self.cdf.is_empty() {
             return None;
         }
-        let (k, p) = super::pick_from_cdf(&self.cdf, u);
+        let (k, p) = crate::sampling::pick_from_cdf(&self.cdf, u);
         if p > 0.0 {
             Some((k, p))
         } else {

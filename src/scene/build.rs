@@ -1,16 +1,13 @@
 //! From parsed scene to [`World`]: check every value, resolve spectra, convert photometric
 //! amounts to radiometric light spectra, build the BVH.
 
+use super::context::{Context, Role, SceneError};
 use super::schema::*;
-use super::SceneError;
 use crate::bxdf::{Diffuse, Frame, Material};
 use crate::camera::{Camera, PixelFilter, ThinLens};
-use crate::colour::sd::SpectralDistribution;
-use crate::colour::{planck::planck_law, tables};
 use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
-use crate::light::{photometric_scale, Light, LightSampler};
+use crate::light::{Light, LightSampler};
 use crate::meter::{Grid, MeasureSettings, Meter, MeterKind};
-use crate::spectrum::rgb_upsample::fit_linear_srgb;
 use crate::spectrum::DenseSpectrum;
 use crate::world::{Object, RenderSettings, World};
 use glam::Vec3;
@@ -104,195 +101,6 @@ pub fn load_world_for(
     build_for(&scene, path, overrides, mode)
 }
 
-struct Ctx<'a> {
-    path: &'a Path,
-    dir: PathBuf,
-    /// Every file the scene refers to, in the order first resolved (see [`World::sources`]).
-    sources: std::cell::RefCell<Vec<PathBuf>>,
-}
-
-impl Ctx<'_> {
-    fn err(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
-        SceneError::Invalid {
-            path: self.path.to_path_buf(),
-            field: field.into(),
-            message: message.into(),
-        }
-    }
-    fn finite(&self, field: &str, v: f64) -> Result<f64, SceneError> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(self.err(field, format!("{v} is not a finite number")))
-        }
-    }
-    fn positive(&self, field: &str, v: f64) -> Result<f64, SceneError> {
-        self.finite(field, v)?;
-        if v > 0.0 {
-            Ok(v)
-        } else {
-            Err(self.err(field, format!("must be greater than 0, got {v}")))
-        }
-    }
-    fn vec3(&self, field: &str, v: V3) -> Result<Vec3, SceneError> {
-        for (k, c) in v.iter().enumerate() {
-            if !c.is_finite() {
-                return Err(self.err(
-                    format!("{field}.{}", ["x", "y", "z"][k]),
-                    format!("{c} is not a finite number"),
-                ));
-            }
-        }
-        Ok(Vec3::from_array(v))
-    }
-    fn resolve(&self, rel: &str) -> PathBuf {
-        let p = self.dir.join(rel);
-        let mut sources = self.sources.borrow_mut();
-        if !sources.contains(&p) {
-            sources.push(p.clone());
-        }
-        p
-    }
-}
-
-#[derive(Clone, Copy, PartialEq)]
-enum Role {
-    Reflectance,
-    Emission,
-}
-
-/// Refuse a table that lies entirely outside 360–830 nm: it would be zero at every wavelength
-/// candela renders (as `candela spectrum` refuses it).
-fn in_range(
-    ctx: &Ctx,
-    field: &str,
-    sd: &SpectralDistribution,
-    what: &str,
-) -> Result<(), SceneError> {
-    use crate::colour::tables::{END_NM, START_NM};
-    let (Some(&first), Some(&last)) = (sd.wavelengths_nm.first(), sd.wavelengths_nm.last()) else {
-        return Ok(());
-    };
-    if last < START_NM as f64 || first > END_NM as f64 {
-        return Err(ctx.err(
-            field,
-            format!(
-                "{what} covers {first}–{last} nm, entirely outside candela's {START_NM}–{END_NM} nm range (it would be 0 at every wavelength rendered)"
-            ),
-        ));
-    }
-    Ok(())
-}
-
-fn resolve_spectrum(
-    ctx: &Ctx,
-    field: &str,
-    desc: &SpectrumDesc,
-    role: Role,
-) -> Result<DenseSpectrum, SceneError> {
-    let dense = match desc {
-        SpectrumDesc::Constant(v) => {
-            let v = ctx.finite(field, *v)?;
-            DenseSpectrum::constant(v as f32)
-        }
-        SpectrumDesc::Blackbody(t) => {
-            if role == Role::Reflectance {
-                return Err(ctx.err(
-                    field,
-                    "a blackbody spectrum describes emission, not a reflectance",
-                ));
-            }
-            let t = ctx.positive(field, *t)?;
-            // Relative shape only: normalise to 1 at 560 nm to keep f32 in range.
-            let norm = planck_law(560e-9, t);
-            DenseSpectrum::from_fn(|nm| planck_law(nm * 1e-9, t) / norm)
-        }
-        SpectrumDesc::Named(name) => {
-            let sd = tables::named_spectrum(name).ok_or_else(|| {
-                ctx.err(
-                    field,
-                    format!(
-                        "unknown spectrum name {name:?}; known names: {}",
-                        tables::named_spectrum_names().join(", ")
-                    ),
-                )
-            })?;
-            DenseSpectrum::from_fn(|nm| sd.value(nm))
-        }
-        SpectrumDesc::Tabulated(pairs) => {
-            let (w, v): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
-            let sd = SpectralDistribution::new(w, v).map_err(|e| ctx.err(field, e.to_string()))?;
-            in_range(ctx, field, &sd, "the table")?;
-            DenseSpectrum::from_fn(|nm| sd.value(nm))
-        }
-        SpectrumDesc::Csv(rel) => {
-            let p = ctx.resolve(rel);
-            let sd = SpectralDistribution::from_csv_path(&p)
-                .map_err(|e| ctx.err(field, e.to_string()))?;
-            in_range(ctx, field, &sd, &format!("{}", p.display()))?;
-            DenseSpectrum::from_fn(|nm| sd.value(nm))
-        }
-        SpectrumDesc::Rgb(..) | SpectrumDesc::Srgb(..) => {
-            let (rgb, encoded) = match *desc {
-                SpectrumDesc::Rgb(r, g, b) => ([r, g, b], false),
-                SpectrumDesc::Srgb(r, g, b) => ([r, g, b], true),
-                _ => unreachable!(),
-            };
-            for (k, c) in rgb.iter().enumerate() {
-                ctx.finite(field, *c)?;
-                if !(0.0..=1.0).contains(c) {
-                    return Err(ctx.err(
-                        field,
-                        format!(
-                            "RGB component {} is {c}; sRGB components must lie in [0, 1]",
-                            ["r", "g", "b"][k]
-                        ),
-                    ));
-                }
-            }
-            let rgb = if encoded {
-                rgb.map(crate::colour::rgb::srgb_decode)
-            } else {
-                rgb
-            };
-            let (sig, _residual) =
-                fit_linear_srgb(rgb).map_err(|e| ctx.err(field, e.to_string()))?;
-            match role {
-                Role::Reflectance => DenseSpectrum::from_fn(|nm| sig.value(nm)),
-                Role::Emission => {
-                    // An RGB emitter is the smooth reflectance-like shape times D65, so that
-                    // white (1,1,1) emits D65 (pbrt-v4's RGBIlluminantSpectrum).
-                    let d65 = tables::named_spectrum("D65").expect("D65 ships with candela");
-                    DenseSpectrum::from_fn(|nm| sig.value(nm) * d65.value(nm))
-                }
-            }
-        }
-    };
-    if dense.values.iter().any(|v| !v.is_finite()) {
-        return Err(ctx.err(field, "the spectrum has non-finite values"));
-    }
-    let min = dense.min_value();
-    if min < 0.0 {
-        return Err(ctx.err(
-            field,
-            format!("the spectrum is negative (minimum {min}); spectra must be ≥ 0"),
-        ));
-    }
-    if role == Role::Reflectance {
-        let max = dense.max_value();
-        if max > 1.0 {
-            let at = dense.values.iter().position(|&v| v == max).unwrap_or(0) + 360;
-            return Err(ctx.err(
-                field,
-                format!(
-                    "reflectance {max} at {at} nm is above 1; a passive surface cannot reflect more light than it receives"
-                ),
-            ));
-        }
-    }
-    Ok(dense)
-}
-
 fn object_field(i: usize, o: &ObjectDesc) -> String {
     match &o.name {
         Some(n) => format!("objects[{i}] {n:?}"),
@@ -301,7 +109,7 @@ fn object_field(i: usize, o: &ObjectDesc) -> String {
 }
 
 /// A mesh file's error; an unreadable file's hint says where relative paths are resolved.
-fn mesh_err(ctx: &Ctx, field: &str, rel: &str, e: geometry::GeometryError) -> SceneError {
+fn mesh_err(ctx: &Context, field: &str, rel: &str, e: geometry::GeometryError) -> SceneError {
     match e {
         geometry::GeometryError::Io { path, source } => ctx.err(
             field,
@@ -324,7 +132,7 @@ fn mesh_err(ctx: &Ctx, field: &str, rel: &str, e: geometry::GeometryError) -> Sc
     }
 }
 
-fn build_shape(ctx: &Ctx, field: &str, desc: &ShapeDesc) -> Result<Shape, SceneError> {
+fn build_shape(ctx: &Context, field: &str, desc: &ShapeDesc) -> Result<Shape, SceneError> {
     let f = |s: &str| format!("{field}.{s}");
     Ok(match desc {
         ShapeDesc::Sphere { center, radius } => Shape::Sphere {
@@ -423,7 +231,7 @@ fn build_shape(ctx: &Ctx, field: &str, desc: &ShapeDesc) -> Result<Shape, SceneE
     })
 }
 
-fn build_transform(ctx: &Ctx, field: &str, t: &TransformDesc) -> Result<Transform, SceneError> {
+fn build_transform(ctx: &Context, field: &str, t: &TransformDesc) -> Result<Transform, SceneError> {
     let tr = match t.translate {
         Some(v) => ctx.vec3(&format!("{field}.translate"), v)?,
         None => Vec3::ZERO,
@@ -457,7 +265,7 @@ pub fn build_for(
     overrides: &Overrides,
     mode: &RunMode,
 ) -> Result<World, SceneError> {
-    let ctx = Ctx {
+    let ctx = Context {
         path,
         dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
         sources: Default::default(),
@@ -598,8 +406,7 @@ pub fn build_for(
         }
         let mat = match m {
             MaterialDesc::Diffuse { reflectance } => Material::Diffuse(Diffuse {
-                reflectance: resolve_spectrum(
-                    &ctx,
+                reflectance: ctx.spectrum(
                     &format!("{field}.reflectance"),
                     reflectance,
                     Role::Reflectance,
@@ -643,8 +450,7 @@ pub fn build_for(
             light: None,
         });
         if let Some(e) = &o.emission {
-            let s = resolve_spectrum(
-                &ctx,
+            let s = ctx.spectrum(
                 &format!("{field}.emission.spectrum"),
                 &e.spectrum,
                 Role::Emission,
@@ -693,11 +499,11 @@ pub fn build_for(
         }
         let afield = format!("{field}.emission.amount");
         let luminance = match amount {
-            Amount::Luminance(l) => nonneg(&ctx, &afield, l)?,
+            Amount::Luminance(l) => ctx.nonneg(&afield, l)?,
             Amount::Flux(phi) => {
                 // Lambertian: Φ = π L A per emitting face.
                 let sides = if two_sided { 2.0 } else { 1.0 };
-                nonneg(&ctx, &afield, phi)? / (std::f64::consts::PI * total * sides)
+                ctx.nonneg(&afield, phi)? / (std::f64::consts::PI * total * sides)
             }
             other => {
                 return Err(ctx.err(
@@ -706,17 +512,20 @@ pub fn build_for(
                 ))
             }
         };
-        let k = photometric_scale(&s, luminance)
-            .map_err(|m| ctx.err(format!("{field}.emission.spectrum"), m))?;
-        representable(&ctx, &afield, &s, k)?;
-        let cdf = crate::light::cdf_from_weights(&areas);
+        let radiance = ctx.scaled_emission(
+            &format!("{field}.emission.spectrum"),
+            &afield,
+            &s,
+            luminance,
+        )?;
+        let cdf = crate::sampling::cdf_from_weights(&areas);
         objects[object as usize].light = Some(lights.len() as u32);
         lights.push(Light::Area {
             object,
             prims,
             cdf,
             total_area: total as f32,
-            radiance: s.scaled(k),
+            radiance,
             two_sided,
         });
     }
@@ -762,16 +571,8 @@ pub fn build_for(
     })
 }
 
-fn unit(ctx: &Ctx, field: &str, v: V3) -> Result<Vec3, SceneError> {
-    let v = ctx.vec3(field, v)?;
-    if v.length_squared() == 0.0 {
-        return Err(ctx.err(field, "the direction is the zero vector"));
-    }
-    Ok(v.normalize())
-}
-
 fn build_meters(
-    ctx: &Ctx,
+    ctx: &Context,
     scene: &SceneFile,
 ) -> Result<(Vec<Meter>, Vec<Grid>, MeasureSettings), SceneError> {
     let mut names = std::collections::HashSet::new();
@@ -787,7 +588,7 @@ fn build_meters(
                 name,
                 MeterKind::Illuminance {
                     position: ctx.vec3(&format!("{field}.position"), *position)?,
-                    normal: unit(ctx, &format!("{field}.normal"), *normal)?,
+                    normal: ctx.unit(&format!("{field}.normal"), *normal)?,
                 },
             ),
             MeterDesc::Luminance {
@@ -807,7 +608,7 @@ fn build_meters(
                     name,
                     MeterKind::Luminance {
                         position: ctx.vec3(&format!("{field}.position"), *position)?,
-                        direction: unit(ctx, &format!("{field}.direction"), *direction)?,
+                        direction: ctx.unit(&format!("{field}.direction"), *direction)?,
                         half_angle_rad: (a as f32).to_radians(),
                     },
                 )
@@ -867,7 +668,7 @@ fn build_meters(
             edge_v: ev,
             nx: g.nx,
             ny: g.ny,
-            normal: unit(ctx, &format!("{field}.normal"), g.normal)?,
+            normal: ctx.unit(&format!("{field}.normal"), g.normal)?,
         });
     }
     let m = &scene.measure;
@@ -893,46 +694,10 @@ fn build_meters(
     ))
 }
 
-/// Largest spectral value of a light (W·m⁻²·sr⁻¹·nm⁻¹ for radiance, W·sr⁻¹·nm⁻¹ for
-/// intensity, W·m⁻²·nm⁻¹ for irradiance) — some 10¹⁸ times the sun's radiance — so that the
-/// single-precision light spectra and the f32 image channels cannot overflow to infinity.
-pub const MAX_SPECTRAL_VALUE: f64 = 1e25;
-
-/// Check that spectrum `s` scaled by `k` stays finite with headroom (see [`MAX_SPECTRAL_VALUE`]).
-fn representable(ctx: &Ctx, afield: &str, s: &DenseSpectrum, k: f32) -> Result<(), SceneError> {
-    let peak = s.max_value() as f64 * k as f64;
-    if peak <= MAX_SPECTRAL_VALUE {
-        Ok(())
-    } else {
-        Err(ctx.err(
-            afield,
-            format!(
-                "the amount is too large: the light's spectral value would reach {peak:e} (more than {MAX_SPECTRAL_VALUE:e} in W, m, sr, nm), beyond any physical source"
-            ),
-        ))
-    }
-}
-
-fn nonneg(ctx: &Ctx, field: &str, v: f64) -> Result<f64, SceneError> {
-    ctx.finite(field, v)?;
-    if v < 0.0 {
-        return Err(ctx.err(
-            field,
-            format!("a photometric amount cannot be negative, got {v}"),
-        ));
-    }
-    Ok(v)
-}
-
-fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneError> {
+fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, SceneError> {
     let afield = format!("{field}.amount");
     let sfield = format!("{field}.spectrum");
-    let scaled = |spec: &SpectrumDesc, amount: f64| -> Result<DenseSpectrum, SceneError> {
-        let s = resolve_spectrum(ctx, &sfield, spec, Role::Emission)?;
-        let k = photometric_scale(&s, amount).map_err(|m| ctx.err(&sfield, m))?;
-        representable(ctx, &afield, &s, k)?;
-        Ok(s.scaled(k))
-    };
+    let scaled = |spec: &SpectrumDesc, amount: f64| ctx.emission(&sfield, &afield, spec, amount);
     let wrong = |a: &Amount, allowed: &str| {
         ctx.err(
             &afield,
@@ -946,8 +711,8 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
             amount,
         } => {
             let cd = match amount {
-                Amount::Intensity(i) => nonneg(ctx, &afield, *i)?,
-                Amount::Flux(phi) => nonneg(ctx, &afield, *phi)? / (4.0 * std::f64::consts::PI),
+                Amount::Intensity(i) => ctx.nonneg(&afield, *i)?,
+                Amount::Flux(phi) => ctx.nonneg(&afield, *phi)? / (4.0 * std::f64::consts::PI),
                 a => return Err(wrong(a, "Intensity(cd) or Flux(lm)")),
             };
             Light::Point {
@@ -980,10 +745,10 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
             }
             let (ci, co) = (inner.to_radians().cos(), outer.to_radians().cos());
             let cd = match amount {
-                Amount::Intensity(i) => nonneg(ctx, &afield, *i)?,
+                Amount::Intensity(i) => ctx.nonneg(&afield, *i)?,
                 // Φ = ∫ I dω = 2π I [(1 − cos θi) + (cos θi − cos θo)/2] for the smoothstep falloff.
                 Amount::Flux(phi) => {
-                    nonneg(ctx, &afield, *phi)?
+                    ctx.nonneg(&afield, *phi)?
                         / (2.0 * std::f64::consts::PI * (1.0 - 0.5 * (ci + co)))
                 }
                 a => return Err(wrong(a, "Intensity(cd) or Flux(lm)")),
@@ -1009,7 +774,7 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
                 ));
             }
             let lux = match amount {
-                Amount::Illuminance(e) => nonneg(ctx, &afield, *e)?,
+                Amount::Illuminance(e) => ctx.nonneg(&afield, *e)?,
                 a => return Err(wrong(a, "Illuminance(lx)")),
             };
             Light::Distant {
@@ -1023,7 +788,7 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
             portals,
         } => {
             let lum = match amount {
-                Amount::Luminance(l) => nonneg(ctx, &afield, *l)?,
+                Amount::Luminance(l) => ctx.nonneg(&afield, *l)?,
                 a => return Err(wrong(a, "Luminance(cd/m²)")),
             };
             let mut built = Vec::with_capacity(portals.len());
@@ -1058,12 +823,12 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
                 Some(r) => ctx.vec3(&format!("{field}.rotate_deg"), *r)?,
                 None => Vec3::ZERO,
             },
-            resolve_spectrum(ctx, &sfield, spectrum, Role::Emission)?,
+            ctx.spectrum(&sfield, spectrum, Role::Emission)?,
             lumens
-                .map(|v| nonneg(ctx, &format!("{field}.lumens"), v))
+                .map(|v| ctx.nonneg(&format!("{field}.lumens"), v))
                 .transpose()?,
             multiplier
-                .map(|v| nonneg(ctx, &format!("{field}.multiplier"), v))
+                .map(|v| ctx.nonneg(&format!("{field}.multiplier"), v))
                 .transpose()?,
         )
         .map_err(|(sub, m)| ctx.err(format!("{field}{sub}"), m))?,
@@ -1071,10 +836,10 @@ fn build_light(ctx: &Ctx, field: &str, l: &LightDesc) -> Result<Light, SceneErro
 }
 
 /// The scattering materials other than `Diffuse`/`Black` (the BSDF library, src/bxdf).
-fn build_material(ctx: &Ctx, field: &str, m: &MaterialDesc) -> Result<Material, SceneError> {
+fn build_material(ctx: &Context, field: &str, m: &MaterialDesc) -> Result<Material, SceneError> {
     use crate::bxdf::{self, ior};
     let refl = |name: &str, d: &SpectrumDesc| {
-        resolve_spectrum(ctx, &format!("{field}.{name}"), d, Role::Reflectance)
+        ctx.spectrum(&format!("{field}.{name}"), d, Role::Reflectance)
     };
     let microfacet = |dist: DistributionDesc,
                       masking: MaskingDesc,
@@ -1228,8 +993,8 @@ fn build_material(ctx: &Ctx, field: &str, m: &MaterialDesc) -> Result<Material, 
                             ));
                         }
                     }
-                    let n = resolve_spectrum(ctx, &format!("{field}.n"), n, Role::Emission)?;
-                    let k = resolve_spectrum(ctx, &format!("{field}.k"), k, Role::Emission)?;
+                    let n = ctx.spectrum(&format!("{field}.n"), n, Role::Emission)?;
+                    let k = ctx.spectrum(&format!("{field}.k"), k, Role::Emission)?;
                     if n.min_value() <= 0.0 {
                         return Err(ctx.err(
                             format!("{field}.n"),

@@ -4,35 +4,14 @@
 //! where the parser knows it, and the field path (e.g. `objects[3] "floor".emission.amount`).
 
 pub mod build;
+pub mod context;
 pub mod schema;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 pub use build::{build, build_for, load_world, load_world_for, Overrides, RunMode};
+pub use context::SceneError;
 pub use schema::SceneFile;
-
-#[derive(Debug, thiserror::Error)]
-pub enum SceneError {
-    #[error("cannot read scene file {}: {source}", path.display())]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-    #[error("{}:{line}:{col}: the scene file is not valid: {message}", path.display())]
-    Parse {
-        path: PathBuf,
-        line: usize,
-        col: usize,
-        message: String,
-    },
-    #[error("{}: `{field}`: {message}", path.display())]
-    Invalid {
-        path: PathBuf,
-        field: String,
-        message: String,
-    },
-}
 
 /// Parse a scene file (syntax, types and unknown fields; values are checked by [`build`]).
 pub fn load(path: &Path) -> Result<SceneFile, SceneError> {

@@ -1,0 +1,154 @@
+//! Warps from [0,1)² to disks, hemispheres, spheres, cones and triangles, each next to its
+//! density. The f64 forms serve the geometry, which samples points in double precision.
+
+use glam::{DVec3, Vec2, Vec3};
+use std::f32::consts::{FRAC_1_PI, PI};
+
+/// Shirley–Chiu concentric map from [0,1)² to the unit disk (uniform by area, density 1/π).
+pub fn concentric_disk(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, std::f32::consts::FRAC_PI_4 * (o.y / o.x))
+    } else {
+        (
+            o.y,
+            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (o.x / o.y),
+        )
+    };
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
+/// The concentric map in f64, as polar coordinates (r, φ) of the unit disk; r may be negative
+/// (the point is r·(cos φ, sin φ)).
+pub fn concentric_disk_polar(u0: f64, u1: f64) -> (f64, f64) {
+    let (a, b) = (2.0 * u0 - 1.0, 2.0 * u1 - 1.0);
+    if a == 0.0 && b == 0.0 {
+        (0.0, 0.0)
+    } else if a.abs() > b.abs() {
+        (a, std::f64::consts::FRAC_PI_4 * (b / a))
+    } else {
+        (
+            b,
+            std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (a / b),
+        )
+    }
+}
+
+/// Uniform by area on the unit disk by the polar map: (radius, angle φ in radians); density
+/// 1/π per unit area.
+pub fn uniform_disk_polar(u: Vec2) -> (f32, f32) {
+    (u.x.sqrt(), 2.0 * PI * u.y)
+}
+
+/// Cosine-weighted direction on the +z hemisphere (Malley's method); density
+/// [`cosine_hemisphere_pdf`].
+pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = concentric_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+/// Density (per steradian) of [`cosine_hemisphere`] at a direction with cos θ = `cos_theta`.
+#[inline]
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    cos_theta * FRAC_1_PI
+}
+
+/// Density (per steradian) of [`uniform_sphere`].
+pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
+
+/// Uniform direction on the unit sphere; density [`UNIFORM_SPHERE_PDF`].
+pub fn uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// [`uniform_sphere`] in f64.
+pub fn uniform_sphere_f64(u0: f64, u1: f64) -> DVec3 {
+    let z = 1.0 - 2.0 * u0;
+    let rr = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * u1;
+    DVec3::new(rr * phi.cos(), rr * phi.sin(), z)
+}
+
+/// Uniform direction in the cone of half-angle θmax about +z, given `one_minus_cos_max` =
+/// 1 − cos θmax (kept without cancellation by the caller): (cos θ, sin θ, φ). Density
+/// [`uniform_cone_pdf`].
+pub fn uniform_cone(u0: f64, u1: f64, one_minus_cos_max: f64) -> (f64, f64, f64) {
+    let omc_t = u0 * one_minus_cos_max;
+    let cos_t = 1.0 - omc_t;
+    let sin_t = (omc_t * (2.0 - omc_t)).max(0.0).sqrt();
+    (cos_t, sin_t, 2.0 * std::f64::consts::PI * u1)
+}
+
+/// Density (per steradian) of [`uniform_cone`]: 1 / (2π (1 − cos θmax)).
+pub fn uniform_cone_pdf(one_minus_cos_max: f64) -> f64 {
+    1.0 / (std::f64::consts::TAU * one_minus_cos_max)
+}
+
+/// Uniform by area on a triangle: barycentric coordinates (b0, b1, b2) of the vertices, by
+/// Heitz 2019, "A Low-Distortion Map Between Triangle and Square". Density 1/area.
+pub fn uniform_triangle(u0: f64, u1: f64) -> (f64, f64, f64) {
+    let (b0, b1) = if u0 < u1 {
+        let b0 = u0 / 2.0;
+        (b0, u1 - b0)
+    } else {
+        let b1 = u1 / 2.0;
+        (u0 - b1, b1)
+    };
+    (b0, b1, 1.0 - b0 - b1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each warp lands in its domain, and the mean of a test function over a stratified grid
+    /// of samples, weighted by 1/pdf, reproduces the domain's measure.
+    #[test]
+    fn warps_cover_their_domains_with_their_densities() {
+        let n = 256;
+        let (mut disk, mut hemi, mut sphere, mut cone, mut tri) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        let omc = 0.3f64;
+        for i in 0..n {
+            for j in 0..n {
+                let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let d = concentric_disk(u);
+                assert!(d.length() <= 1.0 + 1e-6);
+                disk += d.length_squared() as f64; // E[r²] = 1/2 on the unit disk
+                let w = cosine_hemisphere(u);
+                assert!(w.z >= 0.0 && (w.length() - 1.0).abs() < 1e-5);
+                hemi += 1.0 / cosine_hemisphere_pdf(w.z).max(1e-30) as f64;
+                let s = uniform_sphere(u);
+                assert!((s.length() - 1.0).abs() < 1e-5);
+                sphere += s.z as f64;
+                let (c, st, _) = uniform_cone(u.x as f64, u.y as f64, omc);
+                assert!(c >= 1.0 - omc - 1e-12 && (c * c + st * st - 1.0).abs() < 1e-12);
+                cone += 1.0 / uniform_cone_pdf(omc);
+                let (b0, b1, b2) = uniform_triangle(u.x as f64, u.y as f64);
+                assert!(b0 >= 0.0 && b1 >= 0.0 && b2 >= -1e-15);
+                tri += b0;
+            }
+        }
+        let m = (n * n) as f64;
+        assert!((disk / m - 0.5).abs() < 1e-3, "E[r²] {}", disk / m);
+        // ∫ over the hemisphere of 1 = 2π, estimated as mean(1/pdf) (the grid misses the rim).
+        assert!((hemi / m / (2.0 * std::f64::consts::PI) - 1.0).abs() < 0.02);
+        assert!((sphere / m).abs() < 1e-3);
+        assert!((cone / m - std::f64::consts::TAU * omc).abs() < 1e-12);
+        assert!((tri / m - 1.0 / 3.0).abs() < 1e-3);
+        let (r, phi) = concentric_disk_polar(0.75, 0.5);
+        let d = concentric_disk(Vec2::new(0.75, 0.5));
+        assert!(
+            (r * phi.cos() - d.x as f64).abs() < 1e-6 && (r * phi.sin() - d.y as f64).abs() < 1e-6
+        );
+        let v = uniform_sphere_f64(0.2, 0.7);
+        let w = uniform_sphere(Vec2::new(0.2, 0.7));
+        assert!((v.as_vec3() - w).length() < 1e-6);
+    }
+}

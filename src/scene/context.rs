@@ -1,0 +1,303 @@
+//! Reading a scene value: errors that name the scene file and the field, checked numbers and
+//! vectors, paths relative to the scene, spectra, and photometric amounts turned into
+//! radiometric spectra. Every type that builds itself from its description uses it.
+
+use super::schema::{SpectrumDesc, V3};
+use crate::colour::sd::SpectralDistribution;
+use crate::colour::{planck::planck_law, tables};
+use crate::photometry::photometric_scale;
+use crate::spectrum::rgb_upsample::fit_linear_srgb;
+use crate::spectrum::DenseSpectrum;
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+
+/// A scene that cannot be read or built, with the file, the position or the field.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("cannot read scene file {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}:{line}:{col}: the scene file is not valid: {message}", path.display())]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        col: usize,
+        message: String,
+    },
+    #[error("{}: `{field}`: {message}", path.display())]
+    Invalid {
+        path: PathBuf,
+        field: String,
+        message: String,
+    },
+}
+
+/// Largest spectral value of a light (W·m⁻²·sr⁻¹·nm⁻¹ for radiance, W·sr⁻¹·nm⁻¹ for
+/// intensity, W·m⁻²·nm⁻¹ for irradiance) — some 10¹⁸ times the sun's radiance — so that the
+/// single-precision light spectra and the f32 image channels cannot overflow to infinity.
+pub const MAX_SPECTRAL_VALUE: f64 = 1e25;
+
+/// What building a scene value needs: the scene file (for messages), its directory (for
+/// relative paths) and the files it refers to.
+pub struct Context<'a> {
+    pub path: &'a Path,
+    /// Directory relative paths are resolved against.
+    pub dir: PathBuf,
+    /// Every file the scene refers to, in the order first resolved (see [`World::sources`]).
+    pub sources: std::cell::RefCell<Vec<PathBuf>>,
+}
+
+impl Context<'_> {
+    /// An error naming the scene file and `field`.
+    pub fn err(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            path: self.path.to_path_buf(),
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+    pub fn finite(&self, field: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("{v} is not a finite number")))
+        }
+    }
+    pub fn positive(&self, field: &str, v: f64) -> Result<f64, SceneError> {
+        self.finite(field, v)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("must be greater than 0, got {v}")))
+        }
+    }
+    pub fn vec3(&self, field: &str, v: V3) -> Result<Vec3, SceneError> {
+        for (k, c) in v.iter().enumerate() {
+            if !c.is_finite() {
+                return Err(self.err(
+                    format!("{field}.{}", ["x", "y", "z"][k]),
+                    format!("{c} is not a finite number"),
+                ));
+            }
+        }
+        Ok(Vec3::from_array(v))
+    }
+    /// A path of the scene relative to its directory, recorded among the scene's sources.
+    pub fn resolve(&self, rel: &str) -> PathBuf {
+        let p = self.dir.join(rel);
+        let mut sources = self.sources.borrow_mut();
+        if !sources.contains(&p) {
+            sources.push(p.clone());
+        }
+        p
+    }
+
+    /// A unit direction (refusing the zero vector).
+    pub fn unit(&self, field: &str, v: V3) -> Result<Vec3, SceneError> {
+        let v = self.vec3(field, v)?;
+        if v.length_squared() == 0.0 {
+            return Err(self.err(field, "the direction is the zero vector"));
+        }
+        Ok(v.normalize())
+    }
+
+    /// A photometric amount: finite and ≥ 0.
+    pub fn nonneg(&self, field: &str, v: f64) -> Result<f64, SceneError> {
+        self.finite(field, v)?;
+        if v < 0.0 {
+            return Err(self.err(
+                field,
+                format!("a photometric amount cannot be negative, got {v}"),
+            ));
+        }
+        Ok(v)
+    }
+
+    /// Check that spectrum `s` scaled by `k` stays finite with headroom (see
+    /// [`MAX_SPECTRAL_VALUE`]).
+    pub fn representable(&self, afield: &str, s: &DenseSpectrum, k: f32) -> Result<(), SceneError> {
+        let peak = s.max_value() as f64 * k as f64;
+        if peak <= MAX_SPECTRAL_VALUE {
+            Ok(())
+        } else {
+            Err(self.err(
+                afield,
+                format!(
+                    "the amount is too large: the light's spectral value would reach {peak:e} (more than {MAX_SPECTRAL_VALUE:e} in W, m, sr, nm), beyond any physical source"
+                ),
+            ))
+        }
+    }
+
+    /// An emission spectrum (`sfield`) scaled to carry `amount` photometric units (checked by
+    /// the caller; reported at `afield` if too large): spectrum × amount / (K_m ∫ S V dλ).
+    pub fn emission(
+        &self,
+        sfield: &str,
+        afield: &str,
+        desc: &SpectrumDesc,
+        amount: f64,
+    ) -> Result<DenseSpectrum, SceneError> {
+        let s = self.spectrum(sfield, desc, Role::Emission)?;
+        self.scaled_emission(sfield, afield, &s, amount)
+    }
+
+    /// [`Context::emission`] of a resolved spectrum `s`.
+    pub fn scaled_emission(
+        &self,
+        sfield: &str,
+        afield: &str,
+        s: &DenseSpectrum,
+        amount: f64,
+    ) -> Result<DenseSpectrum, SceneError> {
+        let k = photometric_scale(s, amount).map_err(|m| self.err(sfield, m))?;
+        self.representable(afield, s, k)?;
+        Ok(s.scaled(k))
+    }
+
+    /// The spectrum `desc` describes, checked for its `role` (finite, ≥ 0; a reflectance ≤ 1).
+    pub fn spectrum(
+        &self,
+        field: &str,
+        desc: &SpectrumDesc,
+        role: Role,
+    ) -> Result<DenseSpectrum, SceneError> {
+        let ctx = self;
+        let dense = match desc {
+            SpectrumDesc::Constant(v) => {
+                let v = ctx.finite(field, *v)?;
+                DenseSpectrum::constant(v as f32)
+            }
+            SpectrumDesc::Blackbody(t) => {
+                if role == Role::Reflectance {
+                    return Err(ctx.err(
+                        field,
+                        "a blackbody spectrum describes emission, not a reflectance",
+                    ));
+                }
+                let t = ctx.positive(field, *t)?;
+                // Relative shape only: normalise to 1 at 560 nm to keep f32 in range.
+                let norm = planck_law(560e-9, t);
+                DenseSpectrum::from_fn(|nm| planck_law(nm * 1e-9, t) / norm)
+            }
+            SpectrumDesc::Named(name) => {
+                let sd = tables::named_spectrum(name).ok_or_else(|| {
+                    ctx.err(
+                        field,
+                        format!(
+                            "unknown spectrum name {name:?}; known names: {}",
+                            tables::named_spectrum_names().join(", ")
+                        ),
+                    )
+                })?;
+                DenseSpectrum::from_fn(|nm| sd.value(nm))
+            }
+            SpectrumDesc::Tabulated(pairs) => {
+                let (w, v): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
+                let sd =
+                    SpectralDistribution::new(w, v).map_err(|e| ctx.err(field, e.to_string()))?;
+                in_range(self, field, &sd, "the table")?;
+                DenseSpectrum::from_fn(|nm| sd.value(nm))
+            }
+            SpectrumDesc::Csv(rel) => {
+                let p = ctx.resolve(rel);
+                let sd = SpectralDistribution::from_csv_path(&p)
+                    .map_err(|e| ctx.err(field, e.to_string()))?;
+                in_range(self, field, &sd, &format!("{}", p.display()))?;
+                DenseSpectrum::from_fn(|nm| sd.value(nm))
+            }
+            SpectrumDesc::Rgb(..) | SpectrumDesc::Srgb(..) => {
+                let (rgb, encoded) = match *desc {
+                    SpectrumDesc::Rgb(r, g, b) => ([r, g, b], false),
+                    SpectrumDesc::Srgb(r, g, b) => ([r, g, b], true),
+                    _ => unreachable!(),
+                };
+                for (k, c) in rgb.iter().enumerate() {
+                    ctx.finite(field, *c)?;
+                    if !(0.0..=1.0).contains(c) {
+                        return Err(ctx.err(
+                            field,
+                            format!(
+                                "RGB component {} is {c}; sRGB components must lie in [0, 1]",
+                                ["r", "g", "b"][k]
+                            ),
+                        ));
+                    }
+                }
+                let rgb = if encoded {
+                    rgb.map(crate::colour::rgb::srgb_decode)
+                } else {
+                    rgb
+                };
+                let (sig, _residual) =
+                    fit_linear_srgb(rgb).map_err(|e| ctx.err(field, e.to_string()))?;
+                match role {
+                    Role::Reflectance => DenseSpectrum::from_fn(|nm| sig.value(nm)),
+                    Role::Emission => {
+                        // An RGB emitter is the smooth reflectance-like shape times D65, so that
+                        // white (1,1,1) emits D65 (pbrt-v4's RGBIlluminantSpectrum).
+                        let d65 = tables::named_spectrum("D65").expect("D65 ships with candela");
+                        DenseSpectrum::from_fn(|nm| sig.value(nm) * d65.value(nm))
+                    }
+                }
+            }
+        };
+        if dense.values.iter().any(|v| !v.is_finite()) {
+            return Err(ctx.err(field, "the spectrum has non-finite values"));
+        }
+        let min = dense.min_value();
+        if min < 0.0 {
+            return Err(ctx.err(
+                field,
+                format!("the spectrum is negative (minimum {min}); spectra must be ≥ 0"),
+            ));
+        }
+        if role == Role::Reflectance {
+            let max = dense.max_value();
+            if max > 1.0 {
+                let at = dense.values.iter().position(|&v| v == max).unwrap_or(0) + 360;
+                return Err(ctx.err(
+                    field,
+                    format!(
+                        "reflectance {max} at {at} nm is above 1; a passive surface cannot reflect more light than it receives"
+                    ),
+                ));
+            }
+        }
+        Ok(dense)
+    }
+}
+
+#[derive(Clone, Copy, PartialEq)]
+/// What a spectrum describes: reflectances must lie in [0, 1]; emission may not be a
+/// blackbody reflectance.
+pub enum Role {
+    Reflectance,
+    Emission,
+}
+
+/// Refuse a table that lies entirely outside 360–830 nm: it would be zero at every wavelength
+/// candela renders (as `candela spectrum` refuses it).
+fn in_range(
+    ctx: &Context,
+    field: &str,
+    sd: &SpectralDistribution,
+    what: &str,
+) -> Result<(), SceneError> {
+    use crate::colour::tables::{END_NM, START_NM};
+    let (Some(&first), Some(&last)) = (sd.wavelengths_nm.first(), sd.wavelengths_nm.last()) else {
+        return Ok(());
+    };
+    if last < START_NM as f64 || first > END_NM as f64 {
+        return Err(ctx.err(
+            field,
+            format!(
+                "{what} covers {first}–{last} nm, entirely outside candela's {START_NM}–{END_NM} nm range (it would be 0 at every wavelength rendered)"
+            ),
+        ));
+    }
+    Ok(())
+}
