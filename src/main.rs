@@ -1,5 +1,7 @@
 //! The `candela` command line.
 
+mod cli;
+
 use anyhow::{bail, Context, Result};
 use candela::colour::tables::Observer;
 use candela::output::{self, Layers, PngSettings};

@@ -1,0 +1,1 @@
+//! `candela spectrum` and `candela convert`.

@@ -1,0 +1,1 @@
+//! `candela render` and `candela merge`.
