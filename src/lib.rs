@@ -15,6 +15,7 @@ pub mod colour;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
+pub mod job;
 pub mod light;
 pub mod luminaire;
 pub mod meter;

@@ -1,1 +1,325 @@
-//! `candela render` and `candela merge`.
+//! `candela render` and `candela merge`: their options, the progress bar, Ctrl-C, and the
+//! closing summary; the work is [`candela::job::run`] and [`candela::job::merge`].
+
+use anyhow::{bail, Context, Result};
+use candela::job::{self, ImageDone, Outcome, Progress, RenderJob};
+use candela::meter::MeterKind;
+use candela::render::{StopReason, TargetError};
+use candela::report::units::{Quantity, UnitSystem};
+use candela::scene::Overrides;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Options of `candela render`.
+#[derive(clap::Args)]
+pub struct RenderOpts {
+    /// Scene file (RON).
+    scene: PathBuf,
+    /// Samples per pixel (overrides the scene's render.spp).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Output directory, or output file name (NAME, NAME.exr or NAME.png: both files are written). Default: the current directory, named after the scene.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Worker threads (default: all cores; at most 16 per available core). The image does not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Random seed (overrides render.seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Maximum path depth (overrides render.max_depth).
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Exposure of the PNG in EV (ISO 100), between -100 and 100; default: automatic. Does not affect the EXR.
+    #[arg(long, allow_hyphen_values = true)]
+    exposure: Option<f64>,
+    /// Also estimate the illuminance (lx) on the surface seen through each pixel (EXR channels E, stderr.E, mask.E).
+    #[arg(long)]
+    illuminance: bool,
+    /// How caustics (light → smooth glass/metal → surface seen) are rendered: light-tracing (traced from the lights and connected to the camera; the default) or path-tracing (camera paths only). Overrides render.caustics.
+    #[arg(long, value_parser = ["light-tracing", "path-tracing"])]
+    caustics: Option<String>,
+    /// Units of the report: si (lx, cd/m²) or imperial (fc, fL).
+    #[arg(long, default_value = "si", value_parser = ["si", "imperial"])]
+    units: String,
+    /// Render until every pixel's luminance (and illuminance, with --illuminance) is known to this relative error at 95 % confidence, e.g. `1%` or `0.01`; samples go where the error is still large.
+    #[arg(long, value_parser = parse_fraction)]
+    target_error: Option<f64>,
+    /// With --target-error: fraction of the eligible pixels that must meet it (default 1).
+    #[arg(long, default_value_t = 1.0)]
+    target_fraction: f64,
+    /// With --target-error: pixels darker than this luminance (cd/m²) need not meet it (default: 0.1 % of the image's mean luminance).
+    #[arg(long)]
+    target_floor: Option<f64>,
+    /// Upper bound of samples per pixel (default: --spp if given, else the scene's spp, or 65536 with --target-error; with --target-error it counts the decision buffer's samples too).
+    #[arg(long)]
+    max_spp: Option<u32>,
+    /// Stop after this long (e.g. `90s`, `10m`, `2h`), at the end of the pass in progress.
+    #[arg(long, value_parser = humantime::parse_duration)]
+    max_time: Option<std::time::Duration>,
+    /// Write a checkpoint (NAME.state, NAME.exr and NAME.png) this often (e.g. `60s`; `0s` disables).
+    #[arg(long, value_parser = humantime::parse_duration, default_value = "60s")]
+    checkpoint_interval: std::time::Duration,
+    /// Continue from NAME.state (refused if the scene or its settings changed).
+    #[arg(long)]
+    resume: bool,
+    /// Also write NAME.state at the end (for --resume to more samples, or `candela merge`).
+    #[arg(long)]
+    save_state: bool,
+    /// Also write false-colour maps NAME.luminance.png (and NAME.illuminance.png with --illuminance), automatic range; `candela falsecolour` offers every option.
+    #[arg(long)]
+    falsecolour: bool,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// `1%`, `0.5 %` or `0.01` → 0.01.
+fn parse_fraction(s: &str) -> Result<f64, String> {
+    let t = s.trim();
+    let (num, scale) = match t.strip_suffix('%') {
+        Some(n) => (n.trim(), 0.01),
+        None => (t, 1.0),
+    };
+    let v: f64 = num
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number or a percentage"))?;
+    let v = v * scale;
+    if v.is_finite() && v > 0.0 && v < 1.0 {
+        Ok(v)
+    } else {
+        Err(format!("{s:?} must lie strictly between 0 and 100 %"))
+    }
+}
+
+/// Set by the first Ctrl-C: the job ends at the end of its pass with a checkpoint.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+impl RenderOpts {
+    fn job(&self) -> RenderJob {
+        RenderJob {
+            scene: self.scene.clone(),
+            overrides: Overrides {
+                spp: self.spp,
+                seed: self.seed,
+                max_depth: self.max_depth,
+                illuminance: self.illuminance,
+                caustics: self.caustics.as_deref().map(|c| match c {
+                    "path-tracing" => candela::world::Caustics::PathTracing,
+                    _ => candela::world::Caustics::LightTracing,
+                }),
+            },
+            out: self.out.clone(),
+            threads: self.threads,
+            exposure_ev: self.exposure,
+            units: if self.units == "imperial" {
+                UnitSystem::Imperial
+            } else {
+                UnitSystem::Si
+            },
+            target: self.target_error.map(|relative| TargetError {
+                relative,
+                fraction: self.target_fraction,
+                floor_cd_m2: self.target_floor,
+            }),
+            max_spp: self.max_spp,
+            max_time: self.max_time,
+            checkpoint_interval: (!self.checkpoint_interval.is_zero())
+                .then_some(self.checkpoint_interval),
+            resume: self.resume,
+            save_state: self.save_state,
+            falsecolour: self.falsecolour,
+        }
+    }
+}
+
+/// The progress bar, and the target message printed as soon as the image is done.
+struct Bar {
+    bar: ProgressBar,
+    quiet: bool,
+}
+
+impl Progress for Bar {
+    fn start(&mut self, max_samples: u64) -> Result<()> {
+        // Ctrl-C ends the render with a checkpoint from here on; before, it ends the process.
+        ctrlc::set_handler(|| {
+            if STOP.swap(true, Ordering::SeqCst) {
+                eprintln!("\ninterrupted twice: exiting without a checkpoint");
+                candela::output::remove_temporary_files();
+                std::process::exit(130);
+            }
+            eprintln!(
+                "\ninterrupted: finishing with a checkpoint (press Ctrl-C again to quit at once)"
+            );
+        })
+        .context("installing the Ctrl-C handler")?;
+        if self.quiet {
+            return Ok(());
+        }
+        self.bar = ProgressBar::new(max_samples);
+        self.bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta} {msg}",
+            )
+            .expect("valid template"),
+        );
+        Ok(())
+    }
+
+    fn pass(&mut self, s: &candela::render::PassStatus) {
+        self.bar.set_position(s.samples);
+        if let Some(f) = s.converged_fraction {
+            self.bar
+                .set_message(format!("{:.1} % of pixels at target", 100.0 * f));
+        }
+    }
+
+    fn rendered(&mut self, done: &ImageDone) {
+        self.bar.finish_and_clear();
+        let (reason, last) = (done.reason, done.last);
+        match (reason, &done.target) {
+            (StopReason::TargetReached, Some(t)) => say!(
+                "target reached: {:.1} % of eligible pixels have a 95 % interval within ±{} % ",
+                100.0 * last.converged_fraction.unwrap_or(1.0),
+                100.0 * t.relative
+            ),
+            (_, Some(t)) => say!(
+                "target not reached ({}): {:.1} % of eligible pixels within ±{} % (goal {:.1} %)",
+                if reason == StopReason::MaxTime {
+                    "stopped at --max-time"
+                } else {
+                    "the pixels that miss it have --max-spp samples"
+                },
+                100.0 * last.converged_fraction.unwrap_or(0.0),
+                100.0 * t.relative,
+                100.0 * t.fraction
+            ),
+            (StopReason::MaxTime, None) => {
+                say!("stopped at --max-time before every pixel had its samples")
+            }
+            _ => {}
+        }
+    }
+}
+
+/// `candela render`: exit code 130 when interrupted.
+pub fn render(a: &RenderOpts) -> Result<()> {
+    let job = a.job();
+    // The options' own checks, whether or not the option is in effect (the job checks those
+    // that are again).
+    if let Some(n) = job.threads {
+        job::check_threads("--threads", n)?;
+    }
+    job::check_exposure(job.exposure_ev)?;
+    if !(a.target_fraction > 0.0 && a.target_fraction <= 1.0) {
+        bail!(
+            "--target-fraction must lie in (0, 1], got {}",
+            a.target_fraction
+        );
+    }
+    if let Some(f) = a.target_floor {
+        if !(f.is_finite() && f >= 0.0) {
+            bail!("--target-floor must be a luminance ≥ 0 in cd/m², got {f}");
+        }
+    }
+    let mut bar = Bar {
+        bar: ProgressBar::hidden(),
+        quiet: a.quiet,
+    };
+    let out = job::run(&job, &mut bar, &STOP)?;
+    bar.bar.finish_and_clear();
+    let elapsed = out.render.elapsed.as_secs_f64();
+    match out.outcome {
+        Outcome::Finished => {}
+        Outcome::InterruptedBeforeFirstPass => {
+            eprintln!(
+                "interrupted after {elapsed:.1} s, before the first pass finished: nothing written"
+            );
+            std::process::exit(130);
+        }
+        Outcome::InterruptedRender => {
+            eprintln!(
+                "interrupted after {elapsed:.1} s: wrote {} and {}; continue with --resume",
+                out.exr_path.display(),
+                out.state_path.display()
+            );
+            std::process::exit(130);
+        }
+        Outcome::InterruptedMeasuring => {
+            eprintln!(
+                "interrupted during the meter and grid measurements: wrote {} and {} (the render had finished); no meter, grid or report output",
+                out.exr_path.display(),
+                out.png_path.display()
+            );
+            std::process::exit(130);
+        }
+    }
+    let units = job.units;
+    for m in &out.meters {
+        let q = match m.kind {
+            MeterKind::Illuminance { .. } => Quantity::Illuminance,
+            MeterKind::Luminance { .. } => Quantity::Luminance,
+        };
+        let (k, unit) = (units.from_si(q, 1.0), units.symbol(q));
+        let e = &m.estimate;
+        say!(
+            "meter {:?}: {:.4} ± {:.4} {unit} (95 %, {} samples)",
+            m.name,
+            e.mean * k,
+            e.ci95() * k,
+            e.samples
+        );
+    }
+    for g in &out.grids {
+        let s = &g.stats;
+        let (k, u) = (
+            units.from_si(Quantity::Illuminance, 1.0),
+            units.symbol(Quantity::Illuminance),
+        );
+        say!(
+            "grid {:?} ({}×{}): E_min {:.2} {u}, E_avg {:.2} {u}, E_max {:.2} {u}, U0 {:.3}",
+            g.name,
+            g.nx,
+            g.ny,
+            s.min * k,
+            s.avg * k,
+            s.max * k,
+            s.u0.unwrap_or(0.0)
+        );
+    }
+    let r = &out.render;
+    say!(
+        "rendered {}×{} at {:.1} spp (image samples) in {:.2} s on {} threads: {:.3} M samples/s, {:.3} M rays/s; mean luminance {:.4} cd/m²; wrote {} and {}",
+        out.width,
+        out.height,
+        out.samples_per_pixel,
+        elapsed,
+        r.threads,
+        r.samples_per_second() / 1e6,
+        r.rays_per_second() / 1e6,
+        out.mean_luminance_cd_m2,
+        out.exr_path.display(),
+        out.png_path.display()
+    );
+    if r.stats.non_finite > 0 {
+        eprintln!(
+            "warning: {} samples gave a non-finite value and were counted as 0",
+            r.stats.non_finite
+        );
+    }
+    Ok(())
+}
+
+/// `candela merge`.
+pub fn merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()> {
+    let m = job::merge(states, out, exposure)?;
+    say!(
+        "merged {} renders (seeds {:?}): {:.1} image samples per pixel; wrote {}",
+        m.renders,
+        m.seeds,
+        m.samples_per_pixel,
+        m.exr_path.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,469 @@
+//! The whole render job as one library call: load and check the scene, render progressively
+//! (resume, checkpoints, target error, time limit, cancellation), write the image files, run
+//! the meters and grids, and write grid CSVs, heat maps, false-colour maps and the report.
+//! The command line, tests and other front ends call [`run`] and [`merge`]; what they show
+//! while it runs comes through [`Progress`].
+
+mod files;
+mod merge;
+
+pub use files::{
+    check_exposure, check_output_dir, film_layers, output_stem, with_suffix, write_exr, write_png,
+    MAX_ABS_EXPOSURE_EV,
+};
+pub use merge::{merge, MergeOutputs};
+
+use crate::film::Film;
+use crate::meter::{Estimate, GridStats, MeterKind};
+use crate::render::{PassStatus, Progressive, RenderResult, StopReason, TargetError};
+use crate::report::json::{grid_csv, grid_csv_path, report_json, write_text, ReportInput};
+use crate::report::units::{Quantity, UnitSystem as Units};
+use crate::scene::{self, Overrides};
+use crate::state::RenderState;
+use crate::world::World;
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+/// Everything `candela render` is asked to do ([`RenderJob::new`] gives the defaults).
+#[derive(Clone, Debug)]
+pub struct RenderJob {
+    /// The scene file (RON).
+    pub scene: PathBuf,
+    /// Overrides of the scene's render settings (spp, seed, max depth, illuminance, caustics).
+    pub overrides: Overrides,
+    /// Output directory or name (see [`output_stem`]); None: named after the scene in the
+    /// current directory.
+    pub out: Option<PathBuf>,
+    /// Worker threads (None: all cores); the image does not depend on it.
+    pub threads: Option<usize>,
+    /// Exposure of the PNG in EV (None: automatic); the EXR is absolute.
+    pub exposure_ev: Option<f64>,
+    /// Units of the report, grid CSVs and maps.
+    pub units: Units,
+    /// Render until every pixel is known to this error (adaptive sampling).
+    pub target: Option<TargetError>,
+    /// Most samples per pixel (None: the override's or the scene's spp; 65536 with a target).
+    pub max_spp: Option<u32>,
+    /// Stop after this long, at the end of the pass in progress.
+    pub max_time: Option<Duration>,
+    /// Write NAME.state, NAME.exr and NAME.png this often (None: never).
+    pub checkpoint_interval: Option<Duration>,
+    /// Continue from NAME.state.
+    pub resume: bool,
+    /// Also write NAME.state at the end.
+    pub save_state: bool,
+    /// Also write false-colour maps of luminance (and illuminance).
+    pub falsecolour: bool,
+}
+
+impl RenderJob {
+    /// A job that renders `scene` as its file says: outputs named after it in the current
+    /// directory, SI units, checkpoints every 60 s.
+    pub fn new(scene: impl Into<PathBuf>) -> Self {
+        Self {
+            scene: scene.into(),
+            overrides: Overrides::default(),
+            out: None,
+            threads: None,
+            exposure_ev: None,
+            units: Units::Si,
+            target: None,
+            max_spp: None,
+            max_time: None,
+            checkpoint_interval: Some(Duration::from_secs(60)),
+            resume: false,
+            save_state: false,
+            falsecolour: false,
+        }
+    }
+}
+
+/// What a front end shows while a job runs. Every method has an empty default.
+pub trait Progress {
+    /// The render starts, with at most `max_samples` samples over all pixels (the scene is
+    /// loaded and checked by then). An error ends the job before anything is rendered.
+    fn start(&mut self, _max_samples: u64) -> Result<()> {
+        Ok(())
+    }
+    /// A pass of the progressive render ended.
+    fn pass(&mut self, _status: &PassStatus) {}
+    /// The image is finished (before the meters and grids are measured).
+    fn rendered(&mut self, _image: &ImageDone) {}
+}
+
+/// A [`Progress`] that shows nothing.
+pub struct Silent;
+impl Progress for Silent {}
+
+/// How the image's render ended.
+#[derive(Clone, Copy, Debug)]
+pub struct ImageDone {
+    pub reason: StopReason,
+    /// The last pass's status (passes, samples, fraction of pixels at the target).
+    pub last: PassStatus,
+    pub target: Option<TargetError>,
+}
+
+/// One meter's result, in SI units (lx or cd/m²).
+#[derive(Clone, Debug)]
+pub struct MeterResult {
+    pub name: String,
+    pub kind: MeterKind,
+    pub estimate: Estimate,
+}
+
+/// One grid's result: its size and statistics in SI units (lx).
+#[derive(Clone, Debug)]
+pub struct GridResult {
+    pub name: String,
+    pub nx: u32,
+    pub ny: u32,
+    pub stats: GridStats,
+}
+
+/// How a job ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Everything was written.
+    Finished,
+    /// Stopped before the first pass ended: nothing was written.
+    InterruptedBeforeFirstPass,
+    /// Stopped during the render: a checkpoint (state, EXR, PNG) was written.
+    InterruptedRender,
+    /// Stopped during the meters and grids: the images were written, no report.
+    InterruptedMeasuring,
+}
+
+/// What a job wrote and measured.
+pub struct RenderOutputs {
+    pub outcome: Outcome,
+    pub exr_path: PathBuf,
+    pub png_path: PathBuf,
+    pub state_path: PathBuf,
+    /// The report (written when the outcome is [`Outcome::Finished`]).
+    pub report_path: PathBuf,
+    /// Every file written at the end (images, grid CSVs and heat maps, false-colour maps).
+    pub outputs: Vec<String>,
+    pub width: usize,
+    pub height: usize,
+    /// Image samples per pixel.
+    pub samples_per_pixel: f64,
+    pub render: RenderResult,
+    /// Mean luminance of the image, cd/m².
+    pub mean_luminance_cd_m2: f64,
+    pub meters: Vec<MeterResult>,
+    pub grids: Vec<GridResult>,
+}
+
+/// Largest worker-thread count accepted: 16 per available core.
+pub fn max_threads() -> usize {
+    16 * std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Refuses a thread count (named `flag` in the message) of 0 or above [`max_threads`].
+pub fn check_threads(flag: &str, n: usize) -> Result<()> {
+    if n == 0 {
+        bail!("{flag} must be at least 1, got 0");
+    }
+    let max = max_threads();
+    if n > max {
+        bail!(
+            "{flag} {n} is too many: at most {max} threads are accepted (16 per available core, {} cores here)",
+            max / 16
+        );
+    }
+    Ok(())
+}
+
+/// Checks the job's own settings (before the scene is read).
+fn check_job(job: &RenderJob) -> Result<()> {
+    if let Some(n) = job.threads {
+        check_threads("--threads", n)?;
+    }
+    check_exposure(job.exposure_ev)?;
+    if let Some(t) = &job.target {
+        if !(t.fraction > 0.0 && t.fraction <= 1.0) {
+            bail!("--target-fraction must lie in (0, 1], got {}", t.fraction);
+        }
+        if let Some(f) = t.floor_cd_m2 {
+            if !(f.is_finite() && f >= 0.0) {
+                bail!("--target-floor must be a luminance ≥ 0 in cd/m², got {f}");
+            }
+        }
+    }
+    if job.max_spp == Some(0) {
+        bail!("--max-spp must be at least 1");
+    }
+    Ok(())
+}
+
+/// The film to continue: from NAME.state with `resume` (refused if the scene, its settings or
+/// the adaptive mode changed), else a new one.
+fn initial_film(job: &RenderJob, world: &World, hash: u64, state_path: &Path) -> Result<Film> {
+    let (w, h) = (world.camera.width, world.camera.height);
+    if !job.resume {
+        return Ok(if job.target.is_some() {
+            Film::new_adaptive(w, h)
+        } else {
+            Film::new(w, h)
+        });
+    }
+    let st = RenderState::load(state_path)?;
+    if st.scene_hash != hash || st.seed != world.settings.seed {
+        bail!(
+            "cannot resume from {}: the scene file {}, a file it refers to (mesh, spectrum, luminaire data) or its settings (seed, max depth, resolution, illuminance, caustics) changed since the state was written",
+            state_path.display(),
+            job.scene.display()
+        );
+    }
+    if (st.film.width, st.film.height) != (w, h) {
+        bail!(
+            "{} is corrupt: its film is {}×{} but the scene it was rendered from (whose hash it carries) renders {w}×{h}",
+            state_path.display(),
+            st.film.width,
+            st.film.height
+        );
+    }
+    if st.film.decision.is_some() != job.target.is_some() {
+        bail!(
+            "cannot resume from {}: it was {} a --target-error; resume it the same way",
+            state_path.display(),
+            if st.film.decision.is_some() {
+                "rendered with"
+            } else {
+                "rendered without"
+            }
+        );
+    }
+    Ok(st.film)
+}
+
+/// Runs a whole render job. `stop` ends it early (at the end of the pass in progress; during
+/// the meters, at once): the outcome then says what was written.
+pub fn run(
+    job: &RenderJob,
+    progress: &mut dyn Progress,
+    stop: &AtomicBool,
+) -> Result<RenderOutputs> {
+    check_job(job)?;
+    let scene_path = job.scene.as_path();
+    let world = scene::load_world_for(
+        scene_path,
+        &job.overrides,
+        &scene::RunMode {
+            adaptive: job.target.is_some(),
+            falsecolour: job.falsecolour,
+        },
+    )?;
+    let scene_bytes = std::fs::read(scene_path)
+        .with_context(|| format!("cannot read scene file {}", scene_path.display()))?;
+    let hash = crate::state::scene_hash(&scene_bytes, &world);
+    let name = scene_path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "render".into());
+    let stem = output_stem(job.out.as_deref(), &name, &["exr", "png"]);
+    let (exr_path, png_path) = (with_suffix(&stem, ".exr"), with_suffix(&stem, ".png"));
+    check_output_dir(&stem)?;
+    let state_path = with_suffix(&stem, ".state");
+    let report_path = with_suffix(&stem, ".report.json");
+    let (w, h) = (world.camera.width, world.camera.height);
+    let prog = Progressive {
+        max_spp: job
+            .max_spp
+            .or(job.overrides.spp)
+            .unwrap_or(if job.target.is_some() {
+                65536
+            } else {
+                world.settings.spp
+            }),
+        target: job.target,
+        max_time: job.max_time,
+        checkpoint_interval: job.checkpoint_interval,
+    };
+    let mut film = initial_film(job, &world, hash, &state_path)?;
+    let illuminance = world.settings.illuminance;
+    let write_checkpoint = |film: &Film| -> Result<()> {
+        RenderState::new(scene_path, hash, &world, film.clone()).save(&state_path)?;
+        write_exr(scene_path, film, illuminance, &exr_path)?;
+        // The PNG too, so that the image pair on disk is always of the same estimate.
+        write_png(film, &png_path, job.exposure_ev)?;
+        Ok(())
+    };
+    progress.start(prog.max_spp as u64 * (w * h) as u64)?;
+    let mut last = PassStatus::default();
+    let (result, reason) = crate::render::render_progressive(
+        &world,
+        &mut film,
+        job.threads,
+        &prog,
+        stop,
+        &mut |s| {
+            last = *s;
+            progress.pass(s);
+        },
+        &mut |f| write_checkpoint(f),
+    )?;
+    let spp = result.film.total_samples() as f64 / (w * h) as f64;
+    let mut outputs = RenderOutputs {
+        outcome: Outcome::Finished,
+        exr_path: exr_path.clone(),
+        png_path: png_path.clone(),
+        state_path: state_path.clone(),
+        report_path: report_path.clone(),
+        outputs: Vec::new(),
+        width: w,
+        height: h,
+        samples_per_pixel: spp,
+        mean_luminance_cd_m2: result
+            .film
+            .pixels
+            .iter()
+            .map(|p| p.mean_xyz()[1])
+            .sum::<f64>()
+            / (w * h) as f64,
+        render: result,
+        meters: Vec::new(),
+        grids: Vec::new(),
+    };
+    let result = &outputs.render;
+    if reason == StopReason::Interrupted {
+        outputs.outcome = if result.film.total_samples() == 0 {
+            // No pass finished: an all-zero image would replace the files of an earlier render.
+            Outcome::InterruptedBeforeFirstPass
+        } else {
+            write_checkpoint(&result.film)?;
+            Outcome::InterruptedRender
+        };
+        return Ok(outputs);
+    }
+    if job.save_state || job.resume || state_path.exists() {
+        RenderState::new(scene_path, hash, &world, result.film.clone()).save(&state_path)?;
+    }
+    progress.rendered(&ImageDone {
+        reason,
+        last,
+        target: job.target,
+    });
+    let t_measure = std::time::Instant::now();
+    let measurements = crate::meter::measure_all_until(&world, stop);
+    let measure_seconds = t_measure.elapsed().as_secs_f64();
+    write_exr(scene_path, &result.film, illuminance, &exr_path)?;
+    write_png(&result.film, &png_path, job.exposure_ev)?;
+    let Some(measurements) = measurements else {
+        outputs.outcome = Outcome::InterruptedMeasuring;
+        return Ok(outputs);
+    };
+    let mut written = vec![
+        exr_path.display().to_string(),
+        png_path.display().to_string(),
+    ];
+    write_grids(&world, &measurements, &stem, job.units, &mut written)?;
+    if job.falsecolour {
+        write_falsecolour(&world, &exr_path, &stem, job.units, &mut written)?;
+    }
+    let report = report_json(&ReportInput {
+        scene_path,
+        world: &world,
+        render: result,
+        measurements: &measurements,
+        measure_seconds,
+        units: job.units,
+        outputs: written.clone(),
+        progressive: serde_json::json!({
+            "stop_reason": format!("{reason:?}"),
+            "passes": last.passes,
+            "max_spp": prog.max_spp,
+            "image_samples_per_pixel": spp,
+            "target_relative_error_95": job.target.map(|t| t.relative),
+            "target_fraction": job.target.map(|t| t.fraction),
+            "target_floor_cd_m2": job.target.and_then(|t| t.floor_cd_m2),
+            "fraction_of_eligible_pixels_at_target": last.converged_fraction,
+            "max_time_s": job.max_time.map(|d| d.as_secs_f64()),
+        }),
+    });
+    write_text(&report_path, &serde_json::to_string_pretty(&report)?)?;
+    outputs.outputs = written;
+    outputs.meters = world
+        .meters
+        .iter()
+        .zip(&measurements.meters)
+        .map(|(m, e)| MeterResult {
+            name: m.name.clone(),
+            kind: m.kind.clone(),
+            estimate: *e,
+        })
+        .collect();
+    outputs.grids = world
+        .grids
+        .iter()
+        .zip(&measurements.grids)
+        .map(|(g, est)| GridResult {
+            name: g.name.clone(),
+            nx: g.nx,
+            ny: g.ny,
+            stats: crate::meter::grid_stats(est),
+        })
+        .collect();
+    Ok(outputs)
+}
+
+/// Each grid's CSV and heat map, named after the grid.
+fn write_grids(
+    world: &World,
+    measurements: &crate::meter::Measurements,
+    stem: &Path,
+    units: Units,
+    written: &mut Vec<String>,
+) -> Result<()> {
+    for (k, (g, est)) in world.grids.iter().zip(&measurements.grids).enumerate() {
+        let path = grid_csv_path(stem, &g.name);
+        write_text(&path, &grid_csv(world, k, est, units))?;
+        written.push(path.display().to_string());
+        let png = path.with_extension("png");
+        let values = crate::report::heatmap::GridValues {
+            name: g.name.clone(),
+            nx: g.nx as usize,
+            ny: g.ny as usize,
+            values: est.iter().map(|e| e.mean).collect(),
+            stderr: est.iter().map(|e| e.stderr).collect(),
+            size_m: (g.edge_u.length() as f64, g.edge_v.length() as f64),
+        };
+        let settings = crate::report::falsecolour::FalsecolourSettings {
+            quantity: Quantity::Illuminance,
+            units,
+            ..Default::default()
+        };
+        crate::report::heatmap::write_grid_heatmap(&png, &values, &settings)?;
+        written.push(png.display().to_string());
+    }
+    Ok(())
+}
+
+/// False-colour maps of the written EXR: luminance, and illuminance when it was estimated.
+fn write_falsecolour(
+    world: &World,
+    exr_path: &Path,
+    stem: &Path,
+    units: Units,
+    written: &mut Vec<String>,
+) -> Result<()> {
+    let layers = crate::output::read_exr(exr_path)?;
+    let mut quantities = vec![(Quantity::Luminance, ".luminance.png")];
+    if world.settings.illuminance {
+        quantities.push((Quantity::Illuminance, ".illuminance.png"));
+    }
+    for (q, suffix) in quantities {
+        let path = with_suffix(stem, suffix);
+        let settings = crate::report::falsecolour::FalsecolourSettings {
+            quantity: q,
+            units,
+            ..Default::default()
+        };
+        crate::report::falsecolour::write_falsecolour(&path, &layers, &settings)?;
+        written.push(path.display().to_string());
+    }
+    Ok(())
+}
