@@ -39,7 +39,8 @@ impl SceneGeometry {
         }
     }
 
-    /// Primitive ids (as used in [`Hit::prim`]) of that object; empty if unknown.
+    /// Primitive ids (as used in [`Hit::prim`](super::Hit::prim)) of that object; empty if
+    /// unknown.
     pub fn primitives_of_object(&self, object: u32) -> &[u32] {
         match self.object_prims.binary_search_by_key(&object, |(o, _)| *o) {
             Ok(i) => &self.object_prims[i].1,
