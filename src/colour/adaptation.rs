@@ -1,6 +1,6 @@
 //! Chromatic adaptation (von Kries-type transforms: Bradford, CAT02, von Kries).
 
-use crate::colour::rgb::{mat3_inverse, mat3_mul, mat3_mul_vec, Mat3};
+use crate::colour::matrix::{mat3_inverse, mat3_mul, mat3_mul_vec, Mat3};
 
 /// Chromatic adaptation transform (the cone-response matrix of a von Kries-type CAT).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,4 +1,5 @@
-//! Illuminant generation: CIE daylight (D series) at any CCT, blackbodies.
+//! Illuminant generation: CIE daylight (D series) at any chromaticity or CCT, and CIE standard
+//! illuminant A from its formula.
 
 use crate::colour::tables::{daylight_basis, LEN};
 use crate::colour::temperature::cct_to_xy_cie_d;

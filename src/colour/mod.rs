@@ -1,5 +1,6 @@
-//! Colour science for candela: spectral tables, spectral distributions, colorimetry,
-//! RGB colourspaces, correlated colour temperature and colour rendering.
+//! Colour science for candela: spectral tables, spectral distributions, colorimetry, colour
+//! models, chromatic adaptation, RGB colourspaces, correlated colour temperature and colour
+//! rendering.
 //!
 //! Everything here is `f64` and deterministic, and every conversion is validated against
 //! the Python reference library colour-science 0.4.7 (see `tests/colour_science.rs` and
@@ -8,7 +9,9 @@
 pub mod adaptation;
 pub mod colorimetry;
 pub mod cri;
+pub mod grid;
 pub mod illuminants;
+pub mod matrix;
 pub mod models;
 pub mod planck;
 pub mod rgb;

@@ -1,7 +1,7 @@
 //! Planck's law for blackbody radiators.
 
+use crate::colour::grid::{LEN, START_NM};
 use crate::colour::sd::SpectralDistribution;
-use crate::colour::tables::{LEN, START_NM};
 
 /// First radiation constant c₁ = 2πhc², W·m² (colour-science `CONSTANT_C1`).
 pub const C1: f64 = 3.741771e-16;

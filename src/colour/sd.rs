@@ -1,6 +1,9 @@
-//! Spectral distributions: tabulated (wavelength, value) pairs with linear interpolation.
+//! Spectral distributions: tabulated (wavelength, value) pairs with linear interpolation, read
+//! from CSV and resampled to the 1 nm grid.
 
 use std::path::Path;
+
+use crate::colour::grid::{LEN, START_NM};
 
 /// A tabulated spectral distribution: `values[i]` at `wavelengths_nm[i]`.
 ///
@@ -159,20 +162,18 @@ impl SpectralDistribution {
     }
 
     /// Samples the distribution at 360..=830 nm every 1 nm with [`Self::value`].
-    pub fn to_table(&self) -> [f64; crate::colour::tables::LEN] {
-        let mut out = [0.0; crate::colour::tables::LEN];
+    pub fn to_table(&self) -> [f64; LEN] {
+        let mut out = [0.0; LEN];
         for (i, o) in out.iter_mut().enumerate() {
-            *o = self.value(crate::colour::tables::START_NM as f64 + i as f64);
+            *o = self.value(START_NM as f64 + i as f64);
         }
         out
     }
 
     /// Builds a distribution from a 1 nm table over 360..=830 nm.
-    pub fn from_table(values: &[f64; crate::colour::tables::LEN]) -> Self {
+    pub fn from_table(values: &[f64; LEN]) -> Self {
         Self {
-            wavelengths_nm: (0..crate::colour::tables::LEN)
-                .map(|i| crate::colour::tables::START_NM as f64 + i as f64)
-                .collect(),
+            wavelengths_nm: (0..LEN).map(|i| START_NM as f64 + i as f64).collect(),
             values: values.to_vec(),
         }
     }

@@ -7,12 +7,8 @@ use std::sync::LazyLock;
 
 use crate::colour::sd::SpectralDistribution;
 
-/// First tabulated wavelength, nm.
-pub const START_NM: u32 = 360;
-/// Last tabulated wavelength, nm.
-pub const END_NM: u32 = 830;
-/// Number of 1 nm samples from [`START_NM`] to [`END_NM`] inclusive.
-pub const LEN: usize = 471;
+/// The tables' wavelength grid.
+pub use crate::colour::grid::{END_NM, LEN, START_NM};
 
 /// CIE standard colorimetric observer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

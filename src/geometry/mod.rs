@@ -33,19 +33,24 @@
 //! let pdf_light = geo.pdf_prim_solid_angle(lp, hit.p, &lh); // same `reference` as when sampling
 //! ```
 
+mod bvh;
 mod io;
 mod prim;
+mod query;
 mod robust;
+mod sample;
 mod scene;
+mod traverse;
 
 pub mod generate;
 
 pub use io::{load_obj, load_ply};
+pub use query::RayHit;
 pub use robust::{
     gamma, next_float_down, next_float_up, offset_ray_origin, point_error_bound, shadow_ray,
     shadow_ray_between, MACHINE_EPSILON, SHADOW_EPSILON,
 };
-pub use scene::{RayHit, SceneGeometry};
+pub use scene::SceneGeometry;
 
 use glam::{Affine3A, Mat3, Quat, Vec2, Vec3};
 use std::path::PathBuf;

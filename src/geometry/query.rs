@@ -1,0 +1,384 @@
+//! Ray queries on the scene BVH: closest hit (full [`Hit`] or Embree-style [`RayHit`]),
+//! any hit for shadow rays (optionally letting some objects' primitives through), the
+//! per-primitive leaf tests they run, and a brute-force reference.
+
+use super::prim::{Prim, PrimT, RayPre};
+use super::traverse::{prefetch, traverse, LeafTest};
+use super::{Hit, SceneGeometry};
+use glam::{Vec3, Vec3A};
+
+/// A closest hit as [`SceneGeometry::intersect_basic`] returns it: what Embree's
+/// `rtcIntersect1` returns (t, u, v, Ng, primID, geomID).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Surface parameters, as [`Hit::uv`] (triangles: barycentrics b1, b2).
+    pub u: f32,
+    pub v: f32,
+    /// Geometric normal of the front face, not normalized (triangles: (v1 − v0) × (v2 − v0)).
+    pub ng: Vec3,
+    /// Primitive id, as [`Hit::prim`].
+    pub prim: u32,
+    /// Object id, as [`Hit::object`].
+    pub object: u32,
+}
+
+/// [`super::prim::intersect_triangle`] with the vertex transform and the edge functions in SIMD (the
+/// three vertices in three lanes); every operation and its rounding is the same as in the
+/// scalar test, so the results are bit-identical. `v` may also be the marker of a non-triangle
+/// primitive (NaN first vertex), which is then tested from `others`.
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+))]
+#[inline(always)]
+fn intersect_triangle_simd<const KZ: usize>(
+    r: &RayPre,
+    t_max: f32,
+    v: &[Vec3; 3],
+    others: &[Prim],
+) -> Option<PrimT> {
+    use std::arch::x86_64::*;
+    let kx = (KZ + 1) % 3;
+    let ky = (KZ + 2) % 3;
+    // SAFETY: AVX2 and FMA are enabled at compile time; both 8-float loads stay within the 9
+    // floats of `v`.
+    unsafe {
+        let ptr = v.as_ptr() as *const f32;
+        let lo = _mm256_loadu_ps(ptr);
+        let hi = _mm256_loadu_ps(ptr.add(1));
+        // Coordinate c of the three vertices (floats c, c + 3, c + 6) in lanes 0..3.
+        let coord = |c: usize| {
+            let (src, b) = if c == 0 { (lo, 0) } else { (hi, c as i32 - 1) };
+            _mm256_castps256_ps128(_mm256_permutevar8x32_ps(
+                src,
+                _mm256_setr_epi32(b, b + 3, b + 6, b + 6, 0, 0, 0, 0),
+            ))
+        };
+        let o = r.o.to_array();
+        let z = _mm_sub_ps(coord(KZ), _mm_set1_ps(o[KZ]));
+        let x = _mm_add_ps(
+            _mm_sub_ps(coord(kx), _mm_set1_ps(o[kx])),
+            _mm_mul_ps(_mm_set1_ps(r.sx), z),
+        );
+        let y = _mm_add_ps(
+            _mm_sub_ps(coord(ky), _mm_set1_ps(o[ky])),
+            _mm_mul_ps(_mm_set1_ps(r.sy), z),
+        );
+        // e_i = x_{i+1}·y_{i+2} − y_{i+1}·x_{i+2}: exact f64 products, one rounding in f64
+        // (the FMA subtracts an exact product) and one to f32, as `diff_of_products`.
+        let xd = _mm256_cvtps_pd(x);
+        let yd = _mm256_cvtps_pd(y);
+        const NEXT: i32 = 0b11_00_10_01;
+        const NEXT2: i32 = 0b11_01_00_10;
+        let e = _mm256_cvtpd_ps(_mm256_fmsub_pd(
+            _mm256_permute4x64_pd::<NEXT>(xd),
+            _mm256_permute4x64_pd::<NEXT2>(yd),
+            _mm256_mul_pd(
+                _mm256_permute4x64_pd::<NEXT>(yd),
+                _mm256_permute4x64_pd::<NEXT2>(xd),
+            ),
+        ));
+        let zero = _mm_setzero_ps();
+        let neg = _mm_movemask_ps(_mm_cmplt_ps(e, zero)) & 7;
+        let pos = _mm_movemask_ps(_mm_cmpgt_ps(e, zero)) & 7;
+        if neg != 0 && pos != 0 {
+            return None;
+        }
+        // A marker for a non-triangle primitive (see `SceneGeometry::tris`) gets here: its first
+        // vertex is NaN, so two of its edge functions are NaN and the sign test cannot reject it.
+        if v[0].x.is_nan() {
+            return others[v[1].x.to_bits() as usize].intersect::<KZ>(r, t_max);
+        }
+        let mut xa = [0.0f32; 4];
+        let mut ya = [0.0f32; 4];
+        let mut za = [0.0f32; 4];
+        let mut ea = [0.0f32; 4];
+        _mm_storeu_ps(xa.as_mut_ptr(), x);
+        _mm_storeu_ps(ya.as_mut_ptr(), y);
+        _mm_storeu_ps(za.as_mut_ptr(), z);
+        _mm_storeu_ps(ea.as_mut_ptr(), e);
+        let pt = [0, 1, 2].map(|i| Vec3::new(xa[i], ya[i], za[i]));
+        super::prim::triangle_tail(r, t_max, pt, [ea[0], ea[1], ea[2]])
+    }
+}
+
+impl SceneGeometry {
+    #[inline(always)]
+    fn ray_ok(origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        let (o, d) = (Vec3A::from(origin), Vec3A::from(dir));
+        let inf = Vec3A::splat(f32::INFINITY);
+        // NaN compares false, so this also rejects NaN components.
+        (o.abs().cmplt(inf) & d.abs().cmplt(inf)).all() && d.cmpne(Vec3A::ZERO).any() && t_max > 0.0
+    }
+
+    /// Closest hit with `t` in `(0, t_max)` (`t_max` may be `f32::INFINITY`). `dir` need not be
+    /// normalized (any finite non-zero vector); `t` is in units of `|dir|`. Returns `None` for
+    /// a miss or an invalid ray (non-finite, zero direction).
+    ///
+    /// This is [`SceneGeometry::intersect_basic`]'s traversal followed by the full hit record
+    /// (point, unit normals, shading normal, error bounds).
+    pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
+        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+            return None;
+        }
+        let pre = RayPre::new(origin, dir);
+        let (prim, t, a, b) = self.closest_dyn(&pre, t_max)?;
+        Some(self.make_hit(prim, &pre, t, a, b))
+    }
+
+    /// The closest hit as Embree's `rtcIntersect1` reports it: `t`, the surface parameters,
+    /// the unnormalized geometric normal, and the primitive and object ids. Same hits and
+    /// conventions as [`SceneGeometry::intersect`], without building the full [`Hit`].
+    pub fn intersect_basic(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<RayHit> {
+        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+            return None;
+        }
+        let pre = RayPre::new(origin, dir);
+        let (prim, t, u, v) = self.closest_dyn(&pre, t_max)?;
+        let tri = &self.tris[prim as usize];
+        let ng = if tri[0].x.is_nan() {
+            self.prim(prim).normal_at(origin + t * dir)
+        } else {
+            (tri[1] - tri[0]).cross(tri[2] - tri[0])
+        };
+        Some(RayHit {
+            t,
+            u,
+            v,
+            ng,
+            prim,
+            object: self.prim_object[prim as usize],
+        })
+    }
+
+    /// Closest-hit traversal: (primitive, t, a, b) of the closest hit.
+    #[inline(always)]
+    fn closest_dyn(&self, pre: &RayPre, t_max: f32) -> Option<(u32, f32, f32, f32)> {
+        match pre.kz {
+            0 => self.closest::<0>(pre, t_max),
+            1 => self.closest::<1>(pre, t_max),
+            _ => self.closest::<2>(pre, t_max),
+        }
+    }
+
+    #[inline(always)]
+    fn closest<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> Option<(u32, f32, f32, f32)> {
+        struct Closest<'a, const KZ: usize> {
+            geo: &'a SceneGeometry,
+            pre: &'a RayPre,
+            best: (u32, f32, f32, f32),
+        }
+        impl<const KZ: usize> LeafTest for Closest<'_, KZ> {
+            #[inline(always)]
+            fn leaf(&mut self, first: u32, unary: u32, mut t_max: f32) -> Option<f32> {
+                let (mut id, mut u) = (first, unary);
+                while u != 0 {
+                    if let Some((t, a, b)) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max) {
+                        self.best = (id, t, a, b);
+                        t_max = t;
+                    }
+                    id += 1;
+                    u >>= 1;
+                }
+                Some(t_max)
+            }
+            #[inline(always)]
+            fn prefetch(&self, first: u32) {
+                prefetch(self.geo.tris.as_ptr().wrapping_add(first as usize) as *const u8);
+            }
+        }
+        let mut c = Closest::<KZ> {
+            geo: self,
+            pre,
+            best: (u32::MAX, t_max, 0.0, 0.0),
+        };
+        traverse::<true>(&self.bvh.nodes, pre.o, pre.d, t_max, &mut c);
+        (c.best.0 != u32::MAX).then_some(c.best)
+    }
+
+    /// Ray test of primitive `id` (a leaf primitive id from the traversal).
+    #[inline(always)]
+    fn prim_intersect<const KZ: usize>(&self, id: u32, pre: &RayPre, t_max: f32) -> Option<PrimT> {
+        debug_assert!((id as usize) < self.tris.len());
+        // SAFETY: leaf primitive ids index `tris` (same length as the builder's input).
+        let v = unsafe { self.tris.get_unchecked(id as usize) };
+        #[cfg(all(
+            target_arch = "x86_64",
+            target_feature = "avx2",
+            target_feature = "fma"
+        ))]
+        return intersect_triangle_simd::<KZ>(pre, t_max, v, &self.others);
+        #[cfg(not(all(
+            target_arch = "x86_64",
+            target_feature = "avx2",
+            target_feature = "fma"
+        )))]
+        if v[0].x.is_nan() {
+            self.others[v[1].x.to_bits() as usize].intersect::<KZ>(pre, t_max)
+        } else {
+            super::prim::intersect_triangle::<KZ>(pre, t_max, v)
+        }
+    }
+
+    /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
+    /// brute-force tests).
+    fn make_hit(&self, prim: u32, pre: &RayPre, t: f32, a: f32, b: f32) -> Hit {
+        let v = &self.tris[prim as usize];
+        let g = if v[0].x.is_nan() {
+            self.others[v[1].x.to_bits() as usize].hit_geom(pre, t, a, b)
+        } else {
+            super::prim::triangle_hit_geom(v, a, b)
+        };
+        let mut ns = g.ng;
+        if let Some(idx) = self.prim_normals.get(prim as usize) {
+            if idx[0] != u32::MAX {
+                let n = g.bary.x * self.normals[idx[0] as usize]
+                    + g.bary.y * self.normals[idx[1] as usize]
+                    + g.bary.z * self.normals[idx[2] as usize];
+                let n = n.normalize_or_zero();
+                if n != Vec3::ZERO {
+                    ns = if n.dot(g.ng) < 0.0 { -n } else { n };
+                }
+            }
+        }
+        Hit {
+            t,
+            p: g.p,
+            ng: g.ng,
+            ns,
+            uv: g.uv,
+            prim,
+            object: self.prim_object[prim as usize],
+            front_face: pre.d.dot(g.ng) < 0.0,
+            error: g.error,
+        }
+    }
+
+    /// True if anything is hit with `t` in `(0, t_max)` (any-hit traversal, for shadow rays).
+    /// Same ray conventions as [`SceneGeometry::intersect`].
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+            return false;
+        }
+        let pre = RayPre::new(origin, dir);
+        let block = |_: u32, _: &RayPre, _: PrimT| false;
+        match pre.kz {
+            0 => self.any_hit::<0>(&pre, t_max, block),
+            1 => self.any_hit::<1>(&pre, t_max, block),
+            _ => self.any_hit::<2>(&pre, t_max, block),
+        }
+    }
+
+    /// Any-hit query that lets some objects through: true if a primitive of an object whose
+    /// `passes[object]` is false (or out of range) is hit with `t` in `(0, t_max)`. Every
+    /// crossing of a primitive of a passing object (a window pane) is handed to `crossed` as a
+    /// full [`Hit`], in no particular order, and the traversal goes on; `crossed` returns false
+    /// to stop it (the query then reports the ray as blocked). A sphere the ray enters is
+    /// crossed twice (in and out, when both are within `t_max`). Same ray conventions as
+    /// [`SceneGeometry::occluded`], and as cheap when nothing passing is hit.
+    pub fn occluded_except(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        passes: &[bool],
+        mut crossed: impl FnMut(&Hit) -> bool,
+    ) -> bool {
+        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+            return false;
+        }
+        let pre = RayPre::new(origin, dir);
+        let mut pass = |prim: u32, pre: &RayPre, (t, a, b): PrimT| {
+            let object = self.prim_object[prim as usize] as usize;
+            if !passes.get(object).copied().unwrap_or(false) {
+                return false;
+            }
+            let hit = self.make_hit(prim, pre, t, a, b);
+            if !crossed(&hit) {
+                return false;
+            }
+            // Entering a sphere (its near root): the way out is a second crossing.
+            if let (Prim::Sphere { center, radius }, true) = (self.prim(prim), hit.front_face) {
+                let o = hit.spawn_origin(dir);
+                let pre = RayPre::new(o, dir);
+                let t_left = t_max - (o - origin).dot(dir) / dir.length_squared();
+                if let Some((t, _, _)) = super::prim::intersect_sphere(&pre, t_left, center, radius)
+                {
+                    return crossed(&self.make_hit(prim, &pre, t, 0.0, 0.0));
+                }
+            }
+            true
+        };
+        match pre.kz {
+            0 => self.any_hit::<0>(&pre, t_max, &mut pass),
+            1 => self.any_hit::<1>(&pre, t_max, &mut pass),
+            _ => self.any_hit::<2>(&pre, t_max, &mut pass),
+        }
+    }
+
+    /// Any-hit traversal; a hit primitive for which `pass(prim, ray, (t, a, b))` is true does
+    /// not end it.
+    #[inline(always)]
+    fn any_hit<const KZ: usize>(
+        &self,
+        pre: &RayPre,
+        t_max: f32,
+        pass: impl FnMut(u32, &RayPre, PrimT) -> bool,
+    ) -> bool {
+        struct AnyHit<'a, F, const KZ: usize> {
+            geo: &'a SceneGeometry,
+            pre: &'a RayPre,
+            pass: F,
+            hit: bool,
+        }
+        impl<F: FnMut(u32, &RayPre, PrimT) -> bool, const KZ: usize> LeafTest for AnyHit<'_, F, KZ> {
+            #[inline(always)]
+            fn leaf(&mut self, first: u32, unary: u32, t_max: f32) -> Option<f32> {
+                let (mut id, mut u) = (first, unary);
+                while u != 0 {
+                    if let Some(h) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max) {
+                        if !(self.pass)(id, self.pre, h) {
+                            self.hit = true;
+                            return None;
+                        }
+                    }
+                    id += 1;
+                    u >>= 1;
+                }
+                Some(t_max)
+            }
+            #[inline(always)]
+            fn prefetch(&self, first: u32) {
+                prefetch(self.geo.tris.as_ptr().wrapping_add(first as usize) as *const u8);
+            }
+        }
+        let mut a = AnyHit::<_, KZ> {
+            geo: self,
+            pre,
+            pass,
+            hit: false,
+        };
+        traverse::<false>(&self.bvh.nodes, pre.o, pre.d, t_max, &mut a);
+        a.hit
+    }
+
+    /// Brute force closest hit over all primitives (no BVH) — for tests and debugging.
+    pub fn intersect_brute_force(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
+        if !Self::ray_ok(origin, dir, t_max) {
+            return None;
+        }
+        let pre = RayPre::new(origin, dir);
+        let mut tmax = t_max;
+        let mut best = None;
+        for i in 0..self.tris.len() {
+            if let Some((t, a, b)) = self.prim(i as u32).intersect_dyn(&pre, tmax) {
+                tmax = t;
+                best = Some((i as u32, a, b));
+            }
+        }
+        best.map(|(i, a, b)| self.make_hit(i, &pre, tmax, a, b))
+    }
+}

@@ -1,0 +1,138 @@
+//! Sampling the scene's primitives: uniformly by area, and by solid angle as seen from a
+//! reference point (the cone a sphere subtends, area sampling converted for the rest), with
+//! the matching densities.
+
+use super::prim::Prim;
+use super::{Hit, SceneGeometry, SurfacePoint};
+use glam::{Vec2, Vec3};
+
+impl SceneGeometry {
+    /// Surface area of a primitive (m²).
+    pub fn prim_area(&self, prim: u32) -> f32 {
+        self.prim(prim).area()
+    }
+
+    /// Uniform by area on the primitive: point, unit front-face geometric normal; the pdf
+    /// w.r.t. area is `1 / prim_area(prim)`. `u` ∈ [0,1)². The point's error bound is
+    /// [`super::point_error_bound`] (it is computed in f64).
+    pub fn sample_prim(&self, prim: u32, u: Vec2) -> SurfacePoint {
+        let (p, n) = self.prim(prim).sample_area(u);
+        SurfacePoint { p, n }
+    }
+
+    /// For a sphere seen from outside: (sinθmax², 1 − cosθmax) of the cone it subtends.
+    fn sphere_cone(center: Vec3, radius: f32, reference: Vec3) -> Option<(f64, f64)> {
+        let dc2 = (reference.as_dvec3() - center.as_dvec3()).length_squared();
+        let r2 = radius as f64 * radius as f64;
+        // Inside or (numerically) on the sphere: use area sampling instead.
+        if dc2 <= r2 * (1.0 + 1e-6) {
+            return None;
+        }
+        let sin2 = r2 / dc2;
+        let one_minus_cos = if sin2 < 0.00068523 {
+            // Taylor expansion for small angles (pbrt-v4).
+            sin2 / 2.0 + sin2 * sin2 / 8.0
+        } else {
+            1.0 - (1.0 - sin2).max(0.0).sqrt()
+        };
+        Some((sin2, one_minus_cos))
+    }
+
+    /// Solid-angle sampling as seen from `reference`: spheres seen from outside sample the
+    /// subtended cone uniformly; everything else (and a sphere seen from inside) samples area
+    /// uniformly and converts the density. Returns the point (with front-face normal) and its
+    /// pdf w.r.t. solid angle at `reference`, or `None` if that pdf would be 0 / infinite /
+    /// NaN (point at the reference, or seen exactly edge-on). Flat primitives are treated as
+    /// two-sided here (|cos|); emission sidedness is the caller's business.
+    pub fn sample_prim_solid_angle(
+        &self,
+        prim: u32,
+        reference: Vec3,
+        u: Vec2,
+    ) -> Option<(SurfacePoint, f32)> {
+        let pr = self.prim(prim);
+        if let Prim::Sphere { center, radius } = pr {
+            if let Some((sin2_max, one_minus_cos_max)) =
+                Self::sphere_cone(center, radius, reference)
+            {
+                // pbrt-v4 Sphere::Sample(ctx, u), in f64.
+                let (u0, u1) = (u.x as f64, u.y as f64);
+                let sin_max = sin2_max.sqrt();
+                let (sin2, cos) = if sin2_max < 0.00068523 {
+                    let s2 = sin2_max * u0;
+                    (s2, (1.0 - s2).sqrt())
+                } else {
+                    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+                    let c = (cos_max - 1.0) * u0 + 1.0;
+                    ((1.0 - c * c).max(0.0), c)
+                };
+                let cos_alpha = sin2 / sin_max + cos * (1.0 - sin2 / sin2_max).max(0.0).sqrt();
+                let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+                let phi = u1 * std::f64::consts::TAU;
+                let c = center.as_dvec3();
+                let wz = (c - reference.as_dvec3()).normalize();
+                let (tx, ty) = super::prim::basis(wz);
+                // Normal at the sampled point, pointing back toward the reference side.
+                let n = -(sin_alpha * phi.cos() * tx + sin_alpha * phi.sin() * ty + cos_alpha * wz);
+                let n = n.normalize();
+                let p = c + n * radius as f64;
+                let pdf = crate::sampling::uniform_cone_pdf(one_minus_cos_max);
+                let pdf = pdf as f32;
+                if !(pdf.is_finite() && pdf > 0.0) {
+                    return None;
+                }
+                return Some((
+                    SurfacePoint {
+                        p: p.as_vec3(),
+                        n: n.as_vec3(),
+                    },
+                    pdf,
+                ));
+            }
+        }
+        let (p, n) = pr.sample_area(u);
+        let pdf = Self::area_to_solid_angle(pr.area(), reference, p, n);
+        (pdf > 0.0 && pdf.is_finite()).then_some((SurfacePoint { p, n }, pdf))
+    }
+
+    fn area_to_solid_angle(area: f32, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
+        let w = p.as_dvec3() - reference.as_dvec3();
+        let d2 = w.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        let cos = (n.as_dvec3().dot(w) / d2.sqrt()).abs();
+        if cos == 0.0 || area <= 0.0 {
+            return 0.0;
+        }
+        let pdf = (d2 / (cos * area as f64)) as f32;
+        if pdf.is_finite() {
+            pdf
+        } else {
+            0.0
+        }
+    }
+
+    /// The pdf (solid angle at `reference`) that [`SceneGeometry::sample_prim_solid_angle`]
+    /// would have given for the direction that hit `prim` at `hit` (0 when it returns `None`).
+    pub fn pdf_prim_solid_angle(&self, prim: u32, reference: Vec3, hit: &Hit) -> f32 {
+        let pr = self.prim(prim);
+        if let Prim::Sphere { center, radius } = pr {
+            if let Some((_, one_minus_cos_max)) = Self::sphere_cone(center, radius, reference) {
+                let pdf = crate::sampling::uniform_cone_pdf(one_minus_cos_max) as f32;
+                return if pdf.is_finite() { pdf } else { 0.0 };
+            }
+        }
+        Self::area_to_solid_angle(pr.area(), reference, hit.p, hit.ng)
+    }
+
+    /// Solid angle (sr) subtended by a sphere primitive from outside, if `prim` is one and the
+    /// reference is outside it.
+    pub fn sphere_solid_angle(&self, prim: u32, reference: Vec3) -> Option<f32> {
+        if let Prim::Sphere { center, radius } = self.prim(prim) {
+            let (_, omc) = Self::sphere_cone(center, radius, reference)?;
+            return Some((std::f64::consts::TAU * omc) as f32);
+        }
+        None
+    }
+}
