@@ -147,7 +147,7 @@ impl CausticLights {
         let mut powers = Vec::new();
         for (i, l) in lights.iter().enumerate() {
             let p = l.power_lm(geom, scene_radius);
-            if l.can_emit_paths() && p > 0.0 && p.is_finite() {
+            if l.flags().can_emit_paths() && p > 0.0 && p.is_finite() {
                 chosen.push(i as u32);
                 powers.push(p);
             }
@@ -420,10 +420,10 @@ pub fn trace_light_path(
     }
     let light = &world.lights[caustics.lights[k] as usize];
     let mut wl = SampledWavelengths::sample_visible(u_wl);
-    let (origin, dir, mut beta) = if let Light::Distant {
+    let (origin, dir, mut beta) = if let Light::Distant(crate::light::DistantLight {
         to_light,
         irradiance,
-    } = light
+    }) = light
     {
         // Parallel light: flux per path = irradiance normal to the beam / density per area.
         let dir = -*to_light;

@@ -6,7 +6,7 @@
 mod common;
 use candela::colour::colorimetry::sd_to_xyz_absolute;
 use candela::colour::tables::Observer;
-use candela::light::Light;
+use candela::light::{AreaLight, Light};
 use common::*;
 
 /// Mean over pixels of the pixel means, and its standard error from the spread of the pixel
@@ -30,7 +30,7 @@ fn check(spectrum: &str, luminance: f64) {
         )],
     )"#
     ));
-    let Light::Area { radiance, .. } = &w.lights[0] else {
+    let Light::Area(AreaLight { radiance, .. }) = &w.lights[0] else {
         panic!("expected an area light")
     };
     let expected = sd_to_xyz_absolute(&radiance.to_f64_array(), Observer::Cie1931_2);

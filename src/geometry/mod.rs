@@ -106,6 +106,13 @@ pub enum GeometryError {
     },
 }
 
+/// The rotation by Euler angles `rotate_deg` (degrees): about the fixed X axis, then Y, then Z.
+pub fn euler_rotation_deg(rotate_deg: Vec3) -> Quat {
+    Quat::from_rotation_z(rotate_deg.z.to_radians())
+        * Quat::from_rotation_y(rotate_deg.y.to_radians())
+        * Quat::from_rotation_x(rotate_deg.x.to_radians())
+}
+
 /// Affine object-to-world transform built from scale, then rotation, then translation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {
@@ -130,9 +137,7 @@ impl Transform {
     /// then about Z by `rotate_deg.z` (right-handed, counter-clockwise when looking down the
     /// axis toward the origin), then translated by `translate`.
     pub fn from_trs(translate: Vec3, rotate_deg: Vec3, scale: Vec3) -> Self {
-        let r = Quat::from_rotation_z(rotate_deg.z.to_radians())
-            * Quat::from_rotation_y(rotate_deg.y.to_radians())
-            * Quat::from_rotation_x(rotate_deg.x.to_radians());
+        let r = euler_rotation_deg(rotate_deg);
         Self {
             matrix: Affine3A::from_scale_rotation_translation(scale, r, translate),
         }

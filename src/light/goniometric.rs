@@ -9,27 +9,100 @@
 //!
 //! Sampling: next-event estimation from a shading point toward a point light has a single
 //! direction, so the distribution matters only for emission (photons, light paths):
-//! [`Goniometric::sample_emission`] draws directions proportional to the tabulated flux of each
+//! [`GoniometricLight::sample_emission`] draws directions proportional to the tabulated flux of each
 //! table cell ([`crate::luminaire::Distribution::sample`]); the light sampler chooses between
 //! lights by their integrated lumens.
 
+use super::LightFlags;
 use crate::luminaire::Distribution;
 use crate::photometry::luminous_integral;
-use crate::spectrum::DenseSpectrum;
+use crate::scene::context::{Context, Role, SceneError};
+use crate::scene::schema::{SpectrumDesc, V3};
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Mat3, Vec2, Vec3};
 use std::sync::Arc;
 
 #[derive(Clone, Debug)]
-pub struct Goniometric {
+pub struct GoniometricLight {
+    /// Position, m.
     pub position: Vec3,
     /// Luminaire frame → world.
     pub rotation: Mat3,
+    /// The file's luminous intensity distribution, cd.
     pub distribution: Arc<Distribution>,
     /// Radiant intensity per candela of the table, W·sr⁻¹·nm⁻¹ per cd (times the multiplier).
     pub spectrum: DenseSpectrum,
 }
 
-impl Goniometric {
+/// The scene's fields of a goniometric light (see `LightDesc::Goniometric`).
+pub struct GoniometricDesc<'a> {
+    /// Photometric file, relative to the scene file.
+    pub file: &'a str,
+    pub position: V3,
+    /// Euler angles, degrees, about X, then Y, then Z.
+    pub rotate_deg: Option<V3>,
+    pub spectrum: &'a SpectrumDesc,
+    /// Total luminous flux to scale the table to, lm.
+    pub lumens: Option<f64>,
+    /// Factor on the candela (after `lumens`).
+    pub multiplier: Option<f64>,
+}
+
+impl GoniometricLight {
+    pub const FLAGS: LightFlags = LightFlags::DELTA_POSITION;
+
+    /// From `lights[i]`'s fields (`field` is `lights[i]`): the file's candela scaled to
+    /// `lumens` and by `multiplier`, aimed by `rotate_deg`.
+    pub fn build(ctx: &Context, field: &str, d: &GoniometricDesc) -> Result<Self, SceneError> {
+        let file = ctx.resolve(d.file);
+        let position = ctx.vec3(&format!("{field}.position"), d.position)?;
+        let rotate_deg = match d.rotate_deg {
+            Some(r) => ctx.vec3(&format!("{field}.rotate_deg"), r)?,
+            None => Vec3::ZERO,
+        };
+        let spectrum = ctx.spectrum(&format!("{field}.spectrum"), d.spectrum, Role::Emission)?;
+        let lumens = d
+            .lumens
+            .map(|v| ctx.nonneg(&format!("{field}.lumens"), v))
+            .transpose()?;
+        let multiplier = d
+            .multiplier
+            .map(|v| ctx.nonneg(&format!("{field}.multiplier"), v))
+            .transpose()?;
+        let phot = crate::luminaire::load(&file)
+            .map_err(|e| ctx.err(format!("{field}.file"), e.to_string()))?;
+        let distribution = phot.distribution();
+        let table_lm = distribution.lumens();
+        let mut k = multiplier.unwrap_or(1.0);
+        if let Some(target) = lumens {
+            if table_lm <= 0.0 || !table_lm.is_finite() {
+                return Err(ctx.err(
+                    format!("{field}.lumens"),
+                    format!("the file's distribution carries no flux ({table_lm} lm), so it cannot be scaled to {target} lm"),
+                ));
+            }
+            k *= target / table_lm;
+        }
+        let scale = crate::photometry::photometric_scale(&spectrum, k)
+            .map_err(|m| ctx.err(format!("{field}.spectrum"), m))?;
+        Ok(Self {
+            position,
+            rotation: Mat3::from_quat(crate::geometry::euler_rotation_deg(rotate_deg)),
+            distribution: Arc::new(distribution),
+            spectrum: spectrum.scaled(scale),
+        })
+    }
+
+    /// Radiant intensity (W·sr⁻¹·nm⁻¹) toward unit world direction `dir`.
+    pub fn intensity_toward(&self, dir: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
+        let cd = self.table_candela(dir) as f32;
+        if cd > 0.0 && cd.is_finite() {
+            self.spectrum.sample(wl) * cd
+        } else {
+            SampledSpectrum::ZERO
+        }
+    }
+
     /// Table candela (before the spectrum's multiplier) toward a unit world direction.
     pub fn table_candela(&self, dir_world: Vec3) -> f64 {
         let l = self.rotation.transpose() * dir_world;
@@ -56,41 +129,4 @@ impl Goniometric {
         let cd = self.distribution.eval(d);
         Some(((self.rotation * local).normalize(), pdf as f32, cd))
     }
-}
-
-/// Build the light for the scene loader. Errors are (field suffix, message), e.g.
-/// (".file", "…").
-pub fn build(
-    file: &std::path::Path,
-    position: Vec3,
-    rotate_deg: Vec3,
-    spectrum: DenseSpectrum,
-    lumens: Option<f64>,
-    multiplier: Option<f64>,
-) -> Result<super::Light, (String, String)> {
-    let phot = crate::luminaire::load(file).map_err(|e| (".file".to_string(), e.to_string()))?;
-    let distribution = phot.distribution();
-    let table_lm = distribution.lumens();
-    let mut k = multiplier.unwrap_or(1.0);
-    if let Some(target) = lumens {
-        if table_lm <= 0.0 || !table_lm.is_finite() {
-            return Err((
-                ".lumens".into(),
-                format!("the file's distribution carries no flux ({table_lm} lm), so it cannot be scaled to {target} lm"),
-            ));
-        }
-        k *= target / table_lm;
-    }
-    let scale = crate::photometry::photometric_scale(&spectrum, k)
-        .map_err(|m| (".spectrum".to_string(), m))?;
-    let r = rotate_deg;
-    let q = glam::Quat::from_rotation_z(r.z.to_radians())
-        * glam::Quat::from_rotation_y(r.y.to_radians())
-        * glam::Quat::from_rotation_x(r.x.to_radians());
-    Ok(super::Light::Goniometric(Box::new(Goniometric {
-        position,
-        rotation: Mat3::from_quat(q),
-        distribution: Arc::new(distribution),
-        spectrum: spectrum.scaled(scale),
-    })))
 }

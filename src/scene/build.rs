@@ -3,10 +3,10 @@
 
 use super::context::{Context, Role, SceneError};
 use super::schema::*;
-use crate::bxdf::{Diffuse, Frame, Material};
+use crate::bxdf::{Diffuse, Material};
 use crate::camera::{Camera, PixelFilter, ThinLens};
 use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
-use crate::light::{Light, LightSampler};
+use crate::light::{AreaLight, Light, LightFlags, LightSampler};
 use crate::meter::{Grid, MeasureSettings, Meter, MeterKind};
 use crate::spectrum::DenseSpectrum;
 use crate::world::{Object, RenderSettings, World};
@@ -422,7 +422,7 @@ pub fn build_for(
     // Objects and their shapes.
     let mut shapes: Vec<(Shape, u32)> = Vec::with_capacity(scene.objects.len());
     let mut objects = Vec::with_capacity(scene.objects.len());
-    let mut pending_area: Vec<(u32, String, DenseSpectrum, Amount, bool)> = Vec::new();
+    let mut pending_area: Vec<(u32, String, &EmissionDesc, DenseSpectrum)> = Vec::new();
     for (i, o) in scene.objects.iter().enumerate() {
         let field = object_field(i, o);
         let mat = *material_index.get(o.material.as_str()).ok_or_else(|| {
@@ -450,12 +450,8 @@ pub fn build_for(
             light: None,
         });
         if let Some(e) = &o.emission {
-            let s = ctx.spectrum(
-                &format!("{field}.emission.spectrum"),
-                &e.spectrum,
-                Role::Emission,
-            )?;
-            pending_area.push((i as u32, field.clone(), s, e.amount, e.two_sided));
+            let s = AreaLight::spectrum(&ctx, &field, e)?;
+            pending_area.push((i as u32, field.clone(), e, s));
         }
     }
     // Bounding spheres of the objects that scatter specularly: where light tracing aims.
@@ -484,55 +480,15 @@ pub fn build_for(
     // Lights.
     let mut lights: Vec<Light> = Vec::new();
     let mut infinite_lights = Vec::new();
-    for (object, field, s, amount, two_sided) in pending_area {
-        let prims = geometry.primitives_of_object(object).to_vec();
-        let areas: Vec<f64> = prims
-            .iter()
-            .map(|&p| geometry.prim_area(p) as f64)
-            .collect();
-        let total: f64 = areas.iter().sum();
-        if total.is_nan() || total <= 0.0 {
-            return Err(ctx.err(
-                format!("{field}.emission"),
-                "the emitting shape has zero area",
-            ));
-        }
-        let afield = format!("{field}.emission.amount");
-        let luminance = match amount {
-            Amount::Luminance(l) => ctx.nonneg(&afield, l)?,
-            Amount::Flux(phi) => {
-                // Lambertian: Φ = π L A per emitting face.
-                let sides = if two_sided { 2.0 } else { 1.0 };
-                ctx.nonneg(&afield, phi)? / (std::f64::consts::PI * total * sides)
-            }
-            other => {
-                return Err(ctx.err(
-                    afield,
-                    format!("{other:?} is not an amount for surface emission; use Luminance(cd/m²) or Flux(lm)"),
-                ))
-            }
-        };
-        let radiance = ctx.scaled_emission(
-            &format!("{field}.emission.spectrum"),
-            &afield,
-            &s,
-            luminance,
-        )?;
-        let cdf = crate::sampling::cdf_from_weights(&areas);
+    for (object, field, e, s) in pending_area {
+        let light = AreaLight::build(&ctx, &field, object, e, &s, &geometry)?;
         objects[object as usize].light = Some(lights.len() as u32);
-        lights.push(Light::Area {
-            object,
-            prims,
-            cdf,
-            total_area: total as f32,
-            radiance,
-            two_sided,
-        });
+        lights.push(Light::Area(light));
     }
     for (i, l) in scene.lights.iter().enumerate() {
         let field = format!("lights[{i}]");
         let light = build_light(&ctx, &field, l)?;
-        if matches!(light, Light::Environment { .. }) {
+        if light.flags().contains(LightFlags::INFINITE) {
             infinite_lights.push(lights.len() as u32);
         }
         lights.push(light);
@@ -695,31 +651,13 @@ fn build_meters(
 }
 
 fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, SceneError> {
-    let afield = format!("{field}.amount");
-    let sfield = format!("{field}.spectrum");
-    let scaled = |spec: &SpectrumDesc, amount: f64| ctx.emission(&sfield, &afield, spec, amount);
-    let wrong = |a: &Amount, allowed: &str| {
-        ctx.err(
-            &afield,
-            format!("{a:?} is not an amount for this light; use {allowed}"),
-        )
-    };
+    use crate::light::*;
     Ok(match l {
         LightDesc::Point {
             position,
             spectrum,
             amount,
-        } => {
-            let cd = match amount {
-                Amount::Intensity(i) => ctx.nonneg(&afield, *i)?,
-                Amount::Flux(phi) => ctx.nonneg(&afield, *phi)? / (4.0 * std::f64::consts::PI),
-                a => return Err(wrong(a, "Intensity(cd) or Flux(lm)")),
-            };
-            Light::Point {
-                position: ctx.vec3(&format!("{field}.position"), *position)?,
-                intensity: scaled(spectrum, cd)?,
-            }
-        }
+        } => Light::Point(PointLight::build(ctx, field, *position, spectrum, *amount)?),
         LightDesc::Spot {
             position,
             look_at,
@@ -727,88 +665,23 @@ fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, Scene
             outer_deg,
             spectrum,
             amount,
-        } => {
-            let p = ctx.vec3(&format!("{field}.position"), *position)?;
-            let t = ctx.vec3(&format!("{field}.look_at"), *look_at)?;
-            if (t - p).length_squared() == 0.0 {
-                return Err(ctx.err(format!("{field}.look_at"), "look_at equals position"));
-            }
-            let inner = ctx.finite(&format!("{field}.inner_deg"), *inner_deg as f64)?;
-            let outer = ctx.finite(&format!("{field}.outer_deg"), *outer_deg as f64)?;
-            let valid =
-                (0.0..=180.0).contains(&inner) && outer > 0.0 && outer <= 180.0 && inner <= outer;
-            if !valid {
-                return Err(ctx.err(
-                    format!("{field}.outer_deg"),
-                    format!("cone half-angles must satisfy 0 ≤ inner ≤ outer ≤ 180 and outer > 0, got inner {inner}, outer {outer}"),
-                ));
-            }
-            let (ci, co) = (inner.to_radians().cos(), outer.to_radians().cos());
-            let cd = match amount {
-                Amount::Intensity(i) => ctx.nonneg(&afield, *i)?,
-                // Φ = ∫ I dω = 2π I [(1 − cos θi) + (cos θi − cos θo)/2] for the smoothstep falloff.
-                Amount::Flux(phi) => {
-                    ctx.nonneg(&afield, *phi)?
-                        / (2.0 * std::f64::consts::PI * (1.0 - 0.5 * (ci + co)))
-                }
-                a => return Err(wrong(a, "Intensity(cd) or Flux(lm)")),
-            };
-            Light::Spot {
-                position: p,
-                frame: Frame::from_normal((t - p).normalize()),
-                cos_inner: ci as f32,
-                cos_outer: co as f32,
-                intensity: scaled(spectrum, cd)?,
-            }
-        }
+        } => Light::Spot(SpotLight::build(
+            ctx, field, *position, *look_at, *inner_deg, *outer_deg, spectrum, *amount,
+        )?),
         LightDesc::Distant {
             direction,
             spectrum,
             amount,
-        } => {
-            let d = ctx.vec3(&format!("{field}.direction"), *direction)?;
-            if d.length_squared() == 0.0 {
-                return Err(ctx.err(
-                    format!("{field}.direction"),
-                    "the direction is the zero vector",
-                ));
-            }
-            let lux = match amount {
-                Amount::Illuminance(e) => ctx.nonneg(&afield, *e)?,
-                a => return Err(wrong(a, "Illuminance(lx)")),
-            };
-            Light::Distant {
-                to_light: -d.normalize(),
-                irradiance: scaled(spectrum, lux)?,
-            }
-        }
+        } => Light::Distant(DistantLight::build(
+            ctx, field, *direction, spectrum, *amount,
+        )?),
         LightDesc::Environment {
             spectrum,
             amount,
             portals,
-        } => {
-            let lum = match amount {
-                Amount::Luminance(l) => ctx.nonneg(&afield, *l)?,
-                a => return Err(wrong(a, "Luminance(cd/m²)")),
-            };
-            let mut built = Vec::with_capacity(portals.len());
-            for (k, d) in portals.iter().enumerate() {
-                let pf = format!("{field}.portals[{k}]");
-                let origin = ctx.vec3(&format!("{pf}.origin"), d.origin)?;
-                let eu = ctx.vec3(&format!("{pf}.edge_u"), d.edge_u)?;
-                let ev = ctx.vec3(&format!("{pf}.edge_v"), d.edge_v)?;
-                built.push(crate::light::Portal::new(origin, eu, ev).ok_or_else(|| {
-                    ctx.err(
-                        &pf,
-                        "the portal has zero area (its edges are zero or parallel)",
-                    )
-                })?);
-            }
-            Light::Environment {
-                radiance: scaled(spectrum, lum)?,
-                portals: crate::light::Portals::new(built),
-            }
-        }
+        } => Light::Environment(EnvironmentLight::build(
+            ctx, field, spectrum, *amount, portals,
+        )?),
         LightDesc::Goniometric {
             file,
             position,
@@ -816,22 +689,18 @@ fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, Scene
             spectrum,
             lumens,
             multiplier,
-        } => crate::light::goniometric::build(
-            &ctx.resolve(file),
-            ctx.vec3(&format!("{field}.position"), *position)?,
-            match rotate_deg {
-                Some(r) => ctx.vec3(&format!("{field}.rotate_deg"), *r)?,
-                None => Vec3::ZERO,
+        } => Light::Goniometric(Box::new(GoniometricLight::build(
+            ctx,
+            field,
+            &goniometric::GoniometricDesc {
+                file,
+                position: *position,
+                rotate_deg: *rotate_deg,
+                spectrum,
+                lumens: *lumens,
+                multiplier: *multiplier,
             },
-            ctx.spectrum(&sfield, spectrum, Role::Emission)?,
-            lumens
-                .map(|v| ctx.nonneg(&format!("{field}.lumens"), v))
-                .transpose()?,
-            multiplier
-                .map(|v| ctx.nonneg(&format!("{field}.multiplier"), v))
-                .transpose()?,
-        )
-        .map_err(|(sub, m)| ctx.err(format!("{field}{sub}"), m))?,
+        )?)),
     })
 }
 
