@@ -123,7 +123,8 @@ mod tests {
                 disk += d.length_squared() as f64; // E[r²] = 1/2 on the unit disk
                 let w = cosine_hemisphere(u);
                 assert!(w.z >= 0.0 && (w.length() - 1.0).abs() < 1e-5);
-                hemi += 1.0 / cosine_hemisphere_pdf(w.z).max(1e-30) as f64;
+                let c = w.z as f64;
+                hemi += c * c / cosine_hemisphere_pdf(w.z) as f64;
                 let s = uniform_sphere(u);
                 assert!((s.length() - 1.0).abs() < 1e-5);
                 sphere += s.z as f64;
@@ -137,11 +138,19 @@ mod tests {
         }
         let m = (n * n) as f64;
         assert!((disk / m - 0.5).abs() < 1e-3, "E[r²] {}", disk / m);
-        // ∫ over the hemisphere of 1 = 2π, estimated as mean(1/pdf) (the grid misses the rim).
-        assert!((hemi / m / (2.0 * std::f64::consts::PI) - 1.0).abs() < 0.02);
-        assert!((sphere / m).abs() < 1e-3);
-        assert!((cone / m - std::f64::consts::TAU * omc).abs() < 1e-12);
-        assert!((tri / m - 1.0 / 3.0).abs() < 1e-3);
+        // ∫ cos²θ dω over the hemisphere = 2π/3, estimated as mean(cos²θ / pdf).
+        assert!(
+            (hemi / m / (2.0 * std::f64::consts::PI / 3.0) - 1.0).abs() < 1e-3,
+            "{}",
+            hemi / m
+        );
+        assert!((sphere / m).abs() < 1e-3, "E[z] {}", sphere / m);
+        assert!(
+            (cone / m - std::f64::consts::TAU * omc).abs() < 1e-9,
+            "{}",
+            cone / m
+        );
+        assert!((tri / m - 1.0 / 3.0).abs() < 1e-3, "{}", tri / m);
         let (r, phi) = concentric_disk_polar(0.75, 0.5);
         let d = concentric_disk(Vec2::new(0.75, 0.5));
         assert!(
