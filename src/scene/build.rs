@@ -3,7 +3,7 @@
 
 use super::context::{Context, Role, SceneError};
 use super::schema::*;
-use crate::bxdf::{Diffuse, Frame, Material};
+use crate::bxdf::{Frame, Material, MaterialFlags};
 use crate::camera::{Camera, PixelFilter, ThinLens};
 use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
 use crate::light::{Light, LightSampler};
@@ -404,17 +404,7 @@ pub fn build_for(
                 "\"black\" is predefined (it absorbs all light) and cannot be redefined; give this material another name",
             ));
         }
-        let mat = match m {
-            MaterialDesc::Diffuse { reflectance } => Material::Diffuse(Diffuse {
-                reflectance: ctx.spectrum(
-                    &format!("{field}.reflectance"),
-                    reflectance,
-                    Role::Reflectance,
-                )?,
-            }),
-            MaterialDesc::Black => Material::Black,
-            other => build_material(&ctx, &field, other)?,
-        };
+        let mat = Material::build(&ctx, &field, m)?;
         material_index.insert(name.as_str(), materials.len() as u32);
         materials.push(mat);
     }
@@ -461,7 +451,11 @@ pub fn build_for(
     // Bounding spheres of the objects that scatter specularly: where light tracing aims.
     let caustic_targets: Vec<(Vec3, f32)> = shapes
         .iter()
-        .filter(|(_, o)| materials[objects[*o as usize].material as usize].has_delta_lobe())
+        .filter(|(_, o)| {
+            materials[objects[*o as usize].material as usize]
+                .flags()
+                .contains(MaterialFlags::DELTA)
+        })
         .filter_map(|(shape, _)| crate::caustics::bounding_sphere(shape))
         .collect();
     let geometry = SceneGeometry::build(&shapes).map_err(|e| {
@@ -548,7 +542,11 @@ pub fn build_for(
 
     let mut see_through: Vec<bool> = objects
         .iter()
-        .map(|o| materials[o.material as usize].passes_straight())
+        .map(|o| {
+            materials[o.material as usize]
+                .flags()
+                .contains(MaterialFlags::STRAIGHT_THROUGH)
+        })
         .collect();
     if !see_through.contains(&true) {
         see_through.clear();
@@ -832,219 +830,5 @@ fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, Scene
                 .transpose()?,
         )
         .map_err(|(sub, m)| ctx.err(format!("{field}{sub}"), m))?,
-    })
-}
-
-/// The scattering materials other than `Diffuse`/`Black` (the BSDF library, src/bxdf).
-fn build_material(ctx: &Context, field: &str, m: &MaterialDesc) -> Result<Material, SceneError> {
-    use crate::bxdf::{self, ior};
-    let refl = |name: &str, d: &SpectrumDesc| {
-        ctx.spectrum(&format!("{field}.{name}"), d, Role::Reflectance)
-    };
-    let microfacet = |dist: DistributionDesc,
-                      masking: MaskingDesc,
-                      r: f32,
-                      rv: Option<f32>|
-     -> Result<bxdf::Microfacet, SceneError> {
-        let check = |name: &str, v: f32| {
-            if !v.is_finite() || v < 0.0 {
-                Err(ctx.err(
-                    format!("{field}.{name}"),
-                    format!("roughness must be a finite number ≥ 0, got {v}"),
-                ))
-            } else {
-                Ok(v)
-            }
-        };
-        let ax = check("roughness", r)?;
-        let ay = match rv {
-            Some(v) => check("roughness_v", v)?,
-            None => ax,
-        };
-        let dist = match dist {
-            DistributionDesc::Ggx => bxdf::Distribution::Ggx,
-            DistributionDesc::Beckmann => bxdf::Distribution::Beckmann,
-        };
-        let masking = match masking {
-            MaskingDesc::Smith => bxdf::Masking::Smith,
-            MaskingDesc::VCavity => bxdf::Masking::VCavity,
-        };
-        // Below 1e-3 the lobe is a delta; keep both axes consistent.
-        let (ax, ay) = if ax.max(ay) < 1e-3 {
-            (0.0, 0.0)
-        } else {
-            (ax.max(1e-3), ay.max(1e-3))
-        };
-        Ok(bxdf::Microfacet::new(dist, ax, ay, masking))
-    };
-    let dielectric_ior = |d: &IorDesc| -> Result<bxdf::Ior, SceneError> {
-        let f = format!("{field}.ior");
-        let ior = match d {
-            IorDesc::Constant(n) => bxdf::Ior::Constant(*n),
-            IorDesc::Glass(name) => ior::named_glass(name)
-                .ok_or_else(|| {
-                    ctx.err(
-                        &f,
-                        format!(
-                            "unknown glass {name:?}; known glasses: {}",
-                            ior::glass_names().join(", ")
-                        ),
-                    )
-                })?
-                .ior
-                .clone(),
-            IorDesc::Cauchy { a, b, c } => {
-                for v in [a, b, c] {
-                    ctx.finite(&f, *v)?;
-                }
-                bxdf::Ior::Cauchy {
-                    a: *a,
-                    b: *b,
-                    c: *c,
-                }
-            }
-            IorDesc::Sellmeier { b, c } => {
-                for v in b.iter().chain(c) {
-                    ctx.finite(&f, *v)?;
-                }
-                bxdf::Ior::Sellmeier { b: *b, c: *c }
-            }
-        };
-        let (lo, hi) = ior.range();
-        if !(lo.is_finite() && hi.is_finite()) || lo <= 0.0 {
-            return Err(ctx.err(
-                &f,
-                format!(
-                    "the refractive index must be finite and greater than 0 over 360–830 nm (range {lo} to {hi})"
-                ),
-            ));
-        }
-        Ok(ior)
-    };
-    Ok(match m {
-        MaterialDesc::OrenNayar {
-            reflectance,
-            sigma_deg,
-        } => {
-            let s = *sigma_deg;
-            if !s.is_finite() || !(0.0..=90.0).contains(&s) {
-                return Err(ctx.err(
-                    format!("{field}.sigma_deg"),
-                    format!("must be an angle in [0, 90] degrees, got {s}"),
-                ));
-            }
-            Material::OrenNayar(bxdf::OrenNayar::new(
-                refl("reflectance", reflectance)?,
-                s.to_radians(),
-            ))
-        }
-        MaterialDesc::Phong {
-            diffuse,
-            specular,
-            exponent,
-        } => {
-            let kd = refl("diffuse", diffuse)?;
-            let ks = refl("specular", specular)?;
-            if !exponent.is_finite() || *exponent < 0.0 {
-                return Err(ctx.err(
-                    format!("{field}.exponent"),
-                    format!("must be a finite number ≥ 0, got {exponent}"),
-                ));
-            }
-            if let Some(i) = (0..kd.values.len()).find(|&i| kd.values[i] + ks.values[i] > 1.0) {
-                return Err(ctx.err(
-                    field,
-                    format!(
-                        "diffuse + specular = {} at {} nm exceeds 1; the surface would create energy",
-                        kd.values[i] + ks.values[i],
-                        360 + i
-                    ),
-                ));
-            }
-            Material::Phong(bxdf::Phong::new(kd, ks, *exponent))
-        }
-        MaterialDesc::Conductor {
-            metal,
-            n,
-            k,
-            roughness,
-            roughness_v,
-            distribution,
-            masking,
-        } => {
-            let ior = match (metal, n, k) {
-                (Some(name), None, None) => ior::named_metal(name)
-                    .ok_or_else(|| {
-                        ctx.err(
-                            format!("{field}.metal"),
-                            format!(
-                                "unknown metal {name:?}; known metals: {}",
-                                ior::metal_names().join(", ")
-                            ),
-                        )
-                    })?
-                    .clone(),
-                (None, Some(n), Some(k)) => {
-                    for (name, d) in [("n", n), ("k", k)] {
-                        if matches!(d, SpectrumDesc::Blackbody(_) | SpectrumDesc::Rgb(..)) {
-                            return Err(ctx.err(
-                                format!("{field}.{name}"),
-                                "an optical constant must be Constant, Tabulated, Csv or Named",
-                            ));
-                        }
-                    }
-                    let n = ctx.spectrum(&format!("{field}.n"), n, Role::Emission)?;
-                    let k = ctx.spectrum(&format!("{field}.k"), k, Role::Emission)?;
-                    if n.min_value() <= 0.0 {
-                        return Err(ctx.err(
-                            format!("{field}.n"),
-                            "the refractive index n must be greater than 0",
-                        ));
-                    }
-                    bxdf::ConductorIor { n, k }
-                }
-                _ => {
-                    return Err(ctx.err(
-                        field,
-                        "give either `metal` (a name) or both `n` and `k` (spectra)",
-                    ))
-                }
-            };
-            Material::Conductor(bxdf::Conductor {
-                ior,
-                mf: microfacet(*distribution, *masking, *roughness, *roughness_v)?,
-            })
-        }
-        MaterialDesc::Dielectric {
-            ior,
-            roughness,
-            roughness_v,
-            distribution,
-        } => Material::Dielectric(bxdf::Dielectric {
-            ior: dielectric_ior(ior)?,
-            mf: microfacet(*distribution, MaskingDesc::Smith, *roughness, *roughness_v)?,
-        }),
-        MaterialDesc::ThinDielectric { ior } => Material::ThinDielectric(bxdf::ThinDielectric {
-            ior: dielectric_ior(ior)?,
-        }),
-        MaterialDesc::Coated {
-            base,
-            ior,
-            roughness,
-            distribution,
-        } => {
-            if !ior.is_finite() || *ior <= 0.0 {
-                return Err(ctx.err(
-                    format!("{field}.ior"),
-                    format!("the refractive index must be finite and greater than 0, got {ior}"),
-                ));
-            }
-            Material::Coated(bxdf::Coated::new(
-                refl("base", base)?,
-                *ior,
-                microfacet(*distribution, MaskingDesc::Smith, *roughness, None)?,
-            ))
-        }
-        MaterialDesc::Diffuse { .. } | MaterialDesc::Black => unreachable!("handled by build"),
     })
 }
