@@ -4,7 +4,7 @@
 use super::context::{Context, Role, SceneError};
 use super::schema::*;
 use crate::bxdf::{Frame, Material, MaterialFlags};
-use crate::camera::{Camera, PixelFilter, ThinLens};
+use crate::camera::{Camera, PixelFilter};
 use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
 use crate::light::{Light, LightSampler};
 use crate::meter::{Grid, MeasureSettings, Meter, MeterKind};
@@ -84,6 +84,40 @@ fn available_memory() -> Option<u64> {
         avail = avail.min(max.saturating_sub(cur));
     }
     Some(avail)
+}
+
+/// Refuse a film of `w`×`h` pixels beyond [`MAX_PIXELS`] or the memory available to a render
+/// in `mode` (see [`bytes_per_pixel`]).
+fn check_film(
+    ctx: &Context,
+    w: u32,
+    h: u32,
+    mode: &RunMode,
+    illuminance: bool,
+) -> Result<(), SceneError> {
+    if w as u64 * h as u64 > MAX_PIXELS {
+        return Err(ctx.err(
+            "camera.resolution",
+            format!(
+                "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {:.0} GiB)",
+                w as f64 * h as f64 * BYTES_PER_PIXEL as f64 / (1u64 << 30) as f64
+            ),
+        ));
+    }
+    let need = w as u64 * h as u64 * bytes_per_pixel(mode, illuminance);
+    if let Some(avail) = available_memory() {
+        if need > avail {
+            return Err(ctx.err(
+                "camera.resolution",
+                format!(
+                    "{w}×{h} pixels need about {:.1} GiB of memory but only {:.1} GiB is available",
+                    need as f64 / (1u64 << 30) as f64,
+                    avail as f64 / (1u64 << 30) as f64
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Load and build a scene file (for a plain render; see [`load_world_for`]).
@@ -271,80 +305,11 @@ pub fn build_for(
         sources: Default::default(),
     };
 
-    // Camera.
-    let c = &scene.camera;
-    let position = ctx.vec3("camera.position", c.position)?;
-    let look_at = ctx.vec3("camera.look_at", c.look_at)?;
-    let up = ctx.vec3("camera.up", c.up)?;
-    let forward = look_at - position;
-    if forward.length_squared() == 0.0 {
-        return Err(ctx.err("camera.look_at", "look_at equals position"));
-    }
-    if forward.normalize().cross(up).length_squared() < 1e-12 {
-        return Err(ctx.err("camera.up", "up is zero or parallel to the view direction"));
-    }
-    let vfov = ctx.finite("camera.vfov_deg", c.vfov_deg as f64)?;
-    if !(vfov > 0.0 && vfov < 180.0) {
-        return Err(ctx.err(
-            "camera.vfov_deg",
-            format!("the field of view must lie strictly between 0 and 180 degrees, got {vfov}"),
-        ));
-    }
-    let (w, h) = c.resolution;
-    if w == 0 || h == 0 {
-        return Err(ctx.err(
-            "camera.resolution",
-            format!("the resolution must be at least 1×1, got {w}×{h}"),
-        ));
-    }
-    if w as u64 * h as u64 > MAX_PIXELS {
-        return Err(ctx.err(
-            "camera.resolution",
-            format!(
-                "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {:.0} GiB)",
-                w as f64 * h as f64 * BYTES_PER_PIXEL as f64 / (1u64 << 30) as f64
-            ),
-        ));
-    }
+    // Camera, and the film its resolution asks for.
     let illuminance = scene.render.illuminance || overrides.illuminance;
-    let need = w as u64 * h as u64 * bytes_per_pixel(mode, illuminance);
-    if let Some(avail) = available_memory() {
-        if need > avail {
-            return Err(ctx.err(
-                "camera.resolution",
-                format!(
-                    "{w}×{h} pixels need about {:.1} GiB of memory but only {:.1} GiB is available",
-                    need as f64 / (1u64 << 30) as f64,
-                    avail as f64 / (1u64 << 30) as f64
-                ),
-            ));
-        }
-    }
-    let lens = match &c.lens {
-        None => None,
-        Some(l) => {
-            let r = ctx.finite("camera.lens.aperture_radius", l.aperture_radius as f64)?;
-            if r < 0.0 {
-                return Err(ctx.err(
-                    "camera.lens.aperture_radius",
-                    format!("must be ≥ 0, got {r}"),
-                ));
-            }
-            let f = ctx.positive("camera.lens.focus_distance", l.focus_distance as f64)?;
-            Some(ThinLens {
-                radius: r as f32,
-                focus_distance: f as f32,
-            })
-        }
-    };
-    let camera = Camera::new(
-        position,
-        look_at,
-        up,
-        vfov as f32,
-        (w as usize, h as usize),
-        lens,
-    );
+    let camera = Camera::build(&ctx, &scene.camera, |w, h| {
+        check_film(&ctx, w, h, mode, illuminance)
+    })?;
 
     // Render settings.
     let r = &scene.render;
@@ -359,16 +324,7 @@ pub fn build_for(
             format!("{max_depth} is unreasonably deep (limit 10000)"),
         ));
     }
-    let filter = match r.filter {
-        FilterDesc::Box => PixelFilter::Box,
-        FilterDesc::Tent { radius } => PixelFilter::Tent {
-            radius: ctx.positive("render.filter.radius", radius as f64)? as f32,
-        },
-        FilterDesc::Gaussian { sigma, radius } => PixelFilter::gaussian(
-            ctx.positive("render.filter.sigma", sigma as f64)? as f32,
-            ctx.positive("render.filter.radius", radius as f64)? as f32,
-        ),
-    };
+    let filter = PixelFilter::build(&ctx, &r.filter)?;
     let settings = RenderSettings {
         spp,
         max_depth,
