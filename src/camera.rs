@@ -512,4 +512,44 @@ mod tests {
             );
         }
     }
+
+    #[test]
+    fn build_checks_the_film_before_the_lens() {
+        use crate::scene::schema::LensDesc;
+        let path = std::path::Path::new("t.ron");
+        let ctx = Context {
+            path,
+            dir: Default::default(),
+            sources: Default::default(),
+        };
+        let mut desc = CameraDesc {
+            position: [0.0, 0.0, 0.0],
+            look_at: [0.0, 0.0, 1.0],
+            up: [0.0, 1.0, 0.0],
+            vfov_deg: 40.0,
+            resolution: (8, 6),
+            lens: Some(LensDesc {
+                aperture_radius: -1.0,
+                focus_distance: 1.0,
+            }),
+        };
+        let film_err = |w: u32, h: u32| Err(ctx.err("camera.resolution", format!("{w}×{h}")));
+        let e = Camera::build(&ctx, &desc, film_err)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`camera.resolution`: 8×6"), "{e}");
+        let e = Camera::build(&ctx, &desc, |_, _| Ok(()))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`camera.lens.aperture_radius`"), "{e}");
+        desc.resolution = (0, 6);
+        let e = Camera::build(&ctx, &desc, film_err)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("at least 1×1, got 0×6"), "{e}");
+        desc.resolution = (8, 6);
+        desc.lens = None;
+        let cam = Camera::build(&ctx, &desc, |_, _| Ok(())).unwrap();
+        assert_eq!((cam.width, cam.height), (8, 6));
+    }
 }

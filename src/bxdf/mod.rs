@@ -352,4 +352,62 @@ mod tests {
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-6);
         }
     }
+
+    #[test]
+    fn flags_follow_the_family_and_its_roughness() {
+        use crate::spectrum::DenseSpectrum;
+        let rough = Microfacet::isotropic(Distribution::Ggx, 0.3);
+        let smooth = Microfacet::isotropic(Distribution::Ggx, 0.0);
+        let gold = ior::named_metal("Au").unwrap().clone();
+        let base = DenseSpectrum::constant(0.5);
+        let cases = [
+            (Material::Black, MaterialFlags::BLACK),
+            (
+                Material::Diffuse(Diffuse {
+                    reflectance: base.clone(),
+                }),
+                MaterialFlags::NONE,
+            ),
+            (
+                Material::Conductor(Conductor {
+                    ior: gold.clone(),
+                    mf: smooth,
+                }),
+                MaterialFlags::ALL_DELTA,
+            ),
+            (
+                Material::Conductor(Conductor {
+                    ior: gold,
+                    mf: rough,
+                }),
+                MaterialFlags::NONE,
+            ),
+            (
+                Material::Dielectric(Dielectric {
+                    ior: Ior::Constant(1.5),
+                    mf: smooth,
+                }),
+                MaterialFlags::ALL_DELTA,
+            ),
+            (
+                Material::ThinDielectric(ThinDielectric {
+                    ior: Ior::Constant(1.5),
+                }),
+                MaterialFlags::ALL_DELTA | MaterialFlags::STRAIGHT_THROUGH,
+            ),
+            (
+                Material::Coated(Coated::new(base.clone(), 1.5, smooth)),
+                MaterialFlags::DELTA,
+            ),
+            (
+                Material::Coated(Coated::new(base, 1.5, rough)),
+                MaterialFlags::NONE,
+            ),
+        ];
+        for (m, want) in cases {
+            assert_eq!(m.flags(), want, "{m:?}");
+        }
+        assert!(MaterialFlags::ALL_DELTA.contains(MaterialFlags::DELTA));
+        assert!(!MaterialFlags::DELTA.contains(MaterialFlags::ALL_DELTA));
+    }
 }
