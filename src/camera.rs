@@ -4,6 +4,8 @@
 //! radiance arriving along its rays, so a pixel's Y is luminance in cd/m² (no vignetting or
 //! cos⁴ falloff, no exposure). Image rows run top to bottom.
 
+use crate::scene::context::{Context, SceneError};
+use crate::scene::schema::{CameraDesc, FilterDesc};
 use glam::{Vec2, Vec3};
 
 /// Pixel reconstruction filter. Samples are drawn from the filter itself (filter importance
@@ -75,6 +77,20 @@ impl GaussianTable {
 }
 
 impl PixelFilter {
+    /// The filter of `render.filter` from its description (radius and sigma in pixels).
+    pub fn build(ctx: &Context, desc: &FilterDesc) -> Result<Self, SceneError> {
+        Ok(match *desc {
+            FilterDesc::Box => PixelFilter::Box,
+            FilterDesc::Tent { radius } => PixelFilter::Tent {
+                radius: ctx.positive("render.filter.radius", radius as f64)? as f32,
+            },
+            FilterDesc::Gaussian { sigma, radius } => PixelFilter::gaussian(
+                ctx.positive("render.filter.sigma", sigma as f64)? as f32,
+                ctx.positive("render.filter.radius", radius as f64)? as f32,
+            ),
+        })
+    }
+
     pub fn gaussian(sigma: f32, radius: f32) -> Self {
         PixelFilter::Gaussian {
             sigma,
@@ -168,6 +184,68 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// The camera of the scene's `camera` from its description. `check_film` sees the
+    /// resolution (width, height in pixels, each ≥ 1) before the lens is read, so that the
+    /// film's limits are reported first.
+    pub fn build(
+        ctx: &Context,
+        c: &CameraDesc,
+        check_film: impl FnOnce(u32, u32) -> Result<(), SceneError>,
+    ) -> Result<Self, SceneError> {
+        let position = ctx.vec3("camera.position", c.position)?;
+        let look_at = ctx.vec3("camera.look_at", c.look_at)?;
+        let up = ctx.vec3("camera.up", c.up)?;
+        let forward = look_at - position;
+        if forward.length_squared() == 0.0 {
+            return Err(ctx.err("camera.look_at", "look_at equals position"));
+        }
+        if forward.normalize().cross(up).length_squared() < 1e-12 {
+            return Err(ctx.err("camera.up", "up is zero or parallel to the view direction"));
+        }
+        let vfov = ctx.finite("camera.vfov_deg", c.vfov_deg as f64)?;
+        if !(vfov > 0.0 && vfov < 180.0) {
+            return Err(ctx.err(
+                "camera.vfov_deg",
+                format!(
+                    "the field of view must lie strictly between 0 and 180 degrees, got {vfov}"
+                ),
+            ));
+        }
+        let (w, h) = c.resolution;
+        if w == 0 || h == 0 {
+            return Err(ctx.err(
+                "camera.resolution",
+                format!("the resolution must be at least 1×1, got {w}×{h}"),
+            ));
+        }
+        check_film(w, h)?;
+        let lens = match &c.lens {
+            None => None,
+            Some(l) => {
+                let r = ctx.finite("camera.lens.aperture_radius", l.aperture_radius as f64)?;
+                if r < 0.0 {
+                    return Err(ctx.err(
+                        "camera.lens.aperture_radius",
+                        format!("must be ≥ 0, got {r}"),
+                    ));
+                }
+                let f = ctx.positive("camera.lens.focus_distance", l.focus_distance as f64)?;
+                Some(ThinLens {
+                    radius: r as f32,
+                    focus_distance: f as f32,
+                })
+            }
+        };
+        Ok(Camera::new(
+            position,
+            look_at,
+            up,
+            vfov as f32,
+            (w as usize, h as usize),
+            lens,
+        ))
+    }
+
     /// `vfov_deg` is the full vertical field of view. `up` need not be orthogonal to the view
     /// direction but must not be parallel to it.
     pub fn new(
@@ -433,5 +511,45 @@ mod tests {
                 "{f:?}: {s} vs {second}"
             );
         }
+    }
+
+    #[test]
+    fn build_checks_the_film_before_the_lens() {
+        use crate::scene::schema::LensDesc;
+        let path = std::path::Path::new("t.ron");
+        let ctx = Context {
+            path,
+            dir: Default::default(),
+            sources: Default::default(),
+        };
+        let mut desc = CameraDesc {
+            position: [0.0, 0.0, 0.0],
+            look_at: [0.0, 0.0, 1.0],
+            up: [0.0, 1.0, 0.0],
+            vfov_deg: 40.0,
+            resolution: (8, 6),
+            lens: Some(LensDesc {
+                aperture_radius: -1.0,
+                focus_distance: 1.0,
+            }),
+        };
+        let film_err = |w: u32, h: u32| Err(ctx.err("camera.resolution", format!("{w}×{h}")));
+        let e = Camera::build(&ctx, &desc, film_err)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`camera.resolution`: 8×6"), "{e}");
+        let e = Camera::build(&ctx, &desc, |_, _| Ok(()))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`camera.lens.aperture_radius`"), "{e}");
+        desc.resolution = (0, 6);
+        let e = Camera::build(&ctx, &desc, film_err)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("at least 1×1, got 0×6"), "{e}");
+        desc.resolution = (8, 6);
+        desc.lens = None;
+        let cam = Camera::build(&ctx, &desc, |_, _| Ok(())).unwrap();
+        assert_eq!((cam.width, cam.height), (8, 6));
     }
 }

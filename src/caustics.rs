@@ -22,7 +22,7 @@
 //! non-specular vertex to the light, so it keeps all of its own). Each estimator is unbiased on
 //! its part, so the sum is unbiased, without MIS weights. Paths the camera sees through glass
 //! (camera-side vertex specular) stay with the camera paths. The same max depth applies.
-//! Passing straight through a window pane ([`crate::bxdf::Material::passes_straight`]) is a
+//! Passing straight through a window pane ([`crate::bxdf::MaterialFlags::STRAIGHT_THROUGH`]) is a
 //! null event on both sides, not a scattering: it neither counts as a vertex nor decides the
 //! split, and next-event estimation and the camera connections cross panes with their
 //! transmittance ([`crate::integrator::transmittance`]). Sunlight through a window is thus the
@@ -476,7 +476,7 @@ pub fn trace_light_path(
         let object = world.objects[hit.object as usize];
         let material = &world.materials[object.material as usize];
         // A black surface ends the path, but still receives illuminance (below).
-        let black = material.is_black();
+        let black = material.flags().contains(crate::bxdf::MaterialFlags::BLACK);
         depth += 1;
         material.prepare(&mut wl);
         let frame = Frame::from_normal(hit.ns);
@@ -490,7 +490,10 @@ pub fn trace_light_path(
         // the luminance the surface sends toward it (non-specular surfaces) and, with the
         // per-pixel illuminance on, for the illuminance on it (any surface but an emitter,
         // on the side the camera sees).
-        let want_l = !black && !material.is_specular();
+        let want_l = !black
+            && !material
+                .flags()
+                .contains(crate::bxdf::MaterialFlags::ALL_DELTA);
         let want_e = settings.illuminance && object.light.is_none();
         if depth >= 2 && (want_l || want_e) {
             if let Some(c) = camera.connect(hit.p, Vec2::new(lx, ly), filter.radius()) {
@@ -547,7 +550,10 @@ pub fn trace_light_path(
         // of the path without it). The illuminance on the pane itself was recorded above, on
         // arrival, whichever lobe is then chosen.
         let mut chosen = None;
-        if material.passes_straight() {
+        if material
+            .flags()
+            .contains(crate::bxdf::MaterialFlags::STRAIGHT_THROUGH)
+        {
             match choose_pane_lobe(material, wo, &mut sampler, &mut wl) {
                 None => return,
                 Some(PaneLobe::Straight(weight)) => {
@@ -567,7 +573,10 @@ pub fn trace_light_path(
         // Continue while a further surface is within the depth limit; the first scattering
         // must be specular (the paths whose light-side end is non-specular are the camera
         // paths' part).
-        if black || depth >= settings.max_depth || (depth == 1 && !material.has_delta_lobe()) {
+        if black
+            || depth >= settings.max_depth
+            || (depth == 1 && !material.flags().contains(crate::bxdf::MaterialFlags::DELTA))
+        {
             return;
         }
         let [ux, uy, uc, u_rr] = sampler.get4();

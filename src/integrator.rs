@@ -168,7 +168,7 @@ pub fn trace(
         }
 
         let material = &world.materials[object.material as usize];
-        if material.is_black() {
+        if material.flags().contains(crate::bxdf::MaterialFlags::BLACK) {
             break;
         }
         let frame = Frame::from_normal(hit.ns);
@@ -183,7 +183,10 @@ pub fn trace(
         // last real vertex), which matches next-event estimation, whose shadow rays pass
         // through the pane with its transmittance (see `transmittance`).
         let mut chosen = None;
-        if material.passes_straight() {
+        if material
+            .flags()
+            .contains(crate::bxdf::MaterialFlags::STRAIGHT_THROUGH)
+        {
             match choose_pane_lobe(material, wo, sampler, wl) {
                 None => break,
                 Some(PaneLobe::Straight(weight)) => {
@@ -209,7 +212,10 @@ pub fn trace(
         // 2-D pair (see `Sampler`): the point on the light, then the BSDF direction.
         let [ptx, pty, u_light, u_prim] = sampler.get4();
         let u_pt = glam::Vec2::new(ptx, pty);
-        let light_sample = if material.is_specular() {
+        let light_sample = if material
+            .flags()
+            .contains(crate::bxdf::MaterialFlags::ALL_DELTA)
+        {
             None
         } else {
             world.light_sampler.sample(u_light)
@@ -335,7 +341,7 @@ fn shadow_transmittance(
 /// pathological stacks of panes).
 pub const MAX_STRAIGHT_THROUGH: u32 = 64;
 
-/// The lobe a window pane ([`crate::bxdf::Material::passes_straight`]) chose for a path.
+/// The lobe a window pane ([`crate::bxdf::MaterialFlags::STRAIGHT_THROUGH`]) chose for a path.
 pub enum PaneLobe {
     /// Straight through: a null event, with this weight f·|cos|/pdf on the throughput.
     Straight(SampledSpectrum),

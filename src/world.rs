@@ -68,7 +68,7 @@ impl Default for RenderSettings {
 pub struct World {
     pub geometry: SceneGeometry,
     /// Per object: whether its material passes light straight through (a window pane, see
-    /// [`crate::bxdf::Material::passes_straight`]). Empty when no object does. Shadow rays
+    /// [`crate::bxdf::MaterialFlags::STRAIGHT_THROUGH`]). Empty when no object does. Shadow rays
     /// pass through those objects with their transmittance
     /// ([`crate::integrator::transmittance`]).
     pub see_through: Vec<bool>,

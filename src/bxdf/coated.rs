@@ -16,7 +16,9 @@
 use super::conductor::{flip_up, sample_microfacet_reflection};
 use super::fresnel::{fr_dielectric, reflect};
 use super::microfacet::Microfacet;
-use super::{same_hemisphere, BsdfSample};
+use super::{same_hemisphere, BsdfSample, MaterialFlags};
+use crate::scene::context::{Context, Role, SceneError};
+use crate::scene::schema::{DistributionDesc, MaskingDesc, SpectrumDesc};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
@@ -73,6 +75,45 @@ pub fn fresnel_diffuse_reflectance(eta: f32) -> f64 {
 }
 
 impl Coated {
+    /// The material at `field` from its description (`ior` the coat's constant index;
+    /// isotropic roughness, Smith masking).
+    pub fn build(
+        ctx: &Context,
+        field: &str,
+        base: &SpectrumDesc,
+        ior: f32,
+        roughness: f32,
+        distribution: DistributionDesc,
+    ) -> Result<Self, SceneError> {
+        if !ior.is_finite() || ior <= 0.0 {
+            return Err(ctx.err(
+                format!("{field}.ior"),
+                format!("the refractive index must be finite and greater than 0, got {ior}"),
+            ));
+        }
+        Ok(Self::new(
+            ctx.spectrum(&format!("{field}.base"), base, Role::Reflectance)?,
+            ior,
+            Microfacet::build(
+                ctx,
+                field,
+                distribution,
+                MaskingDesc::Smith,
+                roughness,
+                None,
+            )?,
+        ))
+    }
+
+    /// A smooth coat reflects through a delta lobe (beside the diffuse one).
+    pub fn flags(&self) -> MaterialFlags {
+        if self.mf.effectively_smooth() {
+            MaterialFlags::DELTA
+        } else {
+            MaterialFlags::NONE
+        }
+    }
+
     pub fn new(base: DenseSpectrum, eta: f32, mf: Microfacet) -> Self {
         let mut c = Self {
             base,

@@ -6,7 +6,9 @@
 use super::fresnel::{fr_conductor, reflect};
 use super::ior::ConductorIor;
 use super::microfacet::Microfacet;
-use super::{same_hemisphere, BsdfSample};
+use super::{same_hemisphere, BsdfSample, MaterialFlags};
+use crate::scene::context::{Context, SceneError};
+use crate::scene::schema::{DistributionDesc, MaskingDesc, SpectrumDesc};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, N_LAMBDA};
 use glam::{Vec2, Vec3};
 
@@ -17,6 +19,35 @@ pub struct Conductor {
 }
 
 impl Conductor {
+    /// The material at `field` from its description: a named `metal` or `n` and `k` spectra,
+    /// and the microfacet roughness.
+    #[allow(clippy::too_many_arguments)]
+    pub fn build(
+        ctx: &Context,
+        field: &str,
+        metal: Option<&str>,
+        n: Option<&SpectrumDesc>,
+        k: Option<&SpectrumDesc>,
+        roughness: f32,
+        roughness_v: Option<f32>,
+        distribution: DistributionDesc,
+        masking: MaskingDesc,
+    ) -> Result<Self, SceneError> {
+        Ok(Conductor {
+            ior: ConductorIor::build(ctx, field, metal, n, k)?,
+            mf: Microfacet::build(ctx, field, distribution, masking, roughness, roughness_v)?,
+        })
+    }
+
+    /// A smooth mirror is all delta; a rough one has no delta lobe.
+    pub fn flags(&self) -> MaterialFlags {
+        if self.mf.effectively_smooth() {
+            MaterialFlags::ALL_DELTA
+        } else {
+            MaterialFlags::NONE
+        }
+    }
+
     #[inline]
     fn fresnel(&self, cos: f32, wl: &SampledWavelengths) -> SampledSpectrum {
         let (n, k) = self.ior.sample(wl);

@@ -12,7 +12,9 @@
 use super::fresnel::{fr_dielectric, reflect, refract};
 use super::ior::Ior;
 use super::microfacet::Microfacet;
-use super::BsdfSample;
+use super::{BsdfSample, MaterialFlags};
+use crate::scene::context::{Context, SceneError};
+use crate::scene::schema::{DistributionDesc, IorDesc, MaskingDesc};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -35,6 +37,37 @@ fn lanes(v: f32, hero_only: bool) -> SampledSpectrum {
 }
 
 impl Dielectric {
+    /// The material at `field` from its description (Smith masking).
+    pub fn build(
+        ctx: &Context,
+        field: &str,
+        ior: &IorDesc,
+        roughness: f32,
+        roughness_v: Option<f32>,
+        distribution: DistributionDesc,
+    ) -> Result<Self, SceneError> {
+        Ok(Dielectric {
+            ior: Ior::build(ctx, &format!("{field}.ior"), ior)?,
+            mf: Microfacet::build(
+                ctx,
+                field,
+                distribution,
+                MaskingDesc::Smith,
+                roughness,
+                roughness_v,
+            )?,
+        })
+    }
+
+    /// A smooth interface is all delta; a rough one has no delta lobe.
+    pub fn flags(&self) -> MaterialFlags {
+        if self.mf.effectively_smooth() {
+            MaterialFlags::ALL_DELTA
+        } else {
+            MaterialFlags::NONE
+        }
+    }
+
     /// True if the index varies with wavelength.
     pub fn dispersive(&self) -> bool {
         !self.ior.is_constant()

@@ -1,7 +1,9 @@
 //! Lambertian diffuse reflection: f = ρ(λ)/π, sampled with the cosine-weighted hemisphere.
 //! Two-sided: it reflects on whichever side `wo` is.
 
-use super::{same_hemisphere, BsdfSample};
+use super::{same_hemisphere, BsdfSample, MaterialFlags};
+use crate::scene::context::{Context, Role, SceneError};
+use crate::scene::schema::SpectrumDesc;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
@@ -13,6 +15,23 @@ pub struct Diffuse {
 }
 
 impl Diffuse {
+    pub const FLAGS: MaterialFlags = MaterialFlags::NONE;
+
+    /// The material at `field` from its description.
+    pub fn build(
+        ctx: &Context,
+        field: &str,
+        reflectance: &SpectrumDesc,
+    ) -> Result<Self, SceneError> {
+        Ok(Diffuse {
+            reflectance: ctx.spectrum(
+                &format!("{field}.reflectance"),
+                reflectance,
+                Role::Reflectance,
+            )?,
+        })
+    }
+
     pub fn eval(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
         if !same_hemisphere(wo, wi) {
             return SampledSpectrum::ZERO;

@@ -5,6 +5,8 @@
 //! Sellmeier: n² = 1 + Σᵢ Bᵢ λ² / (λ² − Cᵢ), λ in µm, Cᵢ in µm² (SCHOTT catalogue form).
 //! Cauchy: n = A + B/λ² + C/λ⁴, λ in nm.
 
+use crate::scene::context::{Context, Role, SceneError};
+use crate::scene::schema::{IorDesc, SpectrumDesc};
 use crate::spectrum::{DenseSpectrum, SampledWavelengths, N_LAMBDA};
 use std::sync::OnceLock;
 
@@ -26,6 +28,52 @@ pub enum Ior {
 }
 
 impl Ior {
+    /// A dielectric's index from its description at `field`, positive and finite over
+    /// 360–830 nm.
+    pub fn build(ctx: &Context, field: &str, desc: &IorDesc) -> Result<Self, SceneError> {
+        let ior = match desc {
+            IorDesc::Constant(n) => Ior::Constant(*n),
+            IorDesc::Glass(name) => named_glass(name)
+                .ok_or_else(|| {
+                    ctx.err(
+                        field,
+                        format!(
+                            "unknown glass {name:?}; known glasses: {}",
+                            glass_names().join(", ")
+                        ),
+                    )
+                })?
+                .ior
+                .clone(),
+            IorDesc::Cauchy { a, b, c } => {
+                for v in [a, b, c] {
+                    ctx.finite(field, *v)?;
+                }
+                Ior::Cauchy {
+                    a: *a,
+                    b: *b,
+                    c: *c,
+                }
+            }
+            IorDesc::Sellmeier { b, c } => {
+                for v in b.iter().chain(c) {
+                    ctx.finite(field, *v)?;
+                }
+                Ior::Sellmeier { b: *b, c: *c }
+            }
+        };
+        let (lo, hi) = ior.range();
+        if !(lo.is_finite() && hi.is_finite()) || lo <= 0.0 {
+            return Err(ctx.err(
+                field,
+                format!(
+                    "the refractive index must be finite and greater than 0 over 360–830 nm (range {lo} to {hi})"
+                ),
+            ));
+        }
+        Ok(ior)
+    }
+
     /// Index at wavelength `nm`.
     #[inline]
     pub fn at(&self, nm: f32) -> f32 {
@@ -136,6 +184,55 @@ pub struct ConductorIor {
 }
 
 impl ConductorIor {
+    /// The conductor's index of the material at `field`: either a named `metal` or both
+    /// optical constants `n` and `k` as spectra.
+    pub fn build(
+        ctx: &Context,
+        field: &str,
+        metal: Option<&str>,
+        n: Option<&SpectrumDesc>,
+        k: Option<&SpectrumDesc>,
+    ) -> Result<Self, SceneError> {
+        Ok(match (metal, n, k) {
+            (Some(name), None, None) => named_metal(name)
+                .ok_or_else(|| {
+                    ctx.err(
+                        format!("{field}.metal"),
+                        format!(
+                            "unknown metal {name:?}; known metals: {}",
+                            metal_names().join(", ")
+                        ),
+                    )
+                })?
+                .clone(),
+            (None, Some(n), Some(k)) => {
+                for (name, d) in [("n", n), ("k", k)] {
+                    if matches!(d, SpectrumDesc::Blackbody(_) | SpectrumDesc::Rgb(..)) {
+                        return Err(ctx.err(
+                            format!("{field}.{name}"),
+                            "an optical constant must be Constant, Tabulated, Csv or Named",
+                        ));
+                    }
+                }
+                let n = ctx.spectrum(&format!("{field}.n"), n, Role::Emission)?;
+                let k = ctx.spectrum(&format!("{field}.k"), k, Role::Emission)?;
+                if n.min_value() <= 0.0 {
+                    return Err(ctx.err(
+                        format!("{field}.n"),
+                        "the refractive index n must be greater than 0",
+                    ));
+                }
+                ConductorIor { n, k }
+            }
+            _ => {
+                return Err(ctx.err(
+                    field,
+                    "give either `metal` (a name) or both `n` and `k` (spectra)",
+                ))
+            }
+        })
+    }
+
     #[inline]
     pub fn sample(&self, wl: &SampledWavelengths) -> ([f32; N_LAMBDA], [f32; N_LAMBDA]) {
         (self.n.sample(wl).0, self.k.sample(wl).0)

@@ -13,6 +13,8 @@
 //!   Visible Normals", solved here by safeguarded Newton iteration in f64 (as pbrt-v3's
 //!   numerical inversion). With V-cavity masking the normals are drawn from D(ωm) cos θm.
 
+use crate::scene::context::{Context, SceneError};
+use crate::scene::schema::{DistributionDesc, MaskingDesc};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -46,6 +48,47 @@ impl Microfacet {
             alpha_y,
             masking,
         }
+    }
+    /// The microfacet lobe of the material at `field` from its description: `roughness` (α
+    /// along the tangent) and `roughness_v` (α along the bitangent; default: isotropic).
+    pub fn build(
+        ctx: &Context,
+        field: &str,
+        dist: DistributionDesc,
+        masking: MaskingDesc,
+        roughness: f32,
+        roughness_v: Option<f32>,
+    ) -> Result<Self, SceneError> {
+        let check = |name: &str, v: f32| {
+            if !v.is_finite() || v < 0.0 {
+                Err(ctx.err(
+                    format!("{field}.{name}"),
+                    format!("roughness must be a finite number ≥ 0, got {v}"),
+                ))
+            } else {
+                Ok(v)
+            }
+        };
+        let ax = check("roughness", roughness)?;
+        let ay = match roughness_v {
+            Some(v) => check("roughness_v", v)?,
+            None => ax,
+        };
+        let dist = match dist {
+            DistributionDesc::Ggx => Distribution::Ggx,
+            DistributionDesc::Beckmann => Distribution::Beckmann,
+        };
+        let masking = match masking {
+            MaskingDesc::Smith => Masking::Smith,
+            MaskingDesc::VCavity => Masking::VCavity,
+        };
+        // Below 1e-3 the lobe is a delta; keep both axes consistent.
+        let (ax, ay) = if ax.max(ay) < 1e-3 {
+            (0.0, 0.0)
+        } else {
+            (ax.max(1e-3), ay.max(1e-3))
+        };
+        Ok(Self::new(dist, ax, ay, masking))
     }
     pub fn isotropic(dist: Distribution, alpha: f32) -> Self {
         Self::new(dist, alpha, alpha, Masking::Smith)

@@ -12,6 +12,10 @@
 //! in `sample` when a smooth interface refracts — through
 //! [`SampledWavelengths::terminate_secondary`]; it then returns values in lane 0 only, and `pdf`
 //! is always the hero wavelength's.
+//!
+//! What the integrators need to know about a material before scattering (does it absorb
+//! everything, is it a delta, does it pass light straight through) is one [`MaterialFlags`]
+//! value, each family's `FLAGS` (or `flags()` where roughness decides).
 
 pub mod coated;
 pub mod conductor;
@@ -24,6 +28,8 @@ pub mod oren_nayar;
 pub mod phong;
 pub mod thin_dielectric;
 
+use crate::scene::context::{Context, SceneError};
+use crate::scene::schema::MaterialDesc;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -59,6 +65,48 @@ pub enum Material {
     Black,
 }
 
+/// Type-level facts about a material that the integrators test before scattering. Combine with
+/// `|`; test with [`MaterialFlags::contains`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MaterialFlags(u8);
+
+impl MaterialFlags {
+    /// None of the facts below.
+    pub const NONE: Self = Self(0);
+    /// Scatters nothing, so paths can stop at it.
+    pub const BLACK: Self = Self(1);
+    /// `sample` can return a delta (specular) lobe: smooth metal and glass, thin slabs, smooth
+    /// coats. Such surfaces make caustics.
+    pub const DELTA: Self = Self(1 << 1);
+    /// Every lobe is a delta, so light sampling cannot contribute (implies [`Self::DELTA`]).
+    pub const ALL_DELTA: Self = Self(1 << 2 | 1 << 1);
+    /// Passes light *straight through* (transmission that keeps the direction: a thin slab).
+    /// The integrators treat such a transmission as a null event: it is not a scattering
+    /// vertex (no depth, no MIS state, no caustic), and shadow rays pass through the surface
+    /// weighted by [`Material::straight_transmittance`], so that light sampling sees the sun
+    /// or a lamp through a window pane.
+    pub const STRAIGHT_THROUGH: Self = Self(1 << 3);
+
+    /// Both sets of facts.
+    #[inline]
+    pub const fn union(self, other: Self) -> Self {
+        Self(self.0 | other.0)
+    }
+    /// Whether every fact of `other` holds.
+    #[inline]
+    pub const fn contains(self, other: Self) -> bool {
+        self.0 & other.0 == other.0
+    }
+}
+
+impl std::ops::BitOr for MaterialFlags {
+    type Output = Self;
+    #[inline]
+    fn bitor(self, other: Self) -> Self {
+        self.union(other)
+    }
+}
+
 /// Result of sampling a BSDF.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
@@ -73,6 +121,88 @@ pub struct BsdfSample {
 }
 
 impl Material {
+    /// The material at `field` (e.g. `materials["glass"]`) from its description.
+    pub fn build(ctx: &Context, field: &str, desc: &MaterialDesc) -> Result<Self, SceneError> {
+        Ok(match desc {
+            MaterialDesc::Diffuse { reflectance } => {
+                Material::Diffuse(Diffuse::build(ctx, field, reflectance)?)
+            }
+            MaterialDesc::OrenNayar {
+                reflectance,
+                sigma_deg,
+            } => Material::OrenNayar(OrenNayar::build(ctx, field, reflectance, *sigma_deg)?),
+            MaterialDesc::Phong {
+                diffuse,
+                specular,
+                exponent,
+            } => Material::Phong(Phong::build(ctx, field, diffuse, specular, *exponent)?),
+            MaterialDesc::Conductor {
+                metal,
+                n,
+                k,
+                roughness,
+                roughness_v,
+                distribution,
+                masking,
+            } => Material::Conductor(Conductor::build(
+                ctx,
+                field,
+                metal.as_deref(),
+                n.as_ref(),
+                k.as_ref(),
+                *roughness,
+                *roughness_v,
+                *distribution,
+                *masking,
+            )?),
+            MaterialDesc::Dielectric {
+                ior,
+                roughness,
+                roughness_v,
+                distribution,
+            } => Material::Dielectric(Dielectric::build(
+                ctx,
+                field,
+                ior,
+                *roughness,
+                *roughness_v,
+                *distribution,
+            )?),
+            MaterialDesc::ThinDielectric { ior } => {
+                Material::ThinDielectric(ThinDielectric::build(ctx, field, ior)?)
+            }
+            MaterialDesc::Coated {
+                base,
+                ior,
+                roughness,
+                distribution,
+            } => Material::Coated(Coated::build(
+                ctx,
+                field,
+                base,
+                *ior,
+                *roughness,
+                *distribution,
+            )?),
+            MaterialDesc::Black => Material::Black,
+        })
+    }
+
+    /// The material's [`MaterialFlags`].
+    #[inline]
+    pub fn flags(&self) -> MaterialFlags {
+        match self {
+            Material::Diffuse(_) => Diffuse::FLAGS,
+            Material::OrenNayar(_) => OrenNayar::FLAGS,
+            Material::Phong(_) => Phong::FLAGS,
+            Material::Conductor(m) => m.flags(),
+            Material::Dielectric(m) => m.flags(),
+            Material::ThinDielectric(_) => ThinDielectric::FLAGS,
+            Material::Coated(m) => m.flags(),
+            Material::Black => MaterialFlags::BLACK,
+        }
+    }
+
     /// Called once per surface hit, before `eval`, `pdf` or `sample`: a material whose
     /// scattering directions depend on wavelength (a rough dispersive dielectric) keeps only
     /// the hero wavelength here, so that light sampling and BSDF sampling at this vertex
@@ -130,23 +260,6 @@ impl Material {
             Material::Black => 0.0,
         }
     }
-    /// True if every lobe is a delta (light sampling cannot contribute).
-    pub fn is_specular(&self) -> bool {
-        match self {
-            Material::Conductor(m) => m.mf.effectively_smooth(),
-            Material::Dielectric(m) => m.mf.effectively_smooth(),
-            Material::ThinDielectric(_) => true,
-            _ => false,
-        }
-    }
-    /// Whether `sample` can return a delta (specular) lobe: smooth metal and glass, thin
-    /// slabs, smooth coats. Such surfaces make caustics.
-    pub fn has_delta_lobe(&self) -> bool {
-        match self {
-            Material::Coated(m) => m.mf.effectively_smooth(),
-            _ => self.is_specular(),
-        }
-    }
     /// Squared relative index of refraction η′² of the scattering `wo` → `wi` (local frame):
     /// (n_inside/n_outside)² when entering a dielectric, its inverse when leaving, 1 for
     /// reflection and for materials that do not refract. Radiance crossing the interface is
@@ -164,20 +277,11 @@ impl Material {
             _ => 1.0,
         }
     }
-    /// Whether the material can pass light *straight through* (transmission that keeps the
-    /// direction: a thin slab). The integrators treat such a transmission as a null event: it
-    /// is not a scattering vertex (no depth, no MIS state, no caustic), and shadow rays pass
-    /// through the surface weighted by [`Material::straight_transmittance`], so that light
-    /// sampling sees the sun or a lamp through a window pane.
-    #[inline]
-    pub fn passes_straight(&self) -> bool {
-        matches!(self, Material::ThinDielectric(_))
-    }
     /// Whether sampled scattering `wo` → `wi` (local frame) is the straight-through
-    /// transmission of a material that [`passes_straight`](Material::passes_straight).
+    /// transmission of a material with [`MaterialFlags::STRAIGHT_THROUGH`].
     #[inline]
     pub fn is_straight_through(&self, wo: Vec3, wi: Vec3) -> bool {
-        self.passes_straight() && wo.z * wi.z < 0.0
+        self.flags().contains(MaterialFlags::STRAIGHT_THROUGH) && wo.z * wi.z < 0.0
     }
     /// Fraction of radiance that passes straight through the surface at |cos θ| = `cos`
     /// (against the shading normal, as `sample` measures it), per wavelength; `None` for a
@@ -193,10 +297,6 @@ impl Material {
             Material::ThinDielectric(m) => Some(m.transmittance(cos, wl)),
             _ => None,
         }
-    }
-    /// True if the material scatters nothing, so paths can stop at it.
-    pub fn is_black(&self) -> bool {
-        matches!(self, Material::Black)
     }
 }
 
@@ -251,5 +351,63 @@ mod tests {
             let v = Vec3::new(0.2, 0.5, -0.7);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-6);
         }
+    }
+
+    #[test]
+    fn flags_follow_the_family_and_its_roughness() {
+        use crate::spectrum::DenseSpectrum;
+        let rough = Microfacet::isotropic(Distribution::Ggx, 0.3);
+        let smooth = Microfacet::isotropic(Distribution::Ggx, 0.0);
+        let gold = ior::named_metal("Au").unwrap().clone();
+        let base = DenseSpectrum::constant(0.5);
+        let cases = [
+            (Material::Black, MaterialFlags::BLACK),
+            (
+                Material::Diffuse(Diffuse {
+                    reflectance: base.clone(),
+                }),
+                MaterialFlags::NONE,
+            ),
+            (
+                Material::Conductor(Conductor {
+                    ior: gold.clone(),
+                    mf: smooth,
+                }),
+                MaterialFlags::ALL_DELTA,
+            ),
+            (
+                Material::Conductor(Conductor {
+                    ior: gold,
+                    mf: rough,
+                }),
+                MaterialFlags::NONE,
+            ),
+            (
+                Material::Dielectric(Dielectric {
+                    ior: Ior::Constant(1.5),
+                    mf: smooth,
+                }),
+                MaterialFlags::ALL_DELTA,
+            ),
+            (
+                Material::ThinDielectric(ThinDielectric {
+                    ior: Ior::Constant(1.5),
+                }),
+                MaterialFlags::ALL_DELTA | MaterialFlags::STRAIGHT_THROUGH,
+            ),
+            (
+                Material::Coated(Coated::new(base.clone(), 1.5, smooth)),
+                MaterialFlags::DELTA,
+            ),
+            (
+                Material::Coated(Coated::new(base, 1.5, rough)),
+                MaterialFlags::NONE,
+            ),
+        ];
+        for (m, want) in cases {
+            assert_eq!(m.flags(), want, "{m:?}");
+        }
+        assert!(MaterialFlags::ALL_DELTA.contains(MaterialFlags::DELTA));
+        assert!(!MaterialFlags::DELTA.contains(MaterialFlags::ALL_DELTA));
     }
 }

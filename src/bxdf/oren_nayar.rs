@@ -4,7 +4,9 @@
 //! A = 1 − σ²/(2(σ² + 0.33)), B = 0.45 σ²/(σ² + 0.09), σ the facet slope deviation (radians).
 //! Sampled with the cosine-weighted hemisphere. Two-sided like [`super::Diffuse`].
 
-use super::{same_hemisphere, BsdfSample};
+use super::{same_hemisphere, BsdfSample, MaterialFlags};
+use crate::scene::context::{Context, Role, SceneError};
+use crate::scene::schema::SpectrumDesc;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
@@ -17,6 +19,32 @@ pub struct OrenNayar {
 }
 
 impl OrenNayar {
+    pub const FLAGS: MaterialFlags = MaterialFlags::NONE;
+
+    /// The material at `field` from its description (`sigma_deg` in degrees, [0, 90]).
+    pub fn build(
+        ctx: &Context,
+        field: &str,
+        reflectance: &SpectrumDesc,
+        sigma_deg: f32,
+    ) -> Result<Self, SceneError> {
+        let s = sigma_deg;
+        if !s.is_finite() || !(0.0..=90.0).contains(&s) {
+            return Err(ctx.err(
+                format!("{field}.sigma_deg"),
+                format!("must be an angle in [0, 90] degrees, got {s}"),
+            ));
+        }
+        Ok(Self::new(
+            ctx.spectrum(
+                &format!("{field}.reflectance"),
+                reflectance,
+                Role::Reflectance,
+            )?,
+            s.to_radians(),
+        ))
+    }
+
     /// `sigma` in radians.
     pub fn new(reflectance: DenseSpectrum, sigma: f32) -> Self {
         let s2 = sigma * sigma;

@@ -5,7 +5,9 @@
 //! choosing the lobe in proportion to the mean k_d and k_s, then cosine-weighted or
 //! cosⁿ-around-the-mirror-direction. Two-sided.
 
-use super::{same_hemisphere, BsdfSample, Frame};
+use super::{same_hemisphere, BsdfSample, Frame, MaterialFlags};
+use crate::scene::context::{Context, Role, SceneError};
+use crate::scene::schema::SpectrumDesc;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
@@ -20,6 +22,38 @@ pub struct Phong {
 }
 
 impl Phong {
+    pub const FLAGS: MaterialFlags = MaterialFlags::NONE;
+
+    /// The material at `field` from its description, refusing diffuse + specular > 1 at any
+    /// wavelength.
+    pub fn build(
+        ctx: &Context,
+        field: &str,
+        diffuse: &SpectrumDesc,
+        specular: &SpectrumDesc,
+        exponent: f32,
+    ) -> Result<Self, SceneError> {
+        let kd = ctx.spectrum(&format!("{field}.diffuse"), diffuse, Role::Reflectance)?;
+        let ks = ctx.spectrum(&format!("{field}.specular"), specular, Role::Reflectance)?;
+        if !exponent.is_finite() || exponent < 0.0 {
+            return Err(ctx.err(
+                format!("{field}.exponent"),
+                format!("must be a finite number ≥ 0, got {exponent}"),
+            ));
+        }
+        if let Some(i) = (0..kd.values.len()).find(|&i| kd.values[i] + ks.values[i] > 1.0) {
+            return Err(ctx.err(
+                field,
+                format!(
+                    "diffuse + specular = {} at {} nm exceeds 1; the surface would create energy",
+                    kd.values[i] + ks.values[i],
+                    360 + i
+                ),
+            ));
+        }
+        Ok(Self::new(kd, ks, exponent))
+    }
+
     pub fn new(diffuse: DenseSpectrum, specular: DenseSpectrum, exponent: f32) -> Self {
         let d = diffuse.values.iter().sum::<f32>();
         let s = specular.values.iter().sum::<f32>();

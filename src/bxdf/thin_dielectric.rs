@@ -7,7 +7,9 @@
 
 use super::fresnel::fr_dielectric_sp;
 use super::ior::Ior;
-use super::BsdfSample;
+use super::{BsdfSample, MaterialFlags};
+use crate::scene::context::{Context, SceneError};
+use crate::scene::schema::IorDesc;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, N_LAMBDA};
 use glam::Vec3;
 
@@ -24,6 +26,17 @@ pub fn thin_slab_reflectance(cos: f32, eta: f32) -> f32 {
 }
 
 impl ThinDielectric {
+    /// Both lobes are deltas, and transmission passes straight through.
+    pub const FLAGS: MaterialFlags =
+        MaterialFlags::ALL_DELTA.union(MaterialFlags::STRAIGHT_THROUGH);
+
+    /// The material at `field` from its description.
+    pub fn build(ctx: &Context, field: &str, ior: &IorDesc) -> Result<Self, SceneError> {
+        Ok(ThinDielectric {
+            ior: Ior::build(ctx, &format!("{field}.ior"), ior)?,
+        })
+    }
+
     /// Straight-through transmittance 1 − R' at |cos θ| = `cos`, per wavelength (zero at
     /// grazing incidence).
     pub fn transmittance(&self, cos: f32, wl: &SampledWavelengths) -> SampledSpectrum {

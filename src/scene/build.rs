@@ -1,10 +1,10 @@
 //! From parsed scene to [`World`]: check every value, resolve spectra, convert photometric
 //! amounts to radiometric light spectra, build the BVH.
 
-use super::context::{Context, Role, SceneError};
+use super::context::{Context, SceneError};
 use super::schema::*;
-use crate::bxdf::{Diffuse, Material};
-use crate::camera::{Camera, PixelFilter, ThinLens};
+use crate::bxdf::{Material, MaterialFlags};
+use crate::camera::{Camera, PixelFilter};
 use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
 use crate::light::{AreaLight, Light, LightFlags, LightSampler};
 use crate::meter::{Grid, MeasureSettings, Meter, MeterKind};
@@ -84,6 +84,40 @@ fn available_memory() -> Option<u64> {
         avail = avail.min(max.saturating_sub(cur));
     }
     Some(avail)
+}
+
+/// Refuse a film of `w`×`h` pixels beyond [`MAX_PIXELS`] or the memory available to a render
+/// in `mode` (see [`bytes_per_pixel`]).
+fn check_film(
+    ctx: &Context,
+    w: u32,
+    h: u32,
+    mode: &RunMode,
+    illuminance: bool,
+) -> Result<(), SceneError> {
+    if w as u64 * h as u64 > MAX_PIXELS {
+        return Err(ctx.err(
+            "camera.resolution",
+            format!(
+                "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {:.0} GiB)",
+                w as f64 * h as f64 * BYTES_PER_PIXEL as f64 / (1u64 << 30) as f64
+            ),
+        ));
+    }
+    let need = w as u64 * h as u64 * bytes_per_pixel(mode, illuminance);
+    if let Some(avail) = available_memory() {
+        if need > avail {
+            return Err(ctx.err(
+                "camera.resolution",
+                format!(
+                    "{w}×{h} pixels need about {:.1} GiB of memory but only {:.1} GiB is available",
+                    need as f64 / (1u64 << 30) as f64,
+                    avail as f64 / (1u64 << 30) as f64
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Load and build a scene file (for a plain render; see [`load_world_for`]).
@@ -271,80 +305,11 @@ pub fn build_for(
         sources: Default::default(),
     };
 
-    // Camera.
-    let c = &scene.camera;
-    let position = ctx.vec3("camera.position", c.position)?;
-    let look_at = ctx.vec3("camera.look_at", c.look_at)?;
-    let up = ctx.vec3("camera.up", c.up)?;
-    let forward = look_at - position;
-    if forward.length_squared() == 0.0 {
-        return Err(ctx.err("camera.look_at", "look_at equals position"));
-    }
-    if forward.normalize().cross(up).length_squared() < 1e-12 {
-        return Err(ctx.err("camera.up", "up is zero or parallel to the view direction"));
-    }
-    let vfov = ctx.finite("camera.vfov_deg", c.vfov_deg as f64)?;
-    if !(vfov > 0.0 && vfov < 180.0) {
-        return Err(ctx.err(
-            "camera.vfov_deg",
-            format!("the field of view must lie strictly between 0 and 180 degrees, got {vfov}"),
-        ));
-    }
-    let (w, h) = c.resolution;
-    if w == 0 || h == 0 {
-        return Err(ctx.err(
-            "camera.resolution",
-            format!("the resolution must be at least 1×1, got {w}×{h}"),
-        ));
-    }
-    if w as u64 * h as u64 > MAX_PIXELS {
-        return Err(ctx.err(
-            "camera.resolution",
-            format!(
-                "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {:.0} GiB)",
-                w as f64 * h as f64 * BYTES_PER_PIXEL as f64 / (1u64 << 30) as f64
-            ),
-        ));
-    }
+    // Camera, and the film its resolution asks for.
     let illuminance = scene.render.illuminance || overrides.illuminance;
-    let need = w as u64 * h as u64 * bytes_per_pixel(mode, illuminance);
-    if let Some(avail) = available_memory() {
-        if need > avail {
-            return Err(ctx.err(
-                "camera.resolution",
-                format!(
-                    "{w}×{h} pixels need about {:.1} GiB of memory but only {:.1} GiB is available",
-                    need as f64 / (1u64 << 30) as f64,
-                    avail as f64 / (1u64 << 30) as f64
-                ),
-            ));
-        }
-    }
-    let lens = match &c.lens {
-        None => None,
-        Some(l) => {
-            let r = ctx.finite("camera.lens.aperture_radius", l.aperture_radius as f64)?;
-            if r < 0.0 {
-                return Err(ctx.err(
-                    "camera.lens.aperture_radius",
-                    format!("must be ≥ 0, got {r}"),
-                ));
-            }
-            let f = ctx.positive("camera.lens.focus_distance", l.focus_distance as f64)?;
-            Some(ThinLens {
-                radius: r as f32,
-                focus_distance: f as f32,
-            })
-        }
-    };
-    let camera = Camera::new(
-        position,
-        look_at,
-        up,
-        vfov as f32,
-        (w as usize, h as usize),
-        lens,
-    );
+    let camera = Camera::build(&ctx, &scene.camera, |w, h| {
+        check_film(&ctx, w, h, mode, illuminance)
+    })?;
 
     // Render settings.
     let r = &scene.render;
@@ -359,16 +324,7 @@ pub fn build_for(
             format!("{max_depth} is unreasonably deep (limit 10000)"),
         ));
     }
-    let filter = match r.filter {
-        FilterDesc::Box => PixelFilter::Box,
-        FilterDesc::Tent { radius } => PixelFilter::Tent {
-            radius: ctx.positive("render.filter.radius", radius as f64)? as f32,
-        },
-        FilterDesc::Gaussian { sigma, radius } => PixelFilter::gaussian(
-            ctx.positive("render.filter.sigma", sigma as f64)? as f32,
-            ctx.positive("render.filter.radius", radius as f64)? as f32,
-        ),
-    };
+    let filter = PixelFilter::build(&ctx, &r.filter)?;
     let settings = RenderSettings {
         spp,
         max_depth,
@@ -404,17 +360,7 @@ pub fn build_for(
                 "\"black\" is predefined (it absorbs all light) and cannot be redefined; give this material another name",
             ));
         }
-        let mat = match m {
-            MaterialDesc::Diffuse { reflectance } => Material::Diffuse(Diffuse {
-                reflectance: ctx.spectrum(
-                    &format!("{field}.reflectance"),
-                    reflectance,
-                    Role::Reflectance,
-                )?,
-            }),
-            MaterialDesc::Black => Material::Black,
-            other => build_material(&ctx, &field, other)?,
-        };
+        let mat = Material::build(&ctx, &field, m)?;
         material_index.insert(name.as_str(), materials.len() as u32);
         materials.push(mat);
     }
@@ -457,7 +403,11 @@ pub fn build_for(
     // Bounding spheres of the objects that scatter specularly: where light tracing aims.
     let caustic_targets: Vec<(Vec3, f32)> = shapes
         .iter()
-        .filter(|(_, o)| materials[objects[*o as usize].material as usize].has_delta_lobe())
+        .filter(|(_, o)| {
+            materials[objects[*o as usize].material as usize]
+                .flags()
+                .contains(MaterialFlags::DELTA)
+        })
         .filter_map(|(shape, _)| crate::caustics::bounding_sphere(shape))
         .collect();
     let geometry = SceneGeometry::build(&shapes).map_err(|e| {
@@ -504,7 +454,11 @@ pub fn build_for(
 
     let mut see_through: Vec<bool> = objects
         .iter()
-        .map(|o| materials[o.material as usize].passes_straight())
+        .map(|o| {
+            materials[o.material as usize]
+                .flags()
+                .contains(MaterialFlags::STRAIGHT_THROUGH)
+        })
         .collect();
     if !see_through.contains(&true) {
         see_through.clear();
@@ -701,219 +655,5 @@ fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, Scene
                 multiplier: *multiplier,
             },
         )?)),
-    })
-}
-
-/// The scattering materials other than `Diffuse`/`Black` (the BSDF library, src/bxdf).
-fn build_material(ctx: &Context, field: &str, m: &MaterialDesc) -> Result<Material, SceneError> {
-    use crate::bxdf::{self, ior};
-    let refl = |name: &str, d: &SpectrumDesc| {
-        ctx.spectrum(&format!("{field}.{name}"), d, Role::Reflectance)
-    };
-    let microfacet = |dist: DistributionDesc,
-                      masking: MaskingDesc,
-                      r: f32,
-                      rv: Option<f32>|
-     -> Result<bxdf::Microfacet, SceneError> {
-        let check = |name: &str, v: f32| {
-            if !v.is_finite() || v < 0.0 {
-                Err(ctx.err(
-                    format!("{field}.{name}"),
-                    format!("roughness must be a finite number ≥ 0, got {v}"),
-                ))
-            } else {
-                Ok(v)
-            }
-        };
-        let ax = check("roughness", r)?;
-        let ay = match rv {
-            Some(v) => check("roughness_v", v)?,
-            None => ax,
-        };
-        let dist = match dist {
-            DistributionDesc::Ggx => bxdf::Distribution::Ggx,
-            DistributionDesc::Beckmann => bxdf::Distribution::Beckmann,
-        };
-        let masking = match masking {
-            MaskingDesc::Smith => bxdf::Masking::Smith,
-            MaskingDesc::VCavity => bxdf::Masking::VCavity,
-        };
-        // Below 1e-3 the lobe is a delta; keep both axes consistent.
-        let (ax, ay) = if ax.max(ay) < 1e-3 {
-            (0.0, 0.0)
-        } else {
-            (ax.max(1e-3), ay.max(1e-3))
-        };
-        Ok(bxdf::Microfacet::new(dist, ax, ay, masking))
-    };
-    let dielectric_ior = |d: &IorDesc| -> Result<bxdf::Ior, SceneError> {
-        let f = format!("{field}.ior");
-        let ior = match d {
-            IorDesc::Constant(n) => bxdf::Ior::Constant(*n),
-            IorDesc::Glass(name) => ior::named_glass(name)
-                .ok_or_else(|| {
-                    ctx.err(
-                        &f,
-                        format!(
-                            "unknown glass {name:?}; known glasses: {}",
-                            ior::glass_names().join(", ")
-                        ),
-                    )
-                })?
-                .ior
-                .clone(),
-            IorDesc::Cauchy { a, b, c } => {
-                for v in [a, b, c] {
-                    ctx.finite(&f, *v)?;
-                }
-                bxdf::Ior::Cauchy {
-                    a: *a,
-                    b: *b,
-                    c: *c,
-                }
-            }
-            IorDesc::Sellmeier { b, c } => {
-                for v in b.iter().chain(c) {
-                    ctx.finite(&f, *v)?;
-                }
-                bxdf::Ior::Sellmeier { b: *b, c: *c }
-            }
-        };
-        let (lo, hi) = ior.range();
-        if !(lo.is_finite() && hi.is_finite()) || lo <= 0.0 {
-            return Err(ctx.err(
-                &f,
-                format!(
-                    "the refractive index must be finite and greater than 0 over 360–830 nm (range {lo} to {hi})"
-                ),
-            ));
-        }
-        Ok(ior)
-    };
-    Ok(match m {
-        MaterialDesc::OrenNayar {
-            reflectance,
-            sigma_deg,
-        } => {
-            let s = *sigma_deg;
-            if !s.is_finite() || !(0.0..=90.0).contains(&s) {
-                return Err(ctx.err(
-                    format!("{field}.sigma_deg"),
-                    format!("must be an angle in [0, 90] degrees, got {s}"),
-                ));
-            }
-            Material::OrenNayar(bxdf::OrenNayar::new(
-                refl("reflectance", reflectance)?,
-                s.to_radians(),
-            ))
-        }
-        MaterialDesc::Phong {
-            diffuse,
-            specular,
-            exponent,
-        } => {
-            let kd = refl("diffuse", diffuse)?;
-            let ks = refl("specular", specular)?;
-            if !exponent.is_finite() || *exponent < 0.0 {
-                return Err(ctx.err(
-                    format!("{field}.exponent"),
-                    format!("must be a finite number ≥ 0, got {exponent}"),
-                ));
-            }
-            if let Some(i) = (0..kd.values.len()).find(|&i| kd.values[i] + ks.values[i] > 1.0) {
-                return Err(ctx.err(
-                    field,
-                    format!(
-                        "diffuse + specular = {} at {} nm exceeds 1; the surface would create energy",
-                        kd.values[i] + ks.values[i],
-                        360 + i
-                    ),
-                ));
-            }
-            Material::Phong(bxdf::Phong::new(kd, ks, *exponent))
-        }
-        MaterialDesc::Conductor {
-            metal,
-            n,
-            k,
-            roughness,
-            roughness_v,
-            distribution,
-            masking,
-        } => {
-            let ior = match (metal, n, k) {
-                (Some(name), None, None) => ior::named_metal(name)
-                    .ok_or_else(|| {
-                        ctx.err(
-                            format!("{field}.metal"),
-                            format!(
-                                "unknown metal {name:?}; known metals: {}",
-                                ior::metal_names().join(", ")
-                            ),
-                        )
-                    })?
-                    .clone(),
-                (None, Some(n), Some(k)) => {
-                    for (name, d) in [("n", n), ("k", k)] {
-                        if matches!(d, SpectrumDesc::Blackbody(_) | SpectrumDesc::Rgb(..)) {
-                            return Err(ctx.err(
-                                format!("{field}.{name}"),
-                                "an optical constant must be Constant, Tabulated, Csv or Named",
-                            ));
-                        }
-                    }
-                    let n = ctx.spectrum(&format!("{field}.n"), n, Role::Emission)?;
-                    let k = ctx.spectrum(&format!("{field}.k"), k, Role::Emission)?;
-                    if n.min_value() <= 0.0 {
-                        return Err(ctx.err(
-                            format!("{field}.n"),
-                            "the refractive index n must be greater than 0",
-                        ));
-                    }
-                    bxdf::ConductorIor { n, k }
-                }
-                _ => {
-                    return Err(ctx.err(
-                        field,
-                        "give either `metal` (a name) or both `n` and `k` (spectra)",
-                    ))
-                }
-            };
-            Material::Conductor(bxdf::Conductor {
-                ior,
-                mf: microfacet(*distribution, *masking, *roughness, *roughness_v)?,
-            })
-        }
-        MaterialDesc::Dielectric {
-            ior,
-            roughness,
-            roughness_v,
-            distribution,
-        } => Material::Dielectric(bxdf::Dielectric {
-            ior: dielectric_ior(ior)?,
-            mf: microfacet(*distribution, MaskingDesc::Smith, *roughness, *roughness_v)?,
-        }),
-        MaterialDesc::ThinDielectric { ior } => Material::ThinDielectric(bxdf::ThinDielectric {
-            ior: dielectric_ior(ior)?,
-        }),
-        MaterialDesc::Coated {
-            base,
-            ior,
-            roughness,
-            distribution,
-        } => {
-            if !ior.is_finite() || *ior <= 0.0 {
-                return Err(ctx.err(
-                    format!("{field}.ior"),
-                    format!("the refractive index must be finite and greater than 0, got {ior}"),
-                ));
-            }
-            Material::Coated(bxdf::Coated::new(
-                refl("base", base)?,
-                *ior,
-                microfacet(*distribution, MaskingDesc::Smith, *roughness, None)?,
-            ))
-        }
-        MaterialDesc::Diffuse { .. } | MaterialDesc::Black => unreachable!("handled by build"),
     })
 }
