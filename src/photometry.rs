@@ -10,9 +10,9 @@ use crate::colour::planck::{C1, C2};
 use crate::colour::tables::{photopic_v, scotopic_v, LEN};
 use crate::spectrum::DenseSpectrum;
 
-/// Maximum luminous efficacy for photopic vision, lm/W (CIE; colour-science
-/// `CONSTANT_K_M`).
-pub const K_M: f64 = 683.0;
+/// Maximum luminous efficacy for photopic vision, lm/W; defined beside the tristimulus
+/// integration, which needs it for absolute Y.
+pub use crate::colour::colorimetry::K_M;
 /// Maximum luminous efficacy for scotopic vision, lm/W (CIE 1951; colour-science
 /// `CONSTANT_KP_M`).
 pub const K_M_SCOTOPIC: f64 = 1700.0;
