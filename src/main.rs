@@ -5,8 +5,9 @@ mod cli;
 use anyhow::{bail, Context, Result};
 use candela::colour::tables::Observer;
 use candela::output::{self, Layers, PngSettings};
-use candela::report::json::{grid_csv, grid_csv_path, report_json, write_text, ReportInput, Units};
-use candela::report::units::Quantity;
+use candela::photometry::Quantity;
+use candela::report::json::{grid_csv, grid_csv_path, report_json, write_text, ReportInput};
+use candela::report::units::UnitSystem;
 use candela::scene::{self, Overrides};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -308,9 +309,9 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
     };
     let (out, threads, exposure, quiet) = (a.out.as_deref(), a.threads, a.exposure, a.quiet);
     let units = if a.units == "imperial" {
-        Units::Imperial
+        UnitSystem::Imperial
     } else {
-        Units::Si
+        UnitSystem::Si
     };
     if let Some(n) = threads {
         candela::bench::check_threads("--threads", n)?;

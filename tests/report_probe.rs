@@ -6,8 +6,9 @@ use common::cli;
 use std::path::Path;
 
 use candela::output::{self, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR};
+use candela::photometry::{CD_M2_PER_FL, LX_PER_FC};
 use candela::report::probe::{probe, IlluminanceProbe};
-use candela::report::units::{UnitSystem, CD_M2_PER_FL, LX_PER_FC};
+use candela::report::units::UnitSystem;
 use serde_json::Value;
 
 const W: usize = 9;

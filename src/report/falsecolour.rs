@@ -15,10 +15,11 @@ use std::path::{Path, PathBuf};
 use image::{ImageFormat, Rgb, RgbImage};
 
 use super::draw::{self, Colour, BLACK, DARK_GREY, WHITE};
-use super::units::{format_sig, Quantity, UnitSystem};
+use super::units::{format_sig, UnitSystem};
 use crate::output::{
     write_atomic, Layers, OutputError, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_Y, ILLUMINANCE_SENTINEL,
 };
+use crate::photometry::Quantity;
 
 /// Linear or logarithmic mapping of values to colours.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -453,6 +454,10 @@ fn extract(
             let v = e.iter().map(|&v| units.from_si(q, v as f64)).collect();
             Ok((v, defined))
         }
+        other => Err(format!(
+            "a false-colour map shows luminance or illuminance, not {}",
+            other.name()
+        )),
     }
 }
 
@@ -519,7 +524,7 @@ pub fn render_falsecolour(
     let undefined_label = (undefined > 0).then(|| {
         let what = match settings.quantity {
             Quantity::Illuminance => "no surface: E undefined",
-            Quantity::Luminance => "undefined",
+            _ => "undefined",
         };
         format!(
             "{what} ({} %)",
@@ -913,8 +918,13 @@ pub struct FalsecolourArgs {
 }
 
 fn parse_quantity(s: &str) -> Result<Quantity, String> {
-    Quantity::parse(s)
-        .ok_or_else(|| format!("unknown quantity '{s}' (use luminance or illuminance)"))
+    match s.trim().to_ascii_lowercase().as_str() {
+        "luminance" | "l" | "y" => Ok(Quantity::Luminance),
+        "illuminance" | "e" => Ok(Quantity::Illuminance),
+        _ => Err(format!(
+            "unknown quantity '{s}' (use luminance or illuminance)"
+        )),
+    }
 }
 
 fn parse_scale(s: &str) -> Result<Scale, String> {

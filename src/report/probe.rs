@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::anyhow;
 use serde_json::{json, Value};
 
-use super::units::{format_sig, Quantity, UnitSystem};
+use super::units::{format_sig, UnitSystem};
 use crate::colour::models::{xyz_to_upvp, xyz_to_xy};
 use crate::colour::rgb::{srgb_encode, xyz_to_linear_srgb};
 use crate::colour::temperature::xyz_to_cct_ohno2013;
@@ -15,6 +15,7 @@ use crate::output::{
     read_exr, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR, CHANNEL_X, CHANNEL_Y,
     CHANNEL_Y_STDERR, CHANNEL_Z, ILLUMINANCE_SENTINEL,
 };
+use crate::photometry::Quantity;
 
 /// z value of the two-sided 95 % normal confidence interval.
 pub const Z95: f64 = 1.96;
