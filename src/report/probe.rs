@@ -1,7 +1,6 @@
-//! `candela probe`: the measured values of one pixel, or of a small disc of pixels, of a
-//! rendered EXR — luminance and illuminance with 95 % confidence intervals, XYZ, xy, u′v′,
-//! CCT, Duv and sRGB. See `docs/reports.md` for the text and JSON formats.
-
+//! The probe of one pixel, or of a small disc of pixels, of a rendered EXR: luminance and
+//! illuminance with 95 % confidence intervals, XYZ, xy, u′v′, CCT, Duv and sRGB, and their JSON
+//! (keys in `docs/reports.md`). `candela probe` prints them as text or as that JSON.
 use std::path::Path;
 
 use anyhow::anyhow;
