@@ -78,9 +78,9 @@ enum Command {
     /// Benchmark: samples/s and rays/s on the Cornell box and on a generated 1 M-triangle scene; `bench traversal` (BVH vs Embree) and `bench scaling` (10 k … 5 M triangles).
     Bench(candela::bench::BenchArgs),
     /// Luminance, illuminance (95 % CI), XYZ, xy, u′v′, CCT, Duv and sRGB of a pixel or disc of an EXR; see docs/reports.md.
-    Probe(candela::report::probe::ProbeArgs),
+    Probe(cli::probe::ProbeArgs),
     /// False-colour PNG of luminance or illuminance with a legend; see docs/reports.md.
-    Falsecolour(candela::report::falsecolour::FalsecolourArgs),
+    Falsecolour(cli::falsecolour::FalsecolourArgs),
 }
 
 fn main() -> ExitCode {
@@ -111,10 +111,8 @@ fn main() -> ExitCode {
             candela::luminaire::cli::run(&file, diagram.as_deref()).map(|s| say_raw!("{s}"))
         }
         Command::Bench(args) => candela::bench::main(&args),
-        Command::Probe(args) => candela::report::probe::run(&args).map(|s| say_raw!("{s}")),
-        Command::Falsecolour(args) => {
-            candela::report::falsecolour::run(&args).map(|s| say_raw!("{s}"))
-        }
+        Command::Probe(args) => cli::probe::run(&args).map(|s| say_raw!("{s}")),
+        Command::Falsecolour(args) => cli::falsecolour::run(&args).map(|s| say_raw!("{s}")),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

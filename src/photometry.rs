@@ -10,9 +10,9 @@ use crate::colour::planck::{C1, C2};
 use crate::colour::tables::{photopic_v, scotopic_v, LEN};
 use crate::spectrum::DenseSpectrum;
 
-/// Maximum luminous efficacy for photopic vision, lm/W (CIE; colour-science
-/// `CONSTANT_K_M`).
-pub const K_M: f64 = 683.0;
+/// Maximum luminous efficacy for photopic vision, lm/W; defined beside the tristimulus
+/// integration, which needs it for absolute Y.
+pub use crate::colour::colorimetry::K_M;
 /// Maximum luminous efficacy for scotopic vision, lm/W (CIE 1951; colour-science
 /// `CONSTANT_KP_M`).
 pub const K_M_SCOTOPIC: f64 = 1700.0;
@@ -176,120 +176,161 @@ pub struct Unit {
 /// One international foot in metres.
 pub const FOOT_M: f64 = 0.3048;
 
+/// Lux, lx = lm/m².
+pub const LUX: Unit = Unit {
+    name: "lux",
+    symbol: "lx",
+    quantity: Quantity::Illuminance,
+    si: 1.0,
+    aliases: &["lux", "lx", "lm/m2", "lm/m²", "lm/m^2"],
+};
+
+/// Footcandle, fc = lm/ft².
+pub const FOOTCANDLE: Unit = Unit {
+    name: "footcandle",
+    symbol: "fc",
+    quantity: Quantity::Illuminance,
+    si: 1.0 / (FOOT_M * FOOT_M),
+    aliases: &[
+        "footcandle",
+        "footcandles",
+        "foot-candle",
+        "fc",
+        "ftc",
+        "lm/ft2",
+        "lm/ft²",
+    ],
+};
+
+/// Phot, ph = 10⁴ lx.
+pub const PHOT: Unit = Unit {
+    name: "phot",
+    symbol: "ph",
+    quantity: Quantity::Illuminance,
+    si: 1.0e4,
+    aliases: &["phot", "ph", "lm/cm2", "lm/cm²"],
+};
+
+/// Nit, cd/m².
+pub const NIT: Unit = Unit {
+    name: "nit",
+    symbol: "cd/m²",
+    quantity: Quantity::Luminance,
+    si: 1.0,
+    aliases: &["nit", "nits", "nt", "cd/m2", "cd/m²", "cd/m^2", "cd_m2"],
+};
+
+/// Footlambert, fL = (1/π) cd/ft².
+pub const FOOTLAMBERT: Unit = Unit {
+    name: "footlambert",
+    symbol: "fL",
+    quantity: Quantity::Luminance,
+    si: 1.0 / (std::f64::consts::PI * FOOT_M * FOOT_M),
+    aliases: &[
+        "footlambert",
+        "footlamberts",
+        "foot-lambert",
+        "fl",
+        "ft-l",
+        "ftl",
+    ],
+};
+
+/// Stilb, sb = 10⁴ cd/m².
+pub const STILB: Unit = Unit {
+    name: "stilb",
+    symbol: "sb",
+    quantity: Quantity::Luminance,
+    si: 1.0e4,
+    aliases: &["stilb", "sb", "cd/cm2", "cd/cm²"],
+};
+
+/// Lambert, L = (10⁴/π) cd/m².
+pub const LAMBERT: Unit = Unit {
+    name: "lambert",
+    symbol: "L",
+    quantity: Quantity::Luminance,
+    si: 1.0e4 / std::f64::consts::PI,
+    aliases: &["lambert", "lamberts", "la", "l"],
+};
+
+/// Apostilb, asb = (1/π) cd/m².
+pub const APOSTILB: Unit = Unit {
+    name: "apostilb",
+    symbol: "asb",
+    quantity: Quantity::Luminance,
+    si: 1.0 / std::f64::consts::PI,
+    aliases: &["apostilb", "asb", "blondel"],
+};
+
+/// Lumen, lm.
+pub const LUMEN: Unit = Unit {
+    name: "lumen",
+    symbol: "lm",
+    quantity: Quantity::LuminousFlux,
+    si: 1.0,
+    aliases: &["lumen", "lumens", "lm"],
+};
+
+/// Candela, cd.
+pub const CANDELA: Unit = Unit {
+    name: "candela",
+    symbol: "cd",
+    quantity: Quantity::LuminousIntensity,
+    si: 1.0,
+    aliases: &["candela", "candelas", "cd"],
+};
+
+/// Talbot, lm·s.
+pub const TALBOT: Unit = Unit {
+    name: "talbot",
+    symbol: "lm·s",
+    quantity: Quantity::LuminousEnergy,
+    si: 1.0,
+    aliases: &[
+        "talbot",
+        "talbots",
+        "lm·s",
+        "lm*s",
+        "lm s",
+        "lumen-second",
+        "lumen-seconds",
+    ],
+};
+
+/// Lumen-hour, lm·h = 3600 lm·s.
+pub const LUMEN_HOUR: Unit = Unit {
+    name: "lumen-hour",
+    symbol: "lm·h",
+    quantity: Quantity::LuminousEnergy,
+    si: 3600.0,
+    aliases: &["lumen-hour", "lumen-hours", "lm·h", "lm*h", "lmh"],
+};
+
 /// Every unit [`convert`] knows.
 ///
 /// References: NIST SP 811 (2008) appendix B.8/B.9 (footcandle = lm/ft², footlambert =
 /// (1/π) cd/ft², phot = 10⁴ lx, stilb = 10⁴ cd/m², lambert = (10⁴/π) cd/m², apostilb =
 /// (1/π) cd/m²); talbot = 1 lm·s.
 pub const UNITS: &[Unit] = &[
-    Unit {
-        name: "lux",
-        symbol: "lx",
-        quantity: Quantity::Illuminance,
-        si: 1.0,
-        aliases: &["lux", "lx", "lm/m2", "lm/m²", "lm/m^2"],
-    },
-    Unit {
-        name: "footcandle",
-        symbol: "fc",
-        quantity: Quantity::Illuminance,
-        si: 1.0 / (FOOT_M * FOOT_M),
-        aliases: &[
-            "footcandle",
-            "footcandles",
-            "foot-candle",
-            "fc",
-            "ftc",
-            "lm/ft2",
-            "lm/ft²",
-        ],
-    },
-    Unit {
-        name: "phot",
-        symbol: "ph",
-        quantity: Quantity::Illuminance,
-        si: 1.0e4,
-        aliases: &["phot", "ph", "lm/cm2", "lm/cm²"],
-    },
-    Unit {
-        name: "nit",
-        symbol: "cd/m²",
-        quantity: Quantity::Luminance,
-        si: 1.0,
-        aliases: &["nit", "nits", "nt", "cd/m2", "cd/m²", "cd/m^2", "cd_m2"],
-    },
-    Unit {
-        name: "footlambert",
-        symbol: "fL",
-        quantity: Quantity::Luminance,
-        si: 1.0 / (std::f64::consts::PI * FOOT_M * FOOT_M),
-        aliases: &[
-            "footlambert",
-            "footlamberts",
-            "foot-lambert",
-            "fl",
-            "ft-l",
-            "ftl",
-        ],
-    },
-    Unit {
-        name: "stilb",
-        symbol: "sb",
-        quantity: Quantity::Luminance,
-        si: 1.0e4,
-        aliases: &["stilb", "sb", "cd/cm2", "cd/cm²"],
-    },
-    Unit {
-        name: "lambert",
-        symbol: "L",
-        quantity: Quantity::Luminance,
-        si: 1.0e4 / std::f64::consts::PI,
-        aliases: &["lambert", "lamberts", "la", "l"],
-    },
-    Unit {
-        name: "apostilb",
-        symbol: "asb",
-        quantity: Quantity::Luminance,
-        si: 1.0 / std::f64::consts::PI,
-        aliases: &["apostilb", "asb", "blondel"],
-    },
-    Unit {
-        name: "lumen",
-        symbol: "lm",
-        quantity: Quantity::LuminousFlux,
-        si: 1.0,
-        aliases: &["lumen", "lumens", "lm"],
-    },
-    Unit {
-        name: "candela",
-        symbol: "cd",
-        quantity: Quantity::LuminousIntensity,
-        si: 1.0,
-        aliases: &["candela", "candelas", "cd"],
-    },
-    Unit {
-        name: "talbot",
-        symbol: "lm·s",
-        quantity: Quantity::LuminousEnergy,
-        si: 1.0,
-        aliases: &[
-            "talbot",
-            "talbots",
-            "lm·s",
-            "lm*s",
-            "lm s",
-            "lumen-second",
-            "lumen-seconds",
-        ],
-    },
-    Unit {
-        name: "lumen-hour",
-        symbol: "lm·h",
-        quantity: Quantity::LuminousEnergy,
-        si: 3600.0,
-        aliases: &["lumen-hour", "lumen-hours", "lm·h", "lm*h", "lmh"],
-    },
+    LUX,
+    FOOTCANDLE,
+    PHOT,
+    NIT,
+    FOOTLAMBERT,
+    STILB,
+    LAMBERT,
+    APOSTILB,
+    LUMEN,
+    CANDELA,
+    TALBOT,
+    LUMEN_HOUR,
 ];
+
+/// Lux per footcandle (1 lm/ft²), [`FOOTCANDLE`]'s size.
+pub const LX_PER_FC: f64 = FOOTCANDLE.si;
+/// cd/m² per footlambert ((1/π) cd/ft²), [`FOOTLAMBERT`]'s size.
+pub const CD_M2_PER_FL: f64 = FOOTLAMBERT.si;
 
 /// Why a unit conversion failed.
 #[derive(Debug, thiserror::Error, PartialEq)]

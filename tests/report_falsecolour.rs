@@ -6,8 +6,9 @@ use common::cli;
 use std::path::Path;
 
 use candela::output::{self, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR};
+use candela::photometry::{Quantity, LX_PER_FC};
 use candela::report::falsecolour::{write_falsecolour, FalsecolourSettings, LegendInfo, Scale};
-use candela::report::units::{Quantity, UnitSystem, LX_PER_FC};
+use candela::report::units::UnitSystem;
 
 /// A `w`×`h` EXR whose luminance depends on the column only: Y(x) = `f(x)`.
 fn ramp(path: &Path, w: usize, h: usize, f: impl Fn(usize) -> f32) -> Layers {
@@ -210,7 +211,7 @@ fn illuminance_honours_the_mask_and_imperial_units() {
 fn imperial_luminance_ticks_are_footlamberts() {
     let dir = tempfile::tempdir().unwrap();
     let exr = dir.path().join("fl.exr");
-    let fl = candela::report::units::CD_M2_PER_FL as f32;
+    let fl = candela::photometry::CD_M2_PER_FL as f32;
     let layers = ramp(&exr, 50, 4, |x| (x as f32 + 0.5) * fl);
     let png = dir.path().join("fl.png");
     let settings = FalsecolourSettings {

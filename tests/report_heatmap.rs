@@ -1,9 +1,10 @@
 //! Grid heat maps: the statistics printed (Emin, Eavg, Emax, U₀) match the values, and each
 //! cell is painted with its value's colour, row 0 at the bottom.
 
+use candela::photometry::LX_PER_FC;
 use candela::report::falsecolour::FalsecolourSettings;
 use candela::report::heatmap::{write_grid_heatmap, GridValues};
-use candela::report::units::{format_sig, UnitSystem, LX_PER_FC};
+use candela::report::units::{format_sig, UnitSystem};
 
 fn grid() -> GridValues {
     let (nx, ny) = (6, 4);
@@ -103,8 +104,8 @@ fn inconsistent_grid_is_an_error_naming_the_file() {
 #[ignore]
 fn sample_images() {
     use candela::output::{Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR};
+    use candela::photometry::Quantity;
     use candela::report::falsecolour::{write_falsecolour, Scale};
-    use candela::report::units::Quantity;
     let dir = std::path::PathBuf::from(std::env::var("CANDELA_REPORT_SAMPLES").unwrap());
     // A point source of 1000 cd, 2 m above a 6 × 4 m work plane: E = I cos θ / d².
     let (nx, ny, sx, sy) = (12, 8, 6.0, 4.0);

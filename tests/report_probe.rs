@@ -6,8 +6,9 @@ use common::cli;
 use std::path::Path;
 
 use candela::output::{self, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR};
+use candela::photometry::{CD_M2_PER_FL, LX_PER_FC};
 use candela::report::probe::{probe, IlluminanceProbe};
-use candela::report::units::{UnitSystem, CD_M2_PER_FL, LX_PER_FC};
+use candela::report::units::UnitSystem;
 use serde_json::Value;
 
 const W: usize = 9;
@@ -261,9 +262,9 @@ fn disc_average() {
             mask_mean: Some(0.0)
         }
     );
-    assert!(r
-        .to_text("p.exr")
-        .contains("undefined: pixel sees no surface"));
+    // The terminal text is the command's: probe the same pixel of the EXR on disc.
+    let (_, text, _) = cli(&["probe", "p.exr", "0", "0"], dir.path());
+    assert!(text.contains("undefined: pixel sees no surface"));
 }
 
 #[test]

@@ -1,1 +1,142 @@
-//! `candela falsecolour`.
+//! `candela falsecolour`: reads its arguments, chooses the output path, writes the map with
+//! [`candela::report::falsecolour`] and says what it wrote.
+
+use std::path::PathBuf;
+
+use candela::output::read_exr;
+use candela::photometry::Quantity;
+use candela::report::check_photometric_layers;
+use candela::report::falsecolour::{
+    describe_scale, render_falsecolour, write_png, FalsecolourSettings, Palette, Scale,
+};
+use candela::report::units::UnitSystem;
+
+/// Arguments of `candela falsecolour`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct FalsecolourArgs {
+    /// EXR image written by `candela render`.
+    pub exr: PathBuf,
+    /// luminance (channel Y) or illuminance (channel E, needs a render with --illuminance).
+    #[arg(long, default_value = "luminance", value_parser = parse_quantity)]
+    pub quantity: Quantity,
+    /// linear or log.
+    #[arg(long, default_value = "linear", value_parser = parse_scale)]
+    pub scale: Scale,
+    /// MIN:MAX in display units (either side may be left empty for automatic), e.g. 0:500.
+    #[arg(long, allow_hyphen_values = true)]
+    pub range: Option<String>,
+    /// Number of discrete colour steps; 0 or absent = continuous.
+    #[arg(long)]
+    pub steps: Option<usize>,
+    /// Draw contour lines at the step boundaries (continuous scale: at the legend ticks).
+    #[arg(long)]
+    pub contours: bool,
+    /// si (cd/m², lx) or imperial (fL, fc).
+    #[arg(long, default_value = "si", value_parser = super::probe::parse_units)]
+    pub units: UnitSystem,
+    /// turbo or viridis.
+    #[arg(long, default_value = "turbo", value_parser = parse_palette)]
+    pub palette: Palette,
+    /// Output PNG (default: NAME.luminance.png or NAME.illuminance.png beside the EXR).
+    #[arg(short = 'o', long = "out")]
+    pub out: Option<PathBuf>,
+}
+
+fn parse_quantity(s: &str) -> Result<Quantity, String> {
+    match s.trim().to_ascii_lowercase().as_str() {
+        "luminance" | "l" | "y" => Ok(Quantity::Luminance),
+        "illuminance" | "e" => Ok(Quantity::Illuminance),
+        _ => Err(format!(
+            "unknown quantity '{s}' (use luminance or illuminance)"
+        )),
+    }
+}
+
+fn parse_scale(s: &str) -> Result<Scale, String> {
+    Scale::parse(s).ok_or_else(|| format!("unknown scale '{s}' (use linear or log)"))
+}
+
+fn parse_palette(s: &str) -> Result<Palette, String> {
+    Palette::parse(s).ok_or_else(|| format!("unknown palette '{s}' (use turbo or viridis)"))
+}
+
+/// Parses `MIN:MAX` (either side may be empty = automatic).
+pub fn parse_range(s: &str) -> Result<(Option<f64>, Option<f64>), String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("--range '{s}' must be MIN:MAX, e.g. 0:500 or 10:"))?;
+    let num = |t: &str| -> Result<Option<f64>, String> {
+        let t = t.trim();
+        if t.is_empty() {
+            return Ok(None);
+        }
+        match t.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(Some(v)),
+            _ => Err(format!("--range '{s}': '{t}' is not a finite number")),
+        }
+    };
+    Ok((num(a)?, num(b)?))
+}
+
+/// `candela falsecolour`: writes the PNG and returns the line to print.
+pub fn run(args: &FalsecolourArgs) -> anyhow::Result<String> {
+    let (min, max) = match &args.range {
+        Some(r) => parse_range(r).map_err(anyhow::Error::msg)?,
+        None => (None, None),
+    };
+    let out = args.out.clone().unwrap_or_else(|| {
+        let mut p = args.exr.with_extension("").into_os_string();
+        p.push(format!(".{}.png", args.quantity.name()));
+        PathBuf::from(p)
+    });
+    if out == args.exr {
+        anyhow::bail!("{}: refusing to overwrite the input image", out.display());
+    }
+    let layers = read_exr(&args.exr).map_err(|e| anyhow::anyhow!("{e}"))?;
+    check_photometric_layers(&args.exr, &layers).map_err(|e| anyhow::anyhow!(e))?;
+    let file_name = args
+        .exr
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let q = args.quantity.name();
+    let settings = FalsecolourSettings {
+        quantity: args.quantity,
+        scale: args.scale,
+        min,
+        max,
+        steps: args.steps,
+        contours: args.contours,
+        units: args.units,
+        palette: args.palette,
+        title: Some(format!(
+            "{}{} — {file_name}",
+            q[..1].to_uppercase(),
+            &q[1..]
+        )),
+    };
+    let (img, info) = render_falsecolour(&layers, &settings)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.exr.display()))?;
+    write_png(&out, &img).map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(format!(
+        "wrote {}: {} {}\n",
+        out.display(),
+        q,
+        describe_scale(&info.scale, &info.unit)
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_parse() {
+        assert_eq!(parse_range("0:500"), Ok((Some(0.0), Some(500.0))));
+        assert_eq!(parse_range(":500"), Ok((None, Some(500.0))));
+        assert_eq!(parse_range("1e-2:"), Ok((Some(0.01), None)));
+        assert!(parse_range("500").is_err());
+        assert!(parse_range("a:b").is_err());
+        assert!(parse_range("0:inf").is_err());
+    }
+}

@@ -1,1 +1,177 @@
-//! `candela probe`.
+//! `candela probe`: reads its arguments, probes the EXR with
+//! [`candela::report::probe::probe_file`] and formats the result for the terminal (text, or
+//! the JSON that docs/reports.md documents).
+
+use std::path::PathBuf;
+
+use anyhow::anyhow;
+use candela::photometry::Quantity;
+use candela::report::probe::{probe_file, Estimate, IlluminanceProbe, ProbeResult, Z95};
+use candela::report::units::{format_sig, UnitSystem};
+use serde_json::json;
+
+/// Arguments of `candela probe`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ProbeArgs {
+    /// EXR image written by `candela render` (channels X, Y, Z, stderr.Y; E, stderr.E, mask.E
+    /// with --illuminance).
+    pub exr: PathBuf,
+    /// Column of the pixel, 0 = left.
+    #[arg(allow_hyphen_values = true)]
+    pub x: i64,
+    /// Row of the pixel, 0 = top.
+    #[arg(allow_hyphen_values = true)]
+    pub y: i64,
+    /// Average over every pixel whose centre is within R pixels of (X, Y).
+    #[arg(long, allow_hyphen_values = true)]
+    pub radius: Option<f64>,
+    /// Print JSON (keys documented in docs/reports.md) instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// si (cd/m², lx) or imperial (fL, fc).
+    #[arg(long, default_value = "si", value_parser = parse_units)]
+    pub units: UnitSystem,
+}
+
+/// clap value parser for `--units`.
+pub fn parse_units(s: &str) -> Result<UnitSystem, String> {
+    UnitSystem::parse(s).ok_or_else(|| format!("unknown unit system '{s}' (use si or imperial)"))
+}
+
+/// `candela probe`: returns the text (or JSON) to print.
+pub fn run(args: &ProbeArgs) -> anyhow::Result<String> {
+    // Flatten to one line: the messages already name the file and their cause.
+    let r = probe_file(&args.exr, args.x, args.y, args.radius, args.units)
+        .map_err(|e| anyhow!("{e}"))?;
+    if args.json {
+        let mut v = r.to_json();
+        v["file"] = json!(args.exr.display().to_string());
+        Ok(serde_json::to_string_pretty(&v)? + "\n")
+    } else {
+        Ok(text(&r, &args.exr.display().to_string()))
+    }
+}
+
+fn fmt3(v: [f64; 3], digits: usize) -> String {
+    format!(
+        "{:.*} {:.*} {:.*}",
+        digits, v[0], digits, v[1], digits, v[2]
+    )
+}
+
+fn estimate_text(e: &Estimate, unit: &str) -> String {
+    match (e.stderr, e.ci95()) {
+        (Some(se), Some((lo, hi))) => format!(
+            "{} ± {} {unit}   (95 % CI {} … {}; standard error {})",
+            format_sig(e.mean, 5),
+            format_sig(Z95 * se, 3),
+            format_sig(lo, 5),
+            format_sig(hi, 5),
+            format_sig(se, 3)
+        ),
+        _ => format!(
+            "{} {unit}   (confidence interval unknown: no standard error channel, or fewer than 2 samples per pixel)",
+            format_sig(e.mean, 5)
+        ),
+    }
+}
+
+/// The human-readable report of `r`; `file` names the image in the first line.
+fn text(r: &ProbeResult, file: &str) -> String {
+    let u = r.units;
+    let lu = u.symbol(Quantity::Luminance);
+    let eu = u.symbol(Quantity::Illuminance);
+    let mut s = match r.radius {
+        None => format!("{file}: pixel ({}, {})\n", r.x, r.y),
+        Some(radius) => format!(
+            "{file}: disc of radius {} px around pixel ({}, {}): {} pixel{}\n",
+            format_sig(radius, 4),
+            r.x,
+            r.y,
+            r.pixels,
+            if r.pixels == 1 { "" } else { "s" }
+        ),
+    };
+    let row = |s: &mut String, k: &str, v: String| s.push_str(&format!("  {k:<13} {v}\n"));
+    row(&mut s, "luminance", estimate_text(&r.luminance, lu));
+    let e = match &r.illuminance {
+        IlluminanceProbe::NoChannel => {
+            "no E channel in this image (render with --illuminance)".to_string()
+        }
+        IlluminanceProbe::Undefined { .. } => "undefined: pixel sees no surface".to_string(),
+        IlluminanceProbe::Defined {
+            estimate,
+            pixels,
+            mask_mean,
+        } => {
+            let mut t = estimate_text(estimate, eu);
+            if *pixels < r.pixels {
+                t += &format!(
+                    "; over the {pixels} of {} pixels that see a surface",
+                    r.pixels
+                );
+            }
+            if let Some(m) = mask_mean {
+                if *m < 1.0 {
+                    t += &format!("; coverage {}", format_sig(*m, 3));
+                }
+            }
+            t
+        }
+    };
+    row(&mut s, "illuminance", e);
+    match r.xyz {
+        None => row(&mut s, "XYZ", "no X/Z channels".to_string()),
+        Some(v) => {
+            row(
+                &mut s,
+                "XYZ",
+                format!(
+                    "{} {} {} {lu}",
+                    format_sig(v[0], 5),
+                    format_sig(v[1], 5),
+                    format_sig(v[2], 5)
+                ),
+            );
+        }
+    }
+    if let Some(v) = r.xy {
+        row(&mut s, "xy", format!("{:.4} {:.4}", v[0], v[1]));
+    }
+    if let Some(v) = r.upvp {
+        row(&mut s, "u′v′", format!("{:.4} {:.4}", v[0], v[1]));
+    }
+    match r.cct_duv {
+        Some([t, duv]) => {
+            let mut line = format!("{t:.0} K   Duv {duv:+.4}");
+            if duv.abs() > 0.05 {
+                line += "  (|Duv| > 0.05: CCT is not meaningful)";
+            }
+            row(&mut s, "CCT", line);
+        }
+        None if r.xyz.is_some() => row(&mut s, "CCT", "undefined (black)".into()),
+        None => {}
+    }
+    if let (Some(l), Some(e)) = (r.srgb_linear, r.srgb_encoded) {
+        let gamut = if l.iter().any(|&c| !(-1e-9..=1.0 + 1e-9).contains(&c)) {
+            "  (outside 0…1: out of gamut or brighter than white)"
+        } else {
+            ""
+        };
+        row(
+            &mut s,
+            "sRGB linear",
+            format!("{}   (Y = 1){gamut}", fmt3(l, 4)),
+        );
+        let hex: Vec<String> = e
+            .iter()
+            .map(|c| format!("{:02X}", (c.clamp(0.0, 1.0) * 255.0).round() as u8))
+            .collect();
+        row(
+            &mut s,
+            "sRGB encoded",
+            format!("{}   #{}", fmt3(e, 4), hex.concat()),
+        );
+    }
+    s
+}

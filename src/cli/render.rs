@@ -4,8 +4,9 @@
 use anyhow::{bail, Context, Result};
 use candela::job::{self, ImageDone, Outcome, Progress, RenderJob};
 use candela::meter::MeterKind;
+use candela::photometry::Quantity;
 use candela::render::{StopReason, TargetError};
-use candela::report::units::{Quantity, UnitSystem};
+use candela::report::units::UnitSystem;
 use candela::scene::Overrides;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};

@@ -15,7 +15,11 @@
 //! in method; the difference is the 780–830 nm tail (≤ ~1e-4 relative for deep reds).
 
 use crate::colour::tables::{cmfs, Observer, LEN};
-use crate::photometry::K_M;
+
+/// Maximum luminous efficacy for photopic vision, lm/W (CIE; colour-science
+/// `CONSTANT_K_M`): absolute Y in cd/m² from a radiance. Re-exported by
+/// `photometry`, which builds on this module.
+pub const K_M: f64 = 683.0;
 
 /// Integration method, named after colour-science's `sd_to_XYZ(method=...)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

@@ -15,9 +15,10 @@ pub use merge::{merge, MergeOutputs};
 
 use crate::film::Film;
 use crate::meter::{Estimate, GridStats, MeterKind};
+use crate::photometry::Quantity;
 use crate::render::{PassStatus, Progressive, RenderResult, StopReason, TargetError};
 use crate::report::json::{grid_csv, grid_csv_path, report_json, write_text, ReportInput};
-use crate::report::units::{Quantity, UnitSystem as Units};
+use crate::report::units::UnitSystem;
 use crate::scene::{self, Overrides};
 use crate::state::RenderState;
 use crate::world::World;
@@ -41,7 +42,7 @@ pub struct RenderJob {
     /// Exposure of the PNG in EV (None: automatic); the EXR is absolute.
     pub exposure_ev: Option<f64>,
     /// Units of the report, grid CSVs and maps.
-    pub units: Units,
+    pub units: UnitSystem,
     /// Render until every pixel is known to this error (adaptive sampling).
     pub target: Option<TargetError>,
     /// Most samples per pixel (None: the override's or the scene's spp; 65536 with a target).
@@ -68,7 +69,7 @@ impl RenderJob {
             out: None,
             threads: None,
             exposure_ev: None,
-            units: Units::Si,
+            units: UnitSystem::Si,
             target: None,
             max_spp: None,
             max_time: None,
@@ -415,7 +416,7 @@ fn write_grids(
     world: &World,
     measurements: &crate::meter::Measurements,
     stem: &Path,
-    units: Units,
+    units: UnitSystem,
     written: &mut Vec<String>,
 ) -> Result<()> {
     for (k, (g, est)) in world.grids.iter().zip(&measurements.grids).enumerate() {
@@ -447,7 +448,7 @@ fn write_falsecolour(
     world: &World,
     exr_path: &Path,
     stem: &Path,
-    units: Units,
+    units: UnitSystem,
     written: &mut Vec<String>,
 ) -> Result<()> {
     let layers = crate::output::read_exr(exr_path)?;

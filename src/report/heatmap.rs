@@ -13,8 +13,9 @@ use image::{Rgb, RgbImage};
 
 use super::draw::{self, BLACK, DARK_GREY, WHITE};
 use super::falsecolour::{describe_scale, write_png, ColourScale, FalsecolourSettings, Legend};
-use super::units::{format_sig, Quantity, UnitSystem};
+use super::units::{format_sig, UnitSystem};
 use crate::output::OutputError;
+use crate::photometry::Quantity;
 
 /// The values of one calculation grid, as the report JSON holds them.
 #[derive(Clone, Debug, PartialEq)]

@@ -8,8 +8,8 @@ use crate::world::World;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
-use super::units::Quantity;
-pub use super::units::UnitSystem as Units;
+use super::units::UnitSystem;
+use crate::photometry::Quantity;
 
 fn v3(v: glam::Vec3) -> Value {
     json!([v.x, v.y, v.z])
@@ -59,7 +59,7 @@ pub struct ReportInput<'a> {
     pub render: &'a RenderResult,
     pub measurements: &'a Measurements,
     pub measure_seconds: f64,
-    pub units: Units,
+    pub units: UnitSystem,
     /// Output files already written, for reference.
     pub outputs: Vec<String>,
     /// How the progressive render ended: stop reason, target and what was reached.
@@ -195,7 +195,7 @@ pub fn report_json(r: &ReportInput) -> Value {
 }
 
 /// The CSV of one grid: one row per point.
-pub fn grid_csv(world: &World, grid: usize, est: &[Estimate], units: Units) -> String {
+pub fn grid_csv(world: &World, grid: usize, est: &[Estimate], units: UnitSystem) -> String {
     let g = &world.grids[grid];
     let k = units.from_si(Quantity::Illuminance, 1.0);
     let u = units.symbol(Quantity::Illuminance);

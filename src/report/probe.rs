@@ -1,13 +1,12 @@
-//! `candela probe`: the measured values of one pixel, or of a small disc of pixels, of a
-//! rendered EXR — luminance and illuminance with 95 % confidence intervals, XYZ, xy, u′v′,
-//! CCT, Duv and sRGB. See `docs/reports.md` for the text and JSON formats.
-
-use std::path::{Path, PathBuf};
+//! The probe of one pixel, or of a small disc of pixels, of a rendered EXR: luminance and
+//! illuminance with 95 % confidence intervals, XYZ, xy, u′v′, CCT, Duv and sRGB, and their JSON
+//! (keys in `docs/reports.md`). `candela probe` prints them as text or as that JSON.
+use std::path::Path;
 
 use anyhow::anyhow;
 use serde_json::{json, Value};
 
-use super::units::{format_sig, Quantity, UnitSystem};
+use super::units::UnitSystem;
 use crate::colour::models::{xyz_to_upvp, xyz_to_xy};
 use crate::colour::rgb::{srgb_encode, xyz_to_linear_srgb};
 use crate::colour::temperature::xyz_to_cct_ohno2013;
@@ -15,37 +14,10 @@ use crate::output::{
     read_exr, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR, CHANNEL_X, CHANNEL_Y,
     CHANNEL_Y_STDERR, CHANNEL_Z, ILLUMINANCE_SENTINEL,
 };
+use crate::photometry::Quantity;
 
 /// z value of the two-sided 95 % normal confidence interval.
 pub const Z95: f64 = 1.96;
-
-/// Arguments of `candela probe`.
-#[derive(clap::Args, Debug, Clone)]
-pub struct ProbeArgs {
-    /// EXR image written by `candela render` (channels X, Y, Z, stderr.Y; E, stderr.E, mask.E
-    /// with --illuminance).
-    pub exr: PathBuf,
-    /// Column of the pixel, 0 = left.
-    #[arg(allow_hyphen_values = true)]
-    pub x: i64,
-    /// Row of the pixel, 0 = top.
-    #[arg(allow_hyphen_values = true)]
-    pub y: i64,
-    /// Average over every pixel whose centre is within R pixels of (X, Y).
-    #[arg(long, allow_hyphen_values = true)]
-    pub radius: Option<f64>,
-    /// Print JSON (keys documented in docs/reports.md) instead of text.
-    #[arg(long)]
-    pub json: bool,
-    /// si (cd/m², lx) or imperial (fL, fc).
-    #[arg(long, default_value = "si", value_parser = parse_units)]
-    pub units: UnitSystem,
-}
-
-/// clap value parser for `--units`.
-pub fn parse_units(s: &str) -> Result<UnitSystem, String> {
-    UnitSystem::parse(s).ok_or_else(|| format!("unknown unit system '{s}' (use si or imperial)"))
-}
 
 /// A mean with its standard error (display units).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -293,44 +265,6 @@ pub fn probe_file(
     probe(&layers, x, y, radius, units).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
-/// `candela probe`: returns the text (or JSON) to print.
-pub fn run(args: &ProbeArgs) -> anyhow::Result<String> {
-    // Flatten to one line: the messages already name the file and their cause.
-    let r = probe_file(&args.exr, args.x, args.y, args.radius, args.units)
-        .map_err(|e| anyhow!("{e}"))?;
-    if args.json {
-        let mut v = r.to_json();
-        v["file"] = json!(args.exr.display().to_string());
-        Ok(serde_json::to_string_pretty(&v)? + "\n")
-    } else {
-        Ok(r.to_text(&args.exr.display().to_string()))
-    }
-}
-
-fn fmt3(v: [f64; 3], digits: usize) -> String {
-    format!(
-        "{:.*} {:.*} {:.*}",
-        digits, v[0], digits, v[1], digits, v[2]
-    )
-}
-
-fn estimate_text(e: &Estimate, unit: &str) -> String {
-    match (e.stderr, e.ci95()) {
-        (Some(se), Some((lo, hi))) => format!(
-            "{} ± {} {unit}   (95 % CI {} … {}; standard error {})",
-            format_sig(e.mean, 5),
-            format_sig(Z95 * se, 3),
-            format_sig(lo, 5),
-            format_sig(hi, 5),
-            format_sig(se, 3)
-        ),
-        _ => format!(
-            "{} {unit}   (confidence interval unknown: no standard error channel, or fewer than 2 samples per pixel)",
-            format_sig(e.mean, 5)
-        ),
-    }
-}
-
 impl ProbeResult {
     /// JSON with the keys documented in docs/reports.md (`file` is added by the command).
     pub fn to_json(&self) -> Value {
@@ -376,105 +310,5 @@ impl ProbeResult {
             "srgb_linear": self.srgb_linear,
             "srgb_encoded": self.srgb_encoded,
         })
-    }
-
-    /// The human-readable report; `file` names the image in the first line.
-    pub fn to_text(&self, file: &str) -> String {
-        let u = self.units;
-        let lu = u.symbol(Quantity::Luminance);
-        let eu = u.symbol(Quantity::Illuminance);
-        let mut s = match self.radius {
-            None => format!("{file}: pixel ({}, {})\n", self.x, self.y),
-            Some(r) => format!(
-                "{file}: disc of radius {} px around pixel ({}, {}): {} pixel{}\n",
-                format_sig(r, 4),
-                self.x,
-                self.y,
-                self.pixels,
-                if self.pixels == 1 { "" } else { "s" }
-            ),
-        };
-        let row = |s: &mut String, k: &str, v: String| s.push_str(&format!("  {k:<13} {v}\n"));
-        row(&mut s, "luminance", estimate_text(&self.luminance, lu));
-        let e = match &self.illuminance {
-            IlluminanceProbe::NoChannel => {
-                "no E channel in this image (render with --illuminance)".to_string()
-            }
-            IlluminanceProbe::Undefined { .. } => "undefined: pixel sees no surface".to_string(),
-            IlluminanceProbe::Defined {
-                estimate,
-                pixels,
-                mask_mean,
-            } => {
-                let mut t = estimate_text(estimate, eu);
-                if *pixels < self.pixels {
-                    t += &format!(
-                        "; over the {pixels} of {} pixels that see a surface",
-                        self.pixels
-                    );
-                }
-                if let Some(m) = mask_mean {
-                    if *m < 1.0 {
-                        t += &format!("; coverage {}", format_sig(*m, 3));
-                    }
-                }
-                t
-            }
-        };
-        row(&mut s, "illuminance", e);
-        match self.xyz {
-            None => row(&mut s, "XYZ", "no X/Z channels".to_string()),
-            Some(v) => {
-                row(
-                    &mut s,
-                    "XYZ",
-                    format!(
-                        "{} {} {} {lu}",
-                        format_sig(v[0], 5),
-                        format_sig(v[1], 5),
-                        format_sig(v[2], 5)
-                    ),
-                );
-            }
-        }
-        if let Some(v) = self.xy {
-            row(&mut s, "xy", format!("{:.4} {:.4}", v[0], v[1]));
-        }
-        if let Some(v) = self.upvp {
-            row(&mut s, "u′v′", format!("{:.4} {:.4}", v[0], v[1]));
-        }
-        match self.cct_duv {
-            Some([t, duv]) => {
-                let mut line = format!("{t:.0} K   Duv {duv:+.4}");
-                if duv.abs() > 0.05 {
-                    line += "  (|Duv| > 0.05: CCT is not meaningful)";
-                }
-                row(&mut s, "CCT", line);
-            }
-            None if self.xyz.is_some() => row(&mut s, "CCT", "undefined (black)".into()),
-            None => {}
-        }
-        if let (Some(l), Some(e)) = (self.srgb_linear, self.srgb_encoded) {
-            let gamut = if l.iter().any(|&c| !(-1e-9..=1.0 + 1e-9).contains(&c)) {
-                "  (outside 0…1: out of gamut or brighter than white)"
-            } else {
-                ""
-            };
-            row(
-                &mut s,
-                "sRGB linear",
-                format!("{}   (Y = 1){gamut}", fmt3(l, 4)),
-            );
-            let hex: Vec<String> = e
-                .iter()
-                .map(|c| format!("{:02X}", (c.clamp(0.0, 1.0) * 255.0).round() as u8))
-                .collect();
-            row(
-                &mut s,
-                "sRGB encoded",
-                format!("{}   #{}", fmt3(e, 4), hex.concat()),
-            );
-        }
-        s
     }
 }

@@ -1,46 +1,11 @@
-//! Units for displaying photometric values: SI (cd/m², lx) or imperial (fL, fc).
-//!
-//! Every value candela computes is SI; reports convert only when they print or draw. The
-//! factors are those of [`crate::photometry`] (international foot, NIST SP 811):
-//! 1 fc = 1 lm/ft² = 10.763 910 417 lx and 1 fL = (1/π) cd/ft² = 3.426 259 099 6 cd/m².
+//! Display units of reports: which unit of [`crate::photometry`]'s table a report prints a
+//! quantity in for an SI (cd/m², lx, m) or imperial (fL, fc, ft) system, and how numbers are
+//! formatted. Every value candela computes is SI; reports convert only when they print or
+//! draw, with the unit's own factor.
 
-use crate::photometry::FOOT_M;
-
-/// Lux per footcandle (1 lm/ft²).
-pub const LX_PER_FC: f64 = 1.0 / (FOOT_M * FOOT_M);
-/// cd/m² per footlambert ((1/π) cd/ft²).
-pub const CD_M2_PER_FL: f64 = 1.0 / (std::f64::consts::PI * FOOT_M * FOOT_M);
-/// Metres per foot (international foot).
-pub const M_PER_FT: f64 = FOOT_M;
-
-/// The photometric quantity a report shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Quantity {
-    /// Luminance (EXR channel `Y`), cd/m² or fL.
-    #[default]
-    Luminance,
-    /// Illuminance (EXR channel `E`, or a calculation grid), lx or fc.
-    Illuminance,
-}
-
-impl Quantity {
-    /// `"luminance"` or `"illuminance"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Quantity::Luminance => "luminance",
-            Quantity::Illuminance => "illuminance",
-        }
-    }
-
-    /// Parses `luminance`/`L`/`Y` or `illuminance`/`E` (case-insensitive).
-    pub fn parse(s: &str) -> Option<Self> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "luminance" | "l" | "y" => Some(Quantity::Luminance),
-            "illuminance" | "e" => Some(Quantity::Illuminance),
-            _ => None,
-        }
-    }
-}
+use crate::photometry::{
+    Quantity, Unit, CANDELA, FOOTCANDLE, FOOTLAMBERT, FOOT_M, LUMEN, LUX, NIT, TALBOT,
+};
 
 /// SI or imperial display units.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -70,23 +35,27 @@ impl UnitSystem {
         }
     }
 
-    /// Unit symbol of `q`: `cd/m²`, `lx`, `fL` or `fc`.
-    pub fn symbol(self, q: Quantity) -> &'static str {
+    /// The unit this system shows `q` in: cd/m² or fL, lx or fc; lm, cd and lm·s in both.
+    pub fn unit(self, q: Quantity) -> &'static Unit {
         match (self, q) {
-            (UnitSystem::Si, Quantity::Luminance) => "cd/m²",
-            (UnitSystem::Si, Quantity::Illuminance) => "lx",
-            (UnitSystem::Imperial, Quantity::Luminance) => "fL",
-            (UnitSystem::Imperial, Quantity::Illuminance) => "fc",
+            (UnitSystem::Si, Quantity::Luminance) => &NIT,
+            (UnitSystem::Si, Quantity::Illuminance) => &LUX,
+            (UnitSystem::Imperial, Quantity::Luminance) => &FOOTLAMBERT,
+            (UnitSystem::Imperial, Quantity::Illuminance) => &FOOTCANDLE,
+            (_, Quantity::LuminousFlux) => &LUMEN,
+            (_, Quantity::LuminousIntensity) => &CANDELA,
+            (_, Quantity::LuminousEnergy) => &TALBOT,
         }
+    }
+
+    /// Unit symbol of `q`: `cd/m²`, `lx`, `fL` or `fc` (see [`UnitSystem::unit`]).
+    pub fn symbol(self, q: Quantity) -> &'static str {
+        self.unit(q).symbol
     }
 
     /// How many SI units (cd/m² or lx) one display unit of `q` is.
     pub fn si_per_unit(self, q: Quantity) -> f64 {
-        match (self, q) {
-            (UnitSystem::Si, _) => 1.0,
-            (UnitSystem::Imperial, Quantity::Luminance) => CD_M2_PER_FL,
-            (UnitSystem::Imperial, Quantity::Illuminance) => LX_PER_FC,
-        }
+        self.unit(q).si
     }
 
     /// Converts an SI value (cd/m² or lx) of `q` to this system's unit.
@@ -111,7 +80,7 @@ impl UnitSystem {
     pub fn length_from_m(self, m: f64) -> f64 {
         match self {
             UnitSystem::Si => m,
-            UnitSystem::Imperial => m / M_PER_FT,
+            UnitSystem::Imperial => m / FOOT_M,
         }
     }
 }
@@ -154,6 +123,7 @@ mod tests {
 
     #[test]
     fn factors_match_the_definitions() {
+        use crate::photometry::{CD_M2_PER_FL, LX_PER_FC};
         assert!((LX_PER_FC - 10.763910417).abs() < 1e-8);
         assert!((CD_M2_PER_FL - 3.4262590996).abs() < 1e-9);
         let fc = crate::photometry::convert(100.0, "lx", "fc").unwrap();

@@ -1,0 +1,275 @@
+//! The false-colour image: the values of the chosen channel, the coloured (banded, contoured,
+//! hatched where undefined) map, title, subtitle and footer, and the PNG file.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use image::{ImageFormat, Rgb, RgbImage};
+
+use super::{
+    describe_scale, ColourScale, FalsecolourSettings, Legend, LegendInfo, HATCH_PERIOD, LABEL_PX,
+    UNDEFINED_HATCH,
+};
+use crate::output::{
+    write_atomic, Layers, OutputError, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_Y, ILLUMINANCE_SENTINEL,
+};
+use crate::photometry::Quantity;
+use crate::report::draw::{self, BLACK, DARK_GREY, WHITE};
+use crate::report::units::format_sig;
+
+const PAD: u32 = 16;
+const TITLE_PX: f32 = 20.0;
+
+/// The values to map (display units) and whether each pixel is defined.
+fn extract(
+    layers: &Layers,
+    settings: &FalsecolourSettings,
+) -> Result<(Vec<f64>, Vec<bool>), String> {
+    let units = settings.units;
+    let q = settings.quantity;
+    match q {
+        Quantity::Luminance => {
+            let y = layers
+                .channel(CHANNEL_Y)
+                .ok_or_else(|| format!("image has no '{CHANNEL_Y}' (luminance) channel"))?;
+            let v = y.iter().map(|&v| units.from_si(q, v as f64)).collect();
+            let defined = y.iter().map(|v| v.is_finite()).collect();
+            Ok((v, defined))
+        }
+        Quantity::Illuminance => {
+            let e = layers.channel(CHANNEL_E).ok_or_else(|| {
+                format!(
+                    "image has no '{CHANNEL_E}' (illuminance) channel; render with --illuminance"
+                )
+            })?;
+            let mask = layers.channel(CHANNEL_E_MASK);
+            let defined: Vec<bool> = e
+                .iter()
+                .enumerate()
+                .map(|(i, &v)| {
+                    v.is_finite()
+                        && v != ILLUMINANCE_SENTINEL
+                        && v >= 0.0
+                        && mask.is_none_or(|m| m[i] > 0.0)
+                })
+                .collect();
+            let v = e.iter().map(|&v| units.from_si(q, v as f64)).collect();
+            Ok((v, defined))
+        }
+        other => Err(format!(
+            "a false-colour map shows luminance or illuminance, not {}",
+            other.name()
+        )),
+    }
+}
+
+/// Renders the false-colour image in memory (see [`write_falsecolour`]).
+pub fn render_falsecolour(
+    layers: &Layers,
+    settings: &FalsecolourSettings,
+) -> Result<(RgbImage, LegendInfo), String> {
+    let (w, h) = (layers.width, layers.height);
+    if w == 0 || h == 0 {
+        return Err("image is empty".into());
+    }
+    let (values, defined) = extract(layers, settings)?;
+    if values.len() != w * h {
+        return Err(format!(
+            "channel has {} samples, expected {w}×{h}",
+            values.len()
+        ));
+    }
+    let data: Vec<f64> = values
+        .iter()
+        .zip(&defined)
+        .filter(|(_, &d)| d)
+        .map(|(&v, _)| v)
+        .collect();
+    let cs = ColourScale::resolve(settings, &data)?;
+    let undefined = defined.iter().filter(|&&d| !d).count();
+    let stats = if data.is_empty() {
+        None
+    } else {
+        let lo = data.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = data.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        Some((lo, data.iter().sum::<f64>() / data.len() as f64, hi))
+    };
+    let unit = settings.units.symbol(settings.quantity);
+
+    // Zoom small images so the map is at least ~420 px tall, within 2400 px of width.
+    let zoom = 420_usize.div_ceil(h).clamp(1, 16).min((2400 / w).max(1)) as u32;
+    let (mw, mh) = (w as u32 * zoom, h as u32 * zoom);
+
+    let title = settings.title.clone().unwrap_or_else(|| {
+        let name = settings.quantity.name();
+        let mut c = name.chars();
+        c.next()
+            .map(|f| f.to_uppercase().collect::<String>() + c.as_str())
+            .unwrap_or_default()
+    });
+    let subtitle = describe_scale(&cs, unit);
+    let footer = match stats {
+        Some((lo, mean, hi)) => {
+            let mut s = format!(
+                "min {}   mean {}   max {} {unit}",
+                format_sig(lo, 4),
+                format_sig(mean, 4),
+                format_sig(hi, 4)
+            );
+            if undefined > 0 {
+                s += &format!("   (over {} of {} pixels)", data.len(), w * h);
+            }
+            s
+        }
+        None => format!("no pixel has a defined {}", settings.quantity.name()),
+    };
+    let undefined_label = (undefined > 0).then(|| {
+        let what = match settings.quantity {
+            Quantity::Illuminance => "no surface: E undefined",
+            _ => "undefined",
+        };
+        format!(
+            "{what} ({} %)",
+            format_sig(100.0 * undefined as f64 / (w * h) as f64, 3)
+        )
+    });
+
+    let below_range = data.iter().filter(|&&v| v < cs.min).count();
+    let above_range = data.iter().filter(|&&v| v > cs.max).count();
+    let legend = Legend::new(
+        &cs,
+        unit,
+        undefined_label.as_deref(),
+        (below_range > 0, above_range > 0),
+        mh.max(260),
+    );
+    let header_h = PAD + draw::line_height(TITLE_PX) + 4 + draw::line_height(LABEL_PX) + 10;
+    let footer_h = 8 + draw::line_height(LABEL_PX) + PAD;
+    let body_h = mh.max(legend.height);
+    let width = (PAD + mw + 24 + legend.width + PAD)
+        .max(PAD * 2 + draw::text_width(TITLE_PX, &title))
+        .max(PAD * 2 + draw::text_width(LABEL_PX, &subtitle))
+        .max(PAD * 2 + draw::text_width(LABEL_PX, &footer));
+    let height = header_h + body_h + footer_h;
+    let mut img = RgbImage::from_pixel(width, height, WHITE);
+
+    draw::draw_text(&mut img, PAD as i32, PAD as i32, TITLE_PX, &title, BLACK);
+    let sub_y = PAD + draw::line_height(TITLE_PX) + 4;
+    draw::draw_text(
+        &mut img,
+        PAD as i32,
+        sub_y as i32,
+        LABEL_PX,
+        &subtitle,
+        DARK_GREY,
+    );
+
+    // The map.
+    let (ox, oy) = (PAD, header_h);
+    let classes: Vec<usize> = values.iter().map(|&v| cs.contour_class(v)).collect();
+    for j in 0..h {
+        for i in 0..w {
+            let k = j * w + i;
+            let (x0, y0) = (ox + i as u32 * zoom, oy + j as u32 * zoom);
+            if defined[k] {
+                let c = Rgb(cs.colour(values[k]));
+                for dy in 0..zoom {
+                    for dx in 0..zoom {
+                        img.put_pixel(x0 + dx, y0 + dy, c);
+                    }
+                }
+            } else {
+                for dy in 0..zoom {
+                    for dx in 0..zoom {
+                        let (px, py) = (x0 + dx, y0 + dy);
+                        let (a, b) = UNDEFINED_HATCH;
+                        let c = draw::hatch_colour(px as i32, py as i32, a, b, HATCH_PERIOD);
+                        img.put_pixel(px, py, c);
+                    }
+                }
+            }
+        }
+    }
+    if settings.contours {
+        let line = Rgb([0, 0, 0]);
+        for j in 0..h {
+            for i in 0..w {
+                let k = j * w + i;
+                if !defined[k] {
+                    continue;
+                }
+                let (x0, y0) = (ox + i as u32 * zoom, oy + j as u32 * zoom);
+                if i + 1 < w && defined[k + 1] && classes[k + 1] != classes[k] {
+                    for dy in 0..zoom {
+                        img.put_pixel(x0 + zoom - 1, y0 + dy, line);
+                    }
+                }
+                if j + 1 < h && defined[k + w] && classes[k + w] != classes[k] {
+                    for dx in 0..zoom {
+                        img.put_pixel(x0 + dx, y0 + zoom - 1, line);
+                    }
+                }
+            }
+        }
+    }
+    draw::stroke_rect(
+        &mut img,
+        ox as i32 - 1,
+        oy as i32 - 1,
+        mw + 2,
+        mh + 2,
+        DARK_GREY,
+    );
+
+    legend.draw(&mut img, (ox + mw + 24) as i32, oy as i32);
+    draw::draw_text(
+        &mut img,
+        PAD as i32,
+        (header_h + body_h + 8) as i32,
+        LABEL_PX,
+        &footer,
+        BLACK,
+    );
+
+    let info = LegendInfo {
+        quantity: settings.quantity,
+        units: settings.units,
+        unit: unit.to_string(),
+        step_colours: (0..cs.steps.unwrap_or(0))
+            .map(|k| cs.step_colour(k))
+            .collect(),
+        scale: cs,
+        undefined_pixels: undefined,
+        below_range,
+        above_range,
+        stats,
+        map_origin: (ox, oy),
+        zoom,
+        image_size: (width, height),
+    };
+    Ok((img, info))
+}
+
+/// Writes the false-colour PNG of `layers` to `path` atomically and returns what the legend
+/// shows. Errors (missing channel, bad range, I/O) name `path`.
+pub fn write_falsecolour(
+    path: &Path,
+    layers: &Layers,
+    settings: &FalsecolourSettings,
+) -> Result<LegendInfo, OutputError> {
+    let (img, info) =
+        render_falsecolour(layers, settings).map_err(|e| OutputError::invalid(path, e))?;
+    write_png(path, &img)?;
+    Ok(info)
+}
+
+/// Encodes `img` as PNG and writes it atomically.
+pub fn write_png(path: &Path, img: &RgbImage) -> Result<(), OutputError> {
+    let mut bytes = Vec::new();
+    img.write_to(&mut Cursor::new(&mut bytes), ImageFormat::Png)
+        .map_err(|e| OutputError::Png {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    write_atomic(path, |w| w.write_all(&bytes))
+}
