@@ -6,7 +6,6 @@
 //! Data flow: `scene` (RON) → `world` (spectra resolved, lights in W, one BVH) →
 //! `integrator` per sample → `film` (absolute XYZ sums) → `output` (EXR, PNG).
 
-pub mod bench;
 pub mod bxdf;
 pub mod camera;
 pub mod caustics;

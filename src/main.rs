@@ -83,7 +83,7 @@ enum Command {
         diagram: Option<PathBuf>,
     },
     /// Benchmark: samples/s and rays/s on the Cornell box and on a generated 1 M-triangle scene; `bench traversal` (BVH vs Embree) and `bench scaling` (10 k … 5 M triangles).
-    Bench(candela::bench::BenchArgs),
+    Bench(cli::bench::BenchArgs),
     /// Luminance, illuminance (95 % CI), XYZ, xy, u′v′, CCT, Duv and sRGB of a pixel or disc of an EXR; see docs/reports.md.
     Probe(candela::report::probe::ProbeArgs),
     /// False-colour PNG of luminance or illuminance with a legend; see docs/reports.md.
@@ -181,7 +181,7 @@ fn main() -> ExitCode {
         Command::Luminaire { file, diagram } => {
             candela::luminaire::cli::run(&file, diagram.as_deref()).map(|s| say_raw!("{s}"))
         }
-        Command::Bench(args) => candela::bench::main(&args),
+        Command::Bench(args) => cli::bench::main(&args),
         Command::Probe(args) => candela::report::probe::run(&args).map(|s| say_raw!("{s}")),
         Command::Falsecolour(args) => {
             candela::report::falsecolour::run(&args).map(|s| say_raw!("{s}"))
@@ -313,7 +313,7 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
         Units::Si
     };
     if let Some(n) = threads {
-        candela::bench::check_threads("--threads", n)?;
+        cli::bench::check_threads("--threads", n)?;
     }
     check_exposure(exposure)?;
     if !(a.target_fraction > 0.0 && a.target_fraction <= 1.0) {

@@ -38,8 +38,6 @@ mod prim;
 mod robust;
 mod scene;
 
-pub mod generate;
-
 pub use io::{load_obj, load_ply};
 pub use robust::{
     gamma, next_float_down, next_float_up, offset_ray_origin, point_error_bound, shadow_ray,
