@@ -179,7 +179,7 @@ fn main() -> ExitCode {
             candela::cli_colour::convert_command(value, &from, &to).map(|s| say_raw!("{s}"))
         }
         Command::Luminaire { file, diagram } => {
-            candela::luminaire::cli::run(&file, diagram.as_deref()).map(|s| say_raw!("{s}"))
+            cli::luminaire::run(&file, diagram.as_deref()).map(|s| say_raw!("{s}"))
         }
         Command::Bench(args) => cli::bench::main(&args),
         Command::Probe(args) => candela::report::probe::run(&args).map(|s| say_raw!("{s}")),
