@@ -173,10 +173,10 @@ fn main() -> ExitCode {
             } else {
                 Observer::Cie1931_2
             };
-            candela::cli_colour::spectrum_command(&source, obs, json).map(|s| say_raw!("{s}"))
+            cli::colour::spectrum_command(&source, obs, json).map(|s| say_raw!("{s}"))
         }
         Command::Convert { value, from, to } => {
-            candela::cli_colour::convert_command(value, &from, &to).map(|s| say_raw!("{s}"))
+            cli::colour::convert_command(value, &from, &to).map(|s| say_raw!("{s}"))
         }
         Command::Luminaire { file, diagram } => {
             cli::luminaire::run(&file, diagram.as_deref()).map(|s| say_raw!("{s}"))
