@@ -16,6 +16,7 @@ pub struct Summary {
     pub field: [f64; 2],
 }
 
+/// The summary figures of `p`, from its expanded [`Distribution`](super::Distribution).
 pub fn summarise(p: &Photometry) -> Summary {
     let d = p.distribution();
     let (max_cd, a, b) = d.max_direction();
