@@ -6,11 +6,9 @@
 //! Data flow: `scene` (RON) → `world` (spectra resolved, lights in W, one BVH) →
 //! `integrator` per sample → `film` (absolute XYZ sums) → `output` (EXR, PNG).
 
-pub mod bench;
 pub mod bxdf;
 pub mod camera;
 pub mod caustics;
-pub mod cli_colour;
 pub mod colour;
 pub mod film;
 pub mod geometry;

@@ -76,7 +76,7 @@ enum Command {
         diagram: Option<PathBuf>,
     },
     /// Benchmark: samples/s and rays/s on the Cornell box and on a generated 1 M-triangle scene; `bench traversal` (BVH vs Embree) and `bench scaling` (10 k … 5 M triangles).
-    Bench(candela::bench::BenchArgs),
+    Bench(cli::bench::BenchArgs),
     /// Luminance, illuminance (95 % CI), XYZ, xy, u′v′, CCT, Duv and sRGB of a pixel or disc of an EXR; see docs/reports.md.
     Probe(cli::probe::ProbeArgs),
     /// False-colour PNG of luminance or illuminance with a legend; see docs/reports.md.
@@ -102,15 +102,15 @@ fn main() -> ExitCode {
             } else {
                 Observer::Cie1931_2
             };
-            candela::cli_colour::spectrum_command(&source, obs, json).map(|s| say_raw!("{s}"))
+            cli::colour::spectrum_command(&source, obs, json).map(|s| say_raw!("{s}"))
         }
         Command::Convert { value, from, to } => {
-            candela::cli_colour::convert_command(value, &from, &to).map(|s| say_raw!("{s}"))
+            cli::colour::convert_command(value, &from, &to).map(|s| say_raw!("{s}"))
         }
         Command::Luminaire { file, diagram } => {
-            candela::luminaire::cli::run(&file, diagram.as_deref()).map(|s| say_raw!("{s}"))
+            cli::luminaire::run(&file, diagram.as_deref()).map(|s| say_raw!("{s}"))
         }
-        Command::Bench(args) => candela::bench::main(&args),
+        Command::Bench(args) => cli::bench::main(&args),
         Command::Probe(args) => cli::probe::run(&args).map(|s| say_raw!("{s}")),
         Command::Falsecolour(args) => cli::falsecolour::run(&args).map(|s| say_raw!("{s}")),
     };

@@ -11,8 +11,12 @@
 //! * Exact unit definitions (NIST SP 811, 1 ft = 0.3048 m): 1 fc = 1 lm/ft², 1 fL = (1/π)
 //!   cd/ft².
 
-use candela::cli_colour::{convert_command, spectrum_command};
+#[path = "../src/cli/colour.rs"]
+#[allow(dead_code)]
+mod colour;
+
 use candela::colour::tables::{cmfs, named_spectrum, photopic_v, scotopic_v, Observer, LEN};
+use colour::{convert_command, spectrum_command};
 use serde_json::Value;
 
 fn json(source: &str, observer: Observer) -> Value {

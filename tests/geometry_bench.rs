@@ -2,7 +2,14 @@
 //! `cargo test --release --test geometry_bench -- --ignored --nocapture`
 //! (`RAYON_NUM_THREADS` selects the thread count).
 
-use candela::geometry::generate::{bench_bvh, bumpy_sphere};
+#[path = "../src/cli/bench/generate.rs"]
+#[allow(dead_code)]
+mod generate;
+#[path = "../src/cli/bench/rng.rs"]
+#[allow(dead_code)]
+mod rng;
+
+use generate::{bench_bvh, bumpy_sphere};
 
 #[test]
 #[ignore]

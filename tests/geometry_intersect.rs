@@ -1,8 +1,16 @@
 //! Ray–shape intersection against analytic answers, BVH vs brute force, transforms.
 
-use candela::geometry::generate::{grid_mesh, Rng};
+#[path = "../src/cli/bench/generate.rs"]
+#[allow(dead_code)]
+mod generate;
+#[path = "../src/cli/bench/rng.rs"]
+#[allow(dead_code)]
+mod rng;
+
 use candela::geometry::{SceneGeometry, Shape, Transform, TriangleMesh};
+use generate::grid_mesh;
 use glam::{Vec2, Vec3};
+use rng::Rng;
 
 fn close(a: f32, b: f32, tol: f32) -> bool {
     (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
@@ -483,7 +491,7 @@ fn transforms() {
         _ => unreachable!(),
     }
     // ...and an outward closed mesh stays outward under a mirror.
-    let m = candela::geometry::generate::cube_sphere(4, 0.0);
+    let m = generate::cube_sphere(4, 0.0);
     let mm = match Shape::Mesh(m).to_world(&mirror).unwrap() {
         Shape::Mesh(m) => m,
         _ => unreachable!(),

@@ -1,12 +1,20 @@
 //! Self-intersection: rays spawned with `offset_ray_origin` never re-hit their own surface,
 //! at scales 1e-6 m, 1e-3 m, 1 m, 1e3 m and 1e6 m (and far from the world origin).
 
-use candela::geometry::generate::{grid_mesh, Rng};
+#[path = "../src/cli/bench/generate.rs"]
+#[allow(dead_code)]
+mod generate;
+#[path = "../src/cli/bench/rng.rs"]
+#[allow(dead_code)]
+mod rng;
+
 use candela::geometry::{
     offset_ray_origin, point_error_bound, shadow_ray, Hit, SceneGeometry, Shape, Transform,
     TriangleMesh,
 };
+use generate::grid_mesh;
 use glam::Vec3;
+use rng::Rng;
 
 const SCALES: [f32; 5] = [1e-6, 1e-3, 1.0, 1e3, 1e6];
 const RAYS: usize = 20_000;

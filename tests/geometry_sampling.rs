@@ -1,9 +1,13 @@
 //! Area sampling uniformity and solid-angle pdfs. All tolerances are 5 standard errors
 //! computed from the sample variance.
 
-use candela::geometry::generate::Rng;
+#[path = "../src/cli/bench/rng.rs"]
+#[allow(dead_code)]
+mod rng;
+
 use candela::geometry::{SceneGeometry, Shape, TriangleMesh};
 use glam::{DVec3, Vec3};
+use rng::Rng;
 
 const N: usize = 200_000;
 

@@ -4,6 +4,8 @@
 //! write → read round trips.
 
 use candela::luminaire::{self, ies, ldt, Format, Kind, Photometry, Symmetry};
+#[path = "../src/cli/luminaire.rs"]
+mod cli_luminaire;
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -265,8 +267,7 @@ fn number_after(text: &str, marker: &str) -> f64 {
 fn luminaire_command_reports_and_draws() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("spot.png");
-    let out =
-        luminaire::cli::run(Path::new("data/luminaires/narrow-spot.ies"), Some(&png)).unwrap();
+    let out = cli_luminaire::run(Path::new("data/luminaires/narrow-spot.ies"), Some(&png)).unwrap();
     // Flux: the closed form Φ = 2π·5000/41 = 766.24 lm (∫ cos⁴⁰ γ dω over the lower
     // hemisphere), within the 0.5 % this file uses for every integrated table.
     let integrated = number_before(&out, " lm integrated");

@@ -380,7 +380,7 @@ fn fuzz_parsers_never_panic() {
         assert!(!lm.is_nan());
         let _ = d.sample(0.3, 0.6, 0.9);
         let _ = d.eval([0.0, -1.0, 0.0]);
-        let _ = candela::luminaire::cli::summarise(&p);
+        let _ = candela::luminaire::summary::summarise(&p);
     };
     for (seeds, is_ldt) in [(&seeds_ies[..], false), (&seeds_ldt[..], true)] {
         for _ in 0..iters {

@@ -1,1 +1,236 @@
-//! `candela bench`.
+//! `candela bench`: throughput on the Cornell box and on a generated mesh of about a million
+//! triangles (samples/s and rays/s), plus two sub-benchmarks:
+//! * `candela bench traversal` — closest-hit / any-hit rays per second of the BVH on primary,
+//!   diffuse-bounce and shadow rays, optionally against Embree (see `bench/embree/README.md`);
+//! * `candela bench scaling` — the mesh scene at 10 k … 5 M triangles (build time, bytes per
+//!   triangle, peak memory, ns per sample) and a pixels × samples linearity check.
+//!
+//! Nothing here is asserted by tests (timings depend on the machine).
+
+// Shared with the geometry tests, which use the items the benchmarks do not.
+#[allow(dead_code)]
+pub mod generate;
+pub mod rayfile;
+#[allow(dead_code)]
+pub mod rng;
+pub mod scaling;
+pub mod traversal;
+
+use candela::render::render;
+use candela::scene::{self, schema::*, Overrides};
+use std::path::Path;
+use std::time::Instant;
+
+const CORNELL: &str = include_str!("../../scenes/cornell-box.ron");
+
+/// Options of `candela bench`.
+#[derive(clap::Args, Debug, Clone)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    pub mode: Option<BenchMode>,
+    /// Worker threads (default: all cores; at most 16 per available core).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Samples per pixel for each benchmark scene.
+    #[arg(long, default_value_t = 16)]
+    pub spp: u32,
+    /// Triangles in the generated mesh scene (approximate).
+    #[arg(long, default_value_t = 1_000_000)]
+    pub triangles: usize,
+}
+
+/// The sub-benchmarks of `candela bench` (without one: Cornell box and the 1 M-triangle scene).
+#[derive(clap::Subcommand, Debug, Clone)]
+pub enum BenchMode {
+    /// BVH closest-hit / any-hit Mrays/s on primary, diffuse-bounce and shadow rays (1 and 2 threads); --export writes mesh + rays for bench/embree, --embree compares against Embree. See bench/embree/README.md.
+    Traversal(traversal::TraversalArgs),
+    /// The mesh scene at 10 k, 100 k, 1 M and 5 M triangles: BVH build time, bytes/triangle, peak RSS, ns/sample, samples/s, rays/s; plus a pixels × spp linearity check.
+    Scaling(scaling::ScalingArgs),
+}
+
+pub use candela::job::check_threads;
+
+/// Largest triangle count of a generated benchmark mesh (about 10 GB of mesh and BVH).
+pub const MAX_TRIANGLES: usize = 100_000_000;
+
+/// Refuses a triangle count (of option `flag`) above [`MAX_TRIANGLES`].
+pub fn check_triangles(flag: &str, n: usize) -> anyhow::Result<()> {
+    if n > MAX_TRIANGLES {
+        anyhow::bail!(
+            "{flag} {n} is too many: at most {MAX_TRIANGLES} triangles are generated (each needs about 100 bytes of mesh and BVH)"
+        );
+    }
+    Ok(())
+}
+
+/// Largest `--resolution` of the generated benchmarks (`bench traversal` holds RES² rays per
+/// batch).
+pub const MAX_RESOLUTION: u32 = 8192;
+
+/// Refuses a `--resolution` of 0 or above [`MAX_RESOLUTION`].
+pub fn check_resolution(res: u32) -> anyhow::Result<()> {
+    check_positive("--resolution", res.into())?;
+    if res > MAX_RESOLUTION {
+        anyhow::bail!(
+            "--resolution {res} is too large: at most {MAX_RESOLUTION} ({MAX_RESOLUTION}² primary rays per batch)"
+        );
+    }
+    Ok(())
+}
+
+/// A figure for the benchmark tables with `decimals` decimals, or "n/a" where a run was too
+/// short for the clock (0 s or 0 ns, so the figure is 0 or infinite).
+pub fn cell(x: f64, decimals: usize) -> String {
+    if x.is_finite() && x > 0.0 {
+        format!("{x:.decimals$}")
+    } else {
+        "n/a".into()
+    }
+}
+
+/// Refuses 0 for a count option (`flag`) that needs at least 1.
+pub fn check_positive(flag: &str, n: u64) -> anyhow::Result<()> {
+    if n == 0 {
+        anyhow::bail!("{flag} must be at least 1, got 0");
+    }
+    Ok(())
+}
+
+/// Entry point of `candela bench`.
+pub fn main(args: &BenchArgs) -> anyhow::Result<()> {
+    if args.mode.is_none() {
+        if let Some(n) = args.threads {
+            check_threads("--threads", n)?;
+        }
+        check_positive("--spp", args.spp.into())?;
+        check_triangles("--triangles", args.triangles)?;
+    }
+    match &args.mode {
+        None => run(args.threads, args.spp, args.triangles),
+        Some(BenchMode::Traversal(a)) => traversal::run(a),
+        Some(BenchMode::Scaling(a)) => scaling::run(a),
+    }
+}
+
+fn report(name: &str, r: &candela::render::RenderResult) {
+    println!(
+        "{name:<28} {:>4}×{:<4} {:>4} spp  {:>7.2} s  {:>8.3} M samples/s  {:>8.3} M rays/s  ({} threads)",
+        r.film.width,
+        r.film.height,
+        r.film.total_samples() / (r.film.width * r.film.height) as u64,
+        r.elapsed.as_secs_f64(),
+        r.samples_per_second() / 1e6,
+        r.rays_per_second() / 1e6,
+        r.threads
+    );
+}
+
+/// Cube-sphere subdivisions for about `triangles` triangles (`12·s²`).
+/// Median of `v` (the upper one of an even count; NaN if empty). Sorts `v`.
+pub fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+pub fn subdivisions_for(triangles: usize) -> u32 {
+    ((triangles as f64 / 12.0).sqrt().ceil() as u32).max(1)
+}
+
+/// The mesh benchmark scene: `mesh` (the bumpy sphere, lifted by 1 m) on a 20 m floor quad,
+/// grey diffuse, under a D65 sky and a D50 sun, seen by [`traversal::bench_camera`]'s view.
+pub fn mesh_scene(mesh: candela::geometry::TriangleMesh, spp: u32, resolution: u32) -> SceneFile {
+    SceneFile {
+        camera: CameraDesc {
+            position: [0.0, 1.2, -3.2],
+            look_at: [0.0, 0.9, 0.0],
+            up: [0.0, 1.0, 0.0],
+            vfov_deg: 45.0,
+            resolution: (resolution, resolution),
+            lens: None,
+        },
+        render: RenderDesc {
+            spp,
+            ..Default::default()
+        },
+        materials: [(
+            "grey".to_string(),
+            MaterialDesc::Diffuse {
+                reflectance: SpectrumDesc::Constant(0.6),
+            },
+        )]
+        .into_iter()
+        .collect(),
+        objects: vec![
+            ObjectDesc {
+                name: Some("mesh".into()),
+                shape: ShapeDesc::Triangles {
+                    positions: mesh.positions.iter().map(|p| p.to_array()).collect(),
+                    indices: mesh.indices,
+                    normals: None,
+                },
+                material: "grey".into(),
+                emission: None,
+                transform: Some(TransformDesc {
+                    translate: Some([0.0, 1.0, 0.0]),
+                    rotate_deg: None,
+                    scale: None,
+                }),
+            },
+            ObjectDesc {
+                name: Some("floor".into()),
+                shape: ShapeDesc::Quad {
+                    origin: [-10.0, 0.0, -10.0],
+                    edge_u: [0.0, 0.0, 20.0],
+                    edge_v: [20.0, 0.0, 0.0],
+                },
+                material: "grey".into(),
+                emission: None,
+                transform: None,
+            },
+        ],
+        lights: vec![
+            LightDesc::Environment {
+                spectrum: SpectrumDesc::Named("D65".into()),
+                amount: Amount::Luminance(5000.0),
+                portals: Vec::new(),
+            },
+            LightDesc::Distant {
+                direction: [0.3, -1.0, 0.5],
+                spectrum: SpectrumDesc::Named("D50".into()),
+                amount: Amount::Illuminance(50_000.0),
+            },
+        ],
+        meters: Vec::new(),
+        grids: Vec::new(),
+        measure: MeasureDesc::default(),
+    }
+}
+
+/// The default benchmark: the Cornell box, then the mesh scene with about `triangles` triangles.
+pub fn run(threads: Option<usize>, spp: u32, triangles: usize) -> anyhow::Result<()> {
+    let overrides = Overrides {
+        spp: Some(spp),
+        ..Default::default()
+    };
+    let path = Path::new("scenes/cornell-box.ron");
+    let world = scene::build(&scene::parse(CORNELL, path)?, path, &overrides)?;
+    let r = render(&world, threads, &|_, _| {})?;
+    report("cornell-box", &r);
+
+    // A displaced sphere of ~`triangles` triangles on a floor, under a sky and a sun.
+    let t0 = Instant::now();
+    let mesh = generate::bumpy_sphere(subdivisions_for(triangles));
+    let n_tris = mesh.indices.len();
+    let scene = mesh_scene(mesh, spp, 256);
+    let world = scene::build(&scene, Path::new("<generated>"), &overrides)?;
+    drop(scene);
+    println!(
+        "generated mesh: {n_tris} triangles, scene built (incl. BVH) in {:.2} s, geometry ≈ {:.1} bytes/triangle",
+        t0.elapsed().as_secs_f64(),
+        world.geometry.memory_bytes() as f64 / n_tris as f64
+    );
+    let r = render(&world, threads, &|_, _| {})?;
+    report(&format!("mesh {}k triangles", n_tris / 1000), &r);
+    Ok(())
+}

@@ -42,8 +42,6 @@ mod sample;
 mod scene;
 mod traverse;
 
-pub mod generate;
-
 pub use io::{load_obj, load_ply};
 pub use query::RayHit;
 pub use robust::{

@@ -158,7 +158,9 @@ pub struct RenderOutputs {
     pub grids: Vec<GridResult>,
 }
 
-/// Largest worker-thread count accepted: 16 per available core.
+/// Largest worker-thread count accepted: 16 per available core
+/// ([`std::thread::available_parallelism`]). More only adds contention and memory, and tens of
+/// thousands of threads make the process unresponsive.
 pub fn max_threads() -> usize {
     16 * std::thread::available_parallelism().map_or(1, |n| n.get())
 }

@@ -285,6 +285,11 @@ impl Portals {
 }
 
 #[cfg(test)]
+#[path = "../cli/bench/rng.rs"]
+#[allow(dead_code)]
+mod rng;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::sampling::uniform_sphere;
@@ -311,7 +316,7 @@ mod tests {
         ]);
         let p = Vec3::new(0.1, 0.0, 0.2);
         let n = 400_000;
-        let mut rng = crate::geometry::generate::Rng::new(7);
+        let mut rng = rng::Rng::new(7);
         let mut next = || rng.f32();
         let (mut sum, mut sum2) = (0.0f64, 0.0f64);
         for _ in 0..n {
@@ -388,7 +393,7 @@ mod tests {
         let sub = Portal::new(o + 0.1 * eu + 0.3 * ev, 0.5 * eu, 0.7 * ev).unwrap();
         let mid = o + 0.5 * (eu + ev);
         let normal = eu.cross(ev).normalize();
-        let mut rng = crate::geometry::generate::Rng::new(11);
+        let mut rng = rng::Rng::new(11);
         let mut next = || rng.f32();
         for p in [
             Vec3::new(0.3, 0.0, 0.2),
@@ -439,7 +444,7 @@ mod tests {
             Vec3::new(0.0, 0.0, 1.5),
         );
         let (nb, sub, n) = (10usize, 4usize, 200_000usize);
-        let mut rng = crate::geometry::generate::Rng::new(5);
+        let mut rng = rng::Rng::new(5);
         for ((o, eu, ev), p, label) in [
             (skewed, Vec3::new(0.2, 2.0, 0.1), "1 m below"),
             (skewed, Vec3::new(3.0, 2.6, 2.0), "oblique"),

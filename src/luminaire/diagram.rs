@@ -5,8 +5,11 @@
 //! circles, text in the bundled DejaVu Sans).
 
 use super::{polar_value, Distribution};
+use crate::output::{write_atomic, OutputError};
 use crate::report::draw;
+use image::{codecs::png::PngEncoder, ExtendedColorType, ImageEncoder};
 use image::{Rgb, RgbImage};
+use std::path::Path;
 
 /// Label text size (em height, pixels).
 const FONT_PX: f32 = 18.0;
@@ -31,6 +34,21 @@ pub fn ring_step(max: f64) -> f64 {
         }
     }
     10.0 * p
+}
+
+/// Draws the diagram of `dist` titled `title` and writes it to `path` as a PNG (atomically).
+pub fn write_png(path: &Path, dist: &Distribution, title: &str) -> Result<(), OutputError> {
+    let img = draw(dist, title);
+    write_atomic(path, |wr| {
+        PngEncoder::new(wr)
+            .write_image(
+                img.as_raw(),
+                img.width(),
+                img.height(),
+                ExtendedColorType::Rgb8,
+            )
+            .map_err(std::io::Error::other)
+    })
 }
 
 /// Render the diagram.

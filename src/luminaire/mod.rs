@@ -15,10 +15,10 @@
 //! Candela is bilinear in the two file angles between table entries (continuous everywhere the
 //! table is, exact at the entries) and 0 outside the table's range of vertical angles.
 
-pub mod cli;
 pub mod diagram;
 pub mod ies;
 pub mod ldt;
+pub mod summary;
 
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};

@@ -14,8 +14,8 @@
 //! ```
 //! `t` is the hit distance or +∞ for a miss; for any-hit batches 0 means occluded, +∞ not.
 
-use crate::geometry::TriangleMesh;
 use anyhow::{bail, Context, Result};
+use candela::geometry::TriangleMesh;
 use glam::Vec3;
 use std::path::Path;
 
@@ -204,7 +204,7 @@ impl RayFile {
                 .with_context(|| format!("cannot create the directory '{}'", dir.display()))?;
         }
         let bytes = self.to_bytes()?;
-        crate::output::write_atomic(path, |w| w.write_all(&bytes))
+        candela::output::write_atomic(path, |w| w.write_all(&bytes))
             .with_context(|| format!("cannot write the ray file '{}'", path.display()))
     }
 

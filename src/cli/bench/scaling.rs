@@ -2,15 +2,15 @@
 //! time, bytes per triangle, peak memory, traversal and render throughput) and a
 //! pixels × samples linearity check.
 
+use super::generate::bumpy_sphere;
 use super::rayfile::RayBatch;
 use super::traversal::{bench_camera, generate_batches, trace_batch};
 use super::{median, mesh_scene, subdivisions_for};
-use crate::geometry::generate::bumpy_sphere;
-use crate::geometry::{SceneGeometry, Shape};
-use crate::render::render;
-use crate::scene::{self, Overrides};
-use crate::world::World;
 use anyhow::{Context, Result};
+use candela::geometry::{SceneGeometry, Shape};
+use candela::render::render;
+use candela::scene::{self, Overrides};
+use candela::world::World;
 use glam::Vec3;
 use std::path::Path;
 use std::time::Instant;

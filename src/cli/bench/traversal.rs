@@ -2,12 +2,13 @@
 //! kinds of rays a path tracer shoots, optionally side by side with Embree (the
 //! `bench/embree/embree_trace` program, fed the same mesh and rays through a ray file).
 
+use super::generate::bumpy_sphere;
 use super::median;
 use super::rayfile::{read_hits, BenchRay, RayBatch, RayFile, RayKind};
-use crate::camera::Camera;
-use crate::geometry::generate::{bumpy_sphere, Rng};
-use crate::geometry::{shadow_ray_between, SceneGeometry, Shape, TriangleMesh};
+use super::rng::Rng;
 use anyhow::{bail, Context, Result};
+use candela::camera::Camera;
+use candela::geometry::{shadow_ray_between, SceneGeometry, Shape, TriangleMesh};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -123,7 +124,7 @@ fn cosine_direction(n: Vec3, u: Vec2) -> Vec3 {
 
 /// The three batches of a path tracer's first bounce, in pixel order: `primary` (one jittered
 /// camera ray per pixel), `diffuse` (from each primary hit, a cosine-distributed direction about
-/// the normal facing the camera; origins offset with [`crate::geometry::offset_ray_origin`]) and
+/// the normal facing the camera; origins offset with [`candela::geometry::offset_ray_origin`]) and
 /// `shadow` (from each primary hit toward a uniformly chosen point of [`LIGHT`], only where the
 /// light is above the surface, as next-event estimation would; `t_max` stops short of the
 /// light). Deterministic.
@@ -568,7 +569,7 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
 
     if let Some(path) = &args.hits_out {
         let bytes = super::rayfile::hits_to_bytes(&candela_hits);
-        crate::output::write_atomic(path, |w| w.write_all(&bytes))
+        candela::output::write_atomic(path, |w| w.write_all(&bytes))
             .with_context(|| format!("cannot write the hit file '{}'", path.display()))?;
     }
 
