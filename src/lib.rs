@@ -9,7 +9,6 @@
 pub mod bench;
 pub mod bxdf;
 pub mod camera;
-pub mod caustics;
 pub mod cli_colour;
 pub mod colour;
 pub mod film;

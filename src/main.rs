@@ -5,9 +5,10 @@ mod cli;
 use anyhow::{bail, Context, Result};
 use candela::colour::tables::Observer;
 use candela::output::{self, Layers, PngSettings};
-use candela::report::json::{grid_csv, grid_csv_path, report_json, write_text, ReportInput, Units};
+use candela::report::json::{grid_csv, report_json, write_text, ReportInput, Units};
 use candela::report::units::Quantity;
 use candela::scene::{self, Overrides};
+use candela::world::measure::grid_csv_path;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -570,11 +571,11 @@ fn cmd_render(a: &RenderOpts) -> Result<()> {
     write_text(&report_path, &serde_json::to_string_pretty(&report)?)?;
     for (m, e) in world.meters.iter().zip(&measurements.meters) {
         let (k, unit) = match m.kind {
-            candela::meter::MeterKind::Illuminance { .. } => (
+            candela::world::MeterKind::Illuminance { .. } => (
                 units.from_si(Quantity::Illuminance, 1.0),
                 units.symbol(Quantity::Illuminance),
             ),
-            candela::meter::MeterKind::Luminance { .. } => (
+            candela::world::MeterKind::Luminance { .. } => (
                 units.from_si(Quantity::Luminance, 1.0),
                 units.symbol(Quantity::Luminance),
             ),
