@@ -75,8 +75,8 @@ pub struct PixelSums {
     pub sum_e2: f64,
     pub count_e: u64,
     /// Σ of the caustic light paths' splats on this pixel (XYZ, Y²) and the number of light
-    /// paths traced for the buffer (see [`crate::caustics`]): they add `splat_xyz / light_paths`
-    /// to the camera samples' mean.
+    /// paths traced for the buffer (see [`crate::integrator::light_path`]): they add
+    /// `splat_xyz / light_paths` to the camera samples' mean.
     #[serde(default)]
     pub splat_xyz: [f64; 3],
     #[serde(default)]
@@ -99,8 +99,8 @@ impl PixelSums {
         self.sum_y2 += xyz[1] * xyz[1];
         self.count += 1;
     }
-    /// Add the splats of `paths` light paths (see [`crate::caustics`]): their Σ X, Σ Y, Σ Z,
-    /// Σ Y², Σ E and Σ E² on this pixel.
+    /// Add the splats of `paths` light paths (see [`crate::integrator::light_path`]): their
+    /// Σ X, Σ Y, Σ Z, Σ Y², Σ E and Σ E² on this pixel.
     #[inline]
     pub fn add_light_paths(&mut self, sums: &[f64; 6], paths: u64) {
         for (s, v) in self.splat_xyz.iter_mut().zip(sums) {

@@ -8,7 +8,6 @@
 
 pub mod bxdf;
 pub mod camera;
-pub mod caustics;
 pub mod colour;
 pub mod film;
 pub mod geometry;

@@ -1,6 +1,7 @@
-//! Meters: illuminance at a point, luminance in a cone of directions, and calculation grids of
-//! illuminance meters (a work plane). Each result carries its standard error; each meter runs
-//! its own sample budget, or samples until a target relative error is reached.
+//! Measuring the meters and grids of a world ([`crate::world::measure`]): illuminance at a
+//! point, luminance in a cone of directions, and calculation grids of illuminance meters (a
+//! work plane). Each result carries its standard error; each meter runs its own sample budget,
+//! or samples until a target relative error is reached.
 //!
 //! Every meter point has its own random stream, so results do not depend on the thread count.
 
@@ -8,66 +9,10 @@ use crate::film::{radiance_to_xyz, standard_error};
 use crate::integrator::{irradiance, trace, PathStart, RayStart, RayStats};
 use crate::sampling::{mix64, Sampler};
 use crate::spectrum::SampledWavelengths;
-use crate::world::World;
+use crate::world::{MeasureSettings, MeterKind, World};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
-
-#[derive(Clone, Debug)]
-pub enum MeterKind {
-    /// Illuminance (lx) on the hemisphere around the unit `normal`.
-    Illuminance { position: Vec3, normal: Vec3 },
-    /// Mean luminance (cd/m²) over a cone of directions around the unit `direction`.
-    Luminance {
-        position: Vec3,
-        direction: Vec3,
-        half_angle_rad: f32,
-    },
-}
-
-#[derive(Clone, Debug)]
-pub struct Meter {
-    pub name: String,
-    pub kind: MeterKind,
-}
-
-#[derive(Clone, Debug)]
-pub struct Grid {
-    pub name: String,
-    pub origin: Vec3,
-    pub edge_u: Vec3,
-    pub edge_v: Vec3,
-    pub nx: u32,
-    pub ny: u32,
-    pub normal: Vec3,
-}
-
-impl Grid {
-    /// The meter point of cell (i, j): the cell centre.
-    pub fn point(&self, i: u32, j: u32) -> Vec3 {
-        self.origin
-            + self.edge_u * ((i as f32 + 0.5) / self.nx as f32)
-            + self.edge_v * ((j as f32 + 0.5) / self.ny as f32)
-    }
-}
-
-/// Sample budget of meters.
-#[derive(Clone, Debug)]
-pub struct MeasureSettings {
-    pub samples: u64,
-    pub target_relative_error: Option<f64>,
-    pub max_samples: u64,
-}
-
-impl Default for MeasureSettings {
-    fn default() -> Self {
-        Self {
-            samples: 4096,
-            target_relative_error: None,
-            max_samples: 1 << 22,
-        }
-    }
-}
 
 /// A measured value with its standard error.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -148,7 +148,7 @@ pub struct TargetError {
 
 /// Stream of the decision buffer's samples (statistically independent of the image's).
 const DECISION_STREAM: u64 = 0xdec1_5104_0000_0000;
-/// Stream of the caustic light paths (see [`crate::caustics`]).
+/// Stream of the caustic light paths (see [`crate::integrator::light_path`]).
 const CAUSTIC_STREAM: u64 = 0xca05_71c5_0000_0000;
 
 /// Samples a pixel's decision buffer needs before its error estimate is trusted.
@@ -390,7 +390,7 @@ pub fn render_progressive(
                 let seed = world.settings.seed ^ stream;
                 let mut sums = vec![[0.0f64; 6]; w * h];
                 let traced = pool.install(|| {
-                    crate::caustics::trace_light_paths(
+                    crate::integrator::light_path::trace_light_paths(
                         world, caustics, seed, first, per_buffer, stop, &mut sums,
                     )
                 });

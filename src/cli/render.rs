@@ -3,11 +3,11 @@
 
 use anyhow::{bail, Context, Result};
 use candela::job::{self, ImageDone, Outcome, Progress, RenderJob};
-use candela::meter::MeterKind;
 use candela::photometry::Quantity;
 use candela::render::{StopReason, TargetError};
 use candela::report::units::UnitSystem;
 use candela::scene::Overrides;
+use candela::world::MeterKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};

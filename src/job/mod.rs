@@ -14,13 +14,15 @@ pub use files::{
 pub use merge::{merge, MergeOutputs};
 
 use crate::film::Film;
-use crate::meter::{Estimate, GridStats, MeterKind};
+use crate::meter::{Estimate, GridStats};
 use crate::photometry::Quantity;
 use crate::render::{PassStatus, Progressive, RenderResult, StopReason, TargetError};
-use crate::report::json::{grid_csv, grid_csv_path, report_json, write_text, ReportInput};
+use crate::report::json::{grid_csv, report_json, write_text, ReportInput};
 use crate::report::units::UnitSystem;
 use crate::scene::{self, Overrides};
 use crate::state::RenderState;
+use crate::world::measure::grid_csv_path;
+use crate::world::MeterKind;
 use crate::world::World;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};

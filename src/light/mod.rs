@@ -75,7 +75,7 @@ impl LightFlags {
 
     /// Whether light tracing can start paths at such a light: sources at a finite position
     /// (from [`Light::sample_emission_point`]) and distant lights (parallel beams, started
-    /// across the scene by [`crate::caustics`]); not an environment.
+    /// across the scene by [`crate::integrator::light_path`]); not an environment.
     pub const fn can_emit_paths(self) -> bool {
         !self.contains(Self::INFINITE)
     }

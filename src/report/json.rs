@@ -1,12 +1,13 @@
 //! `NAME.report.json` and one CSV per calculation grid. The schema is documented in
 //! docs/reports.md; every value carries its unit in the `units` object.
 
-use crate::meter::{grid_stats, Estimate, Measurements, MeterKind};
+use crate::meter::{grid_stats, Estimate, Measurements};
 use crate::output::{write_atomic, OutputError};
 use crate::render::RenderResult;
+use crate::world::MeterKind;
 use crate::world::World;
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::units::UnitSystem;
 use crate::photometry::Quantity;
@@ -23,33 +24,6 @@ fn estimate(e: &Estimate, k: f64) -> Value {
         "ci95_high": (e.mean + e.ci95()) * k,
         "samples": e.samples,
     })
-}
-
-/// File-name-safe form of a grid name.
-pub fn slug(name: &str) -> String {
-    let s: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() {
-                c.to_ascii_lowercase()
-            } else {
-                '-'
-            }
-        })
-        .collect();
-    let s = s.trim_matches('-').to_string();
-    if s.is_empty() {
-        "grid".into()
-    } else {
-        s
-    }
-}
-
-/// Path of the CSV of grid `name` next to the report whose outputs share `stem`.
-pub fn grid_csv_path(stem: &Path, name: &str) -> PathBuf {
-    let mut p = stem.as_os_str().to_owned();
-    p.push(format!(".grid-{}.csv", slug(name)));
-    p.into()
 }
 
 /// Everything a report says about one run.

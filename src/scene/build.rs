@@ -7,12 +7,11 @@ use crate::bxdf::{Material, MaterialFlags};
 use crate::camera::{Camera, PixelFilter};
 use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
 use crate::light::{AreaLight, Light, LightFlags, LightSampler};
-use crate::meter::{Grid, MeasureSettings, Meter, MeterKind};
 use crate::spectrum::DenseSpectrum;
 use crate::world::{Object, RenderSettings, World};
 use glam::Vec3;
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Command-line overrides of the scene's render settings.
 #[derive(Clone, Debug, Default)]
@@ -408,7 +407,7 @@ pub fn build_for(
                 .flags()
                 .contains(MaterialFlags::DELTA)
         })
-        .filter_map(|(shape, _)| crate::caustics::bounding_sphere(shape))
+        .filter_map(|(shape, _)| crate::world::caustic_lights::bounding_sphere(shape))
         .collect();
     let geometry = SceneGeometry::build(&shapes).map_err(|e| {
         let field = match &e {
@@ -444,10 +443,11 @@ pub fn build_for(
         lights.push(light);
     }
     let light_sampler = LightSampler::new(&lights, &geometry, scene_radius);
-    let (meters, grids, measure) = build_meters(&ctx, scene)?;
+    let (meters, grids, measure) =
+        crate::world::measure::build_meters(&ctx, &scene.meters, &scene.grids, &scene.measure)?;
     let caustics = match settings.caustics {
         crate::world::Caustics::LightTracing => {
-            crate::caustics::CausticLights::new(&lights, caustic_targets, &geometry, scene_radius)
+            crate::world::CausticLights::new(&lights, caustic_targets, &geometry, scene_radius)
         }
         crate::world::Caustics::PathTracing => None,
     };
@@ -479,129 +479,6 @@ pub fn build_for(
         caustics,
         sources: ctx.sources.into_inner(),
     })
-}
-
-fn build_meters(
-    ctx: &Context,
-    scene: &SceneFile,
-) -> Result<(Vec<Meter>, Vec<Grid>, MeasureSettings), SceneError> {
-    let mut names = std::collections::HashSet::new();
-    let mut meters = Vec::new();
-    for (i, m) in scene.meters.iter().enumerate() {
-        let field = format!("meters[{i}]");
-        let (name, kind) = match m {
-            MeterDesc::Illuminance {
-                name,
-                position,
-                normal,
-            } => (
-                name,
-                MeterKind::Illuminance {
-                    position: ctx.vec3(&format!("{field}.position"), *position)?,
-                    normal: ctx.unit(&format!("{field}.normal"), *normal)?,
-                },
-            ),
-            MeterDesc::Luminance {
-                name,
-                position,
-                direction,
-                half_angle_deg,
-            } => {
-                let a = ctx.finite(&format!("{field}.half_angle_deg"), *half_angle_deg as f64)?;
-                if !(0.0..90.0).contains(&a) {
-                    return Err(ctx.err(
-                        format!("{field}.half_angle_deg"),
-                        format!("the acceptance half-angle must lie in [0, 90) degrees, got {a}"),
-                    ));
-                }
-                (
-                    name,
-                    MeterKind::Luminance {
-                        position: ctx.vec3(&format!("{field}.position"), *position)?,
-                        direction: ctx.unit(&format!("{field}.direction"), *direction)?,
-                        half_angle_rad: (a as f32).to_radians(),
-                    },
-                )
-            }
-        };
-        if !names.insert(name.clone()) {
-            return Err(ctx.err(
-                format!("{field}.name"),
-                format!("the name {name:?} is used twice"),
-            ));
-        }
-        meters.push(Meter {
-            name: name.clone(),
-            kind,
-        });
-    }
-    let mut grids = Vec::new();
-    let mut grid_files: HashMap<PathBuf, (usize, String)> = HashMap::new();
-    for (i, g) in scene.grids.iter().enumerate() {
-        let field = format!("grids[{i}]");
-        if g.nx == 0 || g.ny == 0 || g.nx as u64 * g.ny as u64 > 1_000_000 {
-            return Err(ctx.err(
-                format!("{field}.nx"),
-                format!("a grid needs 1 to 1 000 000 points, got {}×{}", g.nx, g.ny),
-            ));
-        }
-        let eu = ctx.vec3(&format!("{field}.edge_u"), g.edge_u)?;
-        let ev = ctx.vec3(&format!("{field}.edge_v"), g.edge_v)?;
-        if eu.cross(ev).length_squared() == 0.0 {
-            return Err(ctx.err(
-                &field,
-                "the grid has zero area (edge_u and edge_v are parallel or zero)",
-            ));
-        }
-        if !names.insert(g.name.clone()) {
-            return Err(ctx.err(
-                format!("{field}.name"),
-                format!("the name {:?} is used twice", g.name),
-            ));
-        }
-        // Each grid writes NAME.grid-<slug>.csv and .png: names must differ after that mapping.
-        let file = crate::report::json::grid_csv_path(Path::new("NAME"), &g.name);
-        if let Some((j, other)) = grid_files.insert(file.clone(), (i, g.name.clone())) {
-            return Err(ctx.err(
-                format!("{field}.name"),
-                format!(
-                    "grids[{j}] {other:?} and grids[{i}] {:?} would both be written to {} (and .png): grid names must still differ when letters are lower-cased, every character other than an ASCII letter or digit becomes '-', leading and trailing '-' are dropped, and an empty result becomes \"grid\"",
-                    g.name,
-                    file.display()
-                ),
-            ));
-        }
-        grids.push(Grid {
-            name: g.name.clone(),
-            origin: ctx.vec3(&format!("{field}.origin"), g.origin)?,
-            edge_u: eu,
-            edge_v: ev,
-            nx: g.nx,
-            ny: g.ny,
-            normal: ctx.unit(&format!("{field}.normal"), g.normal)?,
-        });
-    }
-    let m = &scene.measure;
-    if m.samples == 0 {
-        return Err(ctx.err("measure.samples", "meters need at least 1 sample"));
-    }
-    if let Some(t) = m.target_relative_error {
-        if !(t.is_finite() && t > 0.0 && t < 1.0) {
-            return Err(ctx.err(
-                "measure.target_relative_error",
-                format!("the target relative error must lie in (0, 1), e.g. 0.01 for 1 %, got {t}"),
-            ));
-        }
-    }
-    Ok((
-        meters,
-        grids,
-        MeasureSettings {
-            samples: m.samples,
-            target_relative_error: m.target_relative_error,
-            max_samples: m.max_samples.max(m.samples),
-        },
-    ))
 }
 
 fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, SceneError> {

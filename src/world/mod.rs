@@ -1,6 +1,13 @@
 //! The built, render-ready scene: geometry in one BVH, materials, lights in radiometric units,
-//! the camera and the render settings. Produced by [`crate::scene::build`]; read-only while
-//! rendering.
+//! the camera, the render settings, the meters and grids ([`measure`]) and where light tracing
+//! starts and aims ([`caustic_lights`]). Plain data, produced by `scene::build`; the
+//! integrators, the renderer and the meters read it and are not imported by it.
+
+pub mod caustic_lights;
+pub mod measure;
+
+pub use caustic_lights::CausticLights;
+pub use measure::{Grid, MeasureSettings, Meter, MeterKind};
 
 use crate::bxdf::Material;
 use crate::camera::{Camera, PixelFilter};
@@ -34,15 +41,10 @@ pub struct RenderSettings {
     pub light_paths_per_sample: f32,
 }
 
-/// Light paths per camera sample unless the scene says otherwise: aimed at the specular
-/// objects, each light path costs about as much as a camera path, and on the benchmark Cornell
-/// box 1/32 already makes the light-traced part's variance negligible beside the camera paths'.
-pub const DEFAULT_LIGHT_PATHS_PER_SAMPLE: f32 = 0.0625;
-
 /// Estimator of the caustic paths light → specular surfaces → non-specular surface → camera.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Caustics {
-    /// Traced from the lights and connected to the camera (see [`crate::caustics`]); used
+    /// Traced from the lights and connected to the camera (`integrator::light_path`); used
     /// when the scene has a delta-lobe material and a light other than an environment.
     #[default]
     LightTracing,
@@ -60,7 +62,7 @@ impl Default for RenderSettings {
             filter: PixelFilter::Box,
             illuminance: false,
             caustics: Caustics::LightTracing,
-            light_paths_per_sample: DEFAULT_LIGHT_PATHS_PER_SAMPLE,
+            light_paths_per_sample: crate::scene::schema::DEFAULT_LIGHT_PATHS_PER_SAMPLE,
         }
     }
 }
@@ -69,8 +71,7 @@ pub struct World {
     pub geometry: SceneGeometry,
     /// Per object: whether its material passes light straight through (a window pane, see
     /// [`crate::bxdf::MaterialFlags::STRAIGHT_THROUGH`]). Empty when no object does. Shadow rays
-    /// pass through those objects with their transmittance
-    /// ([`crate::integrator::transmittance`]).
+    /// pass through those objects with their transmittance (`integrator::transmit`).
     pub see_through: Vec<bool>,
     pub objects: Vec<Object>,
     pub materials: Vec<Material>,
@@ -80,11 +81,11 @@ pub struct World {
     pub infinite_lights: Vec<u32>,
     pub camera: Camera,
     pub settings: RenderSettings,
-    pub meters: Vec<crate::meter::Meter>,
-    pub grids: Vec<crate::meter::Grid>,
-    pub measure: crate::meter::MeasureSettings,
-    /// Light tracing of caustics, when on and useful (see [`crate::caustics`]).
-    pub caustics: Option<crate::caustics::CausticLights>,
+    pub meters: Vec<Meter>,
+    pub grids: Vec<Grid>,
+    pub measure: MeasureSettings,
+    /// Light tracing of caustics, when on and useful (`integrator::light_path`).
+    pub caustics: Option<CausticLights>,
     /// The files the scene refers to (meshes, spectra, luminaire data, …), as resolved when it
     /// was built; a render state's scene hash covers their contents.
     pub sources: Vec<std::path::PathBuf>,

@@ -1,43 +1,18 @@
-//! Unidirectional spectral path tracing with next-event estimation and multiple importance
-//! sampling (Veach 1997, power heuristic β = 2), Russian roulette and a maximum depth.
+//! Camera paths: unidirectional spectral path tracing with next-event estimation and multiple
+//! importance sampling (Veach 1997, power heuristic β = 2), Russian roulette and a maximum
+//! depth; and the irradiance at a point, from the same paths.
 //!
 //! The integrator only talks to materials through [`crate::bxdf::Material`]'s interface and to
 //! lights through [`crate::light::Light`]'s, so new families slot in without touching it.
 
+use super::stats::RayStats;
+use super::transmit::{choose_pane_lobe, transmittance, PaneLobe, MAX_STRAIGHT_THROUGH};
 use crate::bxdf::Frame;
 use crate::geometry::{offset_ray_origin, point_error_bound, shadow_ray_between, Hit};
 use crate::sampling::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
 use glam::Vec3;
-
-/// Counters for the closing summary.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RayStats {
-    pub camera_rays: u64,
-    pub bounce_rays: u64,
-    pub shadow_rays: u64,
-    /// Samples whose estimate was not finite and was dropped (should stay 0).
-    pub non_finite: u64,
-    /// Light paths traced for caustics (see [`crate::caustics`]) and their rays (the camera
-    /// connections count as shadow rays).
-    pub light_paths: u64,
-    pub light_rays: u64,
-}
-
-impl RayStats {
-    pub fn total_rays(&self) -> u64 {
-        self.camera_rays + self.bounce_rays + self.shadow_rays + self.light_rays
-    }
-    pub fn merge(&mut self, o: &RayStats) {
-        self.camera_rays += o.camera_rays;
-        self.bounce_rays += o.bounce_rays;
-        self.shadow_rays += o.shadow_rays;
-        self.non_finite += o.non_finite;
-        self.light_paths += o.light_paths;
-        self.light_rays += o.light_rays;
-    }
-}
 
 #[inline]
 fn power_heuristic(f: f32, g: f32) -> f32 {
@@ -64,7 +39,7 @@ pub struct PathStart {
     /// Scattering events already on the path (0 for a camera ray).
     pub depth: u32,
     /// A camera ray whose caustic paths (first surface scattered non-specularly, last
-    /// scattering before a light that [`crate::caustics::CausticLights`] handles specular)
+    /// scattering before a light that [`crate::world::CausticLights`] handles specular)
     /// are left to light tracing.
     pub caustics_by_light_tracing: bool,
 }
@@ -82,7 +57,7 @@ impl PathStart {
     }
 
     /// A camera ray of the image: without the caustic paths that light tracing estimates when
-    /// the world has it on (see [`crate::caustics`]).
+    /// the world has it on (see [`super::light_path`]).
     pub fn image(world: &World, p: Vec3) -> Self {
         Self {
             caustics_by_light_tracing: world.caustics.is_some(),
@@ -117,7 +92,7 @@ pub fn trace(
     let mut eta_scale = 1.0f32;
     // Whether the path's first scattering (at the surface the camera sees) was non-specular:
     // with `start.caustics_by_light_tracing`, such paths that reach a light through a
-    // specular scattering are light tracing's part (see `crate::caustics`).
+    // specular scattering are light tracing's part (see `super::light_path`).
     // (A receiver's path, started at depth 1, begins at that non-specular receiver.)
     let mut first_non_specular = start.depth >= 1;
     // Null events (straight through window panes) since the last scattering.
@@ -337,98 +312,6 @@ fn shadow_transmittance(
     transmittance(world, origin, dir, t_max, wl)
 }
 
-/// Most surfaces a ray passes straight through before it is given up (a guard against
-/// pathological stacks of panes).
-pub const MAX_STRAIGHT_THROUGH: u32 = 64;
-
-/// The lobe a window pane ([`crate::bxdf::MaterialFlags::STRAIGHT_THROUGH`]) chose for a path.
-pub enum PaneLobe {
-    /// Straight through: a null event, with this weight f·|cos|/pdf on the throughput.
-    Straight(SampledSpectrum),
-    /// A real scattering (the mirror lobe), to be handled like any other.
-    Scatter(crate::bxdf::BsdfSample),
-}
-
-/// At a surface that passes light straight through, choose its lobe before anything else (one
-/// set of four sampler dimensions), so that passing through can be a null event; the camera
-/// paths and the light paths both do this. None when the surface scatters nothing (the path
-/// ends).
-pub fn choose_pane_lobe(
-    material: &crate::bxdf::Material,
-    wo: Vec3,
-    sampler: &mut Sampler,
-    wl: &mut SampledWavelengths,
-) -> Option<PaneLobe> {
-    let [ux, uy, uc, _] = sampler.get4();
-    let bs = material.sample(wo, uc, glam::Vec2::new(ux, uy), wl)?;
-    if bs.pdf.is_nan() || bs.pdf <= 0.0 {
-        return None;
-    }
-    Some(if material.is_straight_through(wo, bs.wi) {
-        PaneLobe::Straight(bs.f * (bs.wi.z.abs() / bs.pdf))
-    } else {
-        PaneLobe::Scatter(bs)
-    })
-}
-
-/// Spectral transmittance of the segment from `origin` along unit `dir` up to `t_max`: `None`
-/// when an opaque surface blocks it, else the product of the straight-through transmittances
-/// ([`crate::bxdf::Material::straight_transmittance`]) of the window panes it crosses (one
-/// when it crosses none). Without see-through materials in the world this is one any-hit
-/// query; with panes, one any-hit query that passes through them.
-pub fn transmittance(
-    world: &World,
-    origin: Vec3,
-    dir: Vec3,
-    t_max: f32,
-    wl: &SampledWavelengths,
-) -> Option<SampledSpectrum> {
-    transmittance_counted(world, origin, dir, t_max, wl).map(|(tr, _)| tr)
-}
-
-/// [`transmittance`], and the number of panes the segment crosses.
-pub fn transmittance_counted(
-    world: &World,
-    origin: Vec3,
-    dir: Vec3,
-    t_max: f32,
-    wl: &SampledWavelengths,
-) -> Option<(SampledSpectrum, u32)> {
-    if world.see_through.is_empty() {
-        return (!world.geometry.occluded(origin, dir, t_max)).then_some((SampledSpectrum::ONE, 0));
-    }
-    // One any-hit traversal that passes through the panes' primitives: the transmittance is a
-    // product, so the order in which they are found does not matter. A ray exactly through the
-    // seam of two pieces of a pane (two triangles, two touching quads) hits both at the same
-    // point: that is one crossing, recognised by points that agree within their error bounds.
-    let mut tr = SampledSpectrum::ONE;
-    let mut seen = [(Vec3::ZERO, Vec3::ZERO); MAX_STRAIGHT_THROUGH as usize];
-    let mut crossed = 0usize;
-    let blocked = world
-        .geometry
-        .occluded_except(origin, dir, t_max, &world.see_through, |hit| {
-            let same =
-                |&(p, e): &(Vec3, Vec3)| ((hit.p - p).abs() - (hit.error + e)).max_element() <= 0.0;
-            if seen[..crossed].iter().any(same) {
-                return true;
-            }
-            if crossed == seen.len() {
-                return false;
-            }
-            seen[crossed] = (hit.p, hit.error);
-            crossed += 1;
-            let material = &world.materials[world.objects[hit.object as usize].material as usize];
-            match material.straight_transmittance(dir.dot(hit.ns), wl) {
-                Some(t) => {
-                    tr *= t;
-                    !tr.is_black()
-                }
-                None => false,
-            }
-        });
-    (!blocked).then_some((tr, crossed as u32))
-}
-
 /// Spectral irradiance (W·m⁻²·nm⁻¹) on the hemisphere around unit normal `n` at `at`: light
 /// sampling and cosine-weighted hemisphere sampling combined by MIS (power heuristic) for
 /// directly visible emitters; light reflected by the scene arrives through the cosine-sampled
@@ -437,7 +320,7 @@ pub fn transmittance_counted(
 ///
 /// With `caustics_by_light_tracing` (the image's per-pixel illuminance when the world traces
 /// caustics from the lights), the paths whose scattering next to the light is specular are
-/// left out: light tracing estimates them (see [`crate::caustics`]).
+/// left out: light tracing estimates them (see [`super::light_path`]).
 ///
 /// With `max_depth` 0 no path may scatter, the receiver included, so the irradiance is 0 (as
 /// the luminance of a Lambertian surface is then): direct illuminance alone is `max_depth` 1.
