@@ -4,8 +4,8 @@
 //! radiance arriving along its rays, so a pixel's Y is luminance in cd/m² (no vignetting or
 //! cos⁴ falloff, no exposure). Image rows run top to bottom.
 
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::{CameraDesc, FilterDesc};
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{CameraDesc, FilterDesc};
 use glam::{Vec2, Vec3};
 
 /// Pixel reconstruction filter. Samples are drawn from the filter itself (filter importance
@@ -515,7 +515,7 @@ mod tests {
 
     #[test]
     fn build_checks_the_film_before_the_lens() {
-        use crate::scene::schema::LensDesc;
+        use crate::description::schema::LensDesc;
         let path = std::path::Path::new("t.ron");
         let ctx = Context {
             path,

@@ -7,8 +7,8 @@ use super::fresnel::{fr_conductor, reflect};
 use super::ior::ConductorIor;
 use super::microfacet::Microfacet;
 use super::{same_hemisphere, BsdfSample, MaterialFlags};
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::{DistributionDesc, MaskingDesc, SpectrumDesc};
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{DistributionDesc, MaskingDesc, SpectrumDesc};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, N_LAMBDA};
 use glam::{Vec2, Vec3};
 

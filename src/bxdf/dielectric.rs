@@ -13,8 +13,8 @@ use super::fresnel::{fr_dielectric, reflect, refract};
 use super::ior::Ior;
 use super::microfacet::Microfacet;
 use super::{BsdfSample, MaterialFlags};
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::{DistributionDesc, IorDesc, MaskingDesc};
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{DistributionDesc, IorDesc, MaskingDesc};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 

@@ -2,8 +2,8 @@
 //! Two-sided: it reflects on whichever side `wo` is.
 
 use super::{same_hemisphere, BsdfSample, MaterialFlags};
-use crate::scene::context::{Context, Role, SceneError};
-use crate::scene::schema::SpectrumDesc;
+use crate::description::context::{Context, Role, SceneError};
+use crate::description::schema::SpectrumDesc;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;

@@ -5,8 +5,8 @@
 //! Sellmeier: n² = 1 + Σᵢ Bᵢ λ² / (λ² − Cᵢ), λ in µm, Cᵢ in µm² (SCHOTT catalogue form).
 //! Cauchy: n = A + B/λ² + C/λ⁴, λ in nm.
 
-use crate::scene::context::{Context, Role, SceneError};
-use crate::scene::schema::{IorDesc, SpectrumDesc};
+use crate::description::context::{Context, Role, SceneError};
+use crate::description::schema::{IorDesc, SpectrumDesc};
 use crate::spectrum::{DenseSpectrum, SampledWavelengths, N_LAMBDA};
 use std::sync::OnceLock;
 

@@ -13,8 +13,8 @@
 //!   Visible Normals", solved here by safeguarded Newton iteration in f64 (as pbrt-v3's
 //!   numerical inversion). With V-cavity masking the normals are drawn from D(ωm) cos θm.
 
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::{DistributionDesc, MaskingDesc};
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{DistributionDesc, MaskingDesc};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 

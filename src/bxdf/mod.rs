@@ -28,8 +28,8 @@ pub mod oren_nayar;
 pub mod phong;
 pub mod thin_dielectric;
 
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::MaterialDesc;
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::MaterialDesc;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 

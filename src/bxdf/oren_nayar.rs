@@ -5,8 +5,8 @@
 //! Sampled with the cosine-weighted hemisphere. Two-sided like [`super::Diffuse`].
 
 use super::{same_hemisphere, BsdfSample, MaterialFlags};
-use crate::scene::context::{Context, Role, SceneError};
-use crate::scene::schema::SpectrumDesc;
+use crate::description::context::{Context, Role, SceneError};
+use crate::description::schema::SpectrumDesc;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;

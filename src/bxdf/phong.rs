@@ -6,8 +6,8 @@
 //! cosⁿ-around-the-mirror-direction. Two-sided.
 
 use super::{same_hemisphere, BsdfSample, Frame, MaterialFlags};
-use crate::scene::context::{Context, Role, SceneError};
-use crate::scene::schema::SpectrumDesc;
+use crate::description::context::{Context, Role, SceneError};
+use crate::description::schema::SpectrumDesc;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};

@@ -8,8 +8,8 @@
 use super::fresnel::fr_dielectric_sp;
 use super::ior::Ior;
 use super::{BsdfSample, MaterialFlags};
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::IorDesc;
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::IorDesc;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, N_LAMBDA};
 use glam::Vec3;
 

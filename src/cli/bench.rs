@@ -16,8 +16,9 @@ pub mod rng;
 pub mod scaling;
 pub mod traversal;
 
+use candela::description::schema::*;
 use candela::render::render;
-use candela::scene::{self, schema::*, Overrides};
+use candela::scene::{self, Overrides};
 use std::path::Path;
 use std::time::Instant;
 

@@ -1,14 +1,14 @@
 //! `candela spectrum` and `candela convert`: the text and JSON they print (the values come
-//! from [`candela::colour::summary`] and [`candela::photometry`]). See `docs/colour.md`.
+//! from [`candela::report::spectrum`] and [`candela::photometry`]). See `docs/colour.md`.
 //!
 //! `tests/colour_cli.rs` includes this file with `#[path]`, so it names the library only
 //! through `candela::` paths.
 
 use serde_json::json;
 
-use candela::colour::summary::{resolve_source, spectrum_colorimetry};
 use candela::colour::tables::{Observer, END_NM, START_NM};
 use candela::photometry::{Quantity, UNITS};
+use candela::report::spectrum::{resolve_source, spectrum_colorimetry};
 
 fn observer_name(o: Observer) -> &'static str {
     match o {

@@ -16,6 +16,5 @@ pub mod models;
 pub mod planck;
 pub mod rgb;
 pub mod sd;
-pub mod summary;
 pub mod tables;
 pub mod temperature;

@@ -2,11 +2,11 @@
 //! given by the surface's luminance or the object's flux.
 
 use super::{EmissionPoint, LightFlags, LightSample};
+use crate::description::context::{Context, Role, SceneError};
+use crate::description::schema::{Amount, EmissionDesc};
 use crate::geometry::{Hit, SceneGeometry};
 use crate::photometry::luminous_integral;
 use crate::sampling::pick_from_cdf;
-use crate::scene::context::{Context, Role, SceneError};
-use crate::scene::schema::{Amount, EmissionDesc};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 

@@ -2,9 +2,9 @@
 //! surface facing it.
 
 use super::{LightFlags, LightSample};
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{Amount, SpectrumDesc, V3};
 use crate::photometry::luminous_integral;
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::{Amount, SpectrumDesc, V3};
 use crate::spectrum::{DenseSpectrum, SampledWavelengths};
 use glam::Vec3;
 

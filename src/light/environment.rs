@@ -4,10 +4,10 @@
 
 use super::portal::{Portal, Portals};
 use super::{LightFlags, LightSample};
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{Amount, PortalDesc, SpectrumDesc};
 use crate::photometry::luminous_integral;
 use crate::sampling::{uniform_sphere, UNIFORM_SPHERE_PDF};
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::{Amount, PortalDesc, SpectrumDesc};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 

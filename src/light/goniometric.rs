@@ -14,10 +14,10 @@
 //! lights by their integrated lumens.
 
 use super::LightFlags;
+use crate::description::context::{Context, Role, SceneError};
+use crate::description::schema::{SpectrumDesc, V3};
 use crate::luminaire::Distribution;
 use crate::photometry::luminous_integral;
-use crate::scene::context::{Context, Role, SceneError};
-use crate::scene::schema::{SpectrumDesc, V3};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Mat3, Vec2, Vec3};
 use std::sync::Arc;

@@ -17,9 +17,9 @@ pub mod portal;
 pub mod sampler;
 pub mod spot;
 
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::Amount;
 use crate::geometry::{Hit, SceneGeometry};
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::Amount;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 

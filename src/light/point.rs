@@ -1,9 +1,9 @@
 //! Isotropic point light: the same radiant intensity in every direction.
 
 use super::LightFlags;
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{Amount, SpectrumDesc, V3};
 use crate::photometry::luminous_integral;
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::{Amount, SpectrumDesc, V3};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
 

@@ -3,9 +3,9 @@
 
 use super::LightFlags;
 use crate::bxdf::Frame;
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{Amount, SpectrumDesc, V3};
 use crate::photometry::luminous_integral;
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::{Amount, SpectrumDesc, V3};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
 

@@ -1,12 +1,12 @@
 //! Polar candela diagram like a manufacturer's data sheet: nadir (γ = 0) at the bottom, the
 //! C0–C180 plane in solid red (C0 on the right), the C90–C270 plane in dashed blue (C90 on the
 //! right), rings at round candela values labelled in cd, spokes every 30° labelled in degrees.
-//! Drawn with the report module's helpers ([`crate::report::draw`]: `imageproc` lines and
+//! Drawn with the report module's helpers ([`crate::output::draw`]: `imageproc` lines and
 //! circles, text in the bundled DejaVu Sans).
 
 use super::{polar_value, Distribution};
+use crate::output::draw;
 use crate::output::{write_atomic, OutputError};
-use crate::report::draw;
 use image::{codecs::png::PngEncoder, ExtendedColorType, ImageEncoder};
 use image::{Rgb, RgbImage};
 use std::path::Path;

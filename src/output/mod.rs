@@ -8,6 +8,7 @@
 //! * [`write_atomic`]: every file this module writes goes through it, so a crash or an error
 //!   never leaves a half-written output behind.
 
+pub mod draw;
 mod exr_io;
 mod png;
 

@@ -11,9 +11,9 @@ use std::path::Path;
 
 use image::{Rgb, RgbImage};
 
-use super::draw::{self, BLACK, DARK_GREY, WHITE};
 use super::falsecolour::{describe_scale, write_png, ColourScale, FalsecolourSettings, Legend};
 use super::units::{format_sig, UnitSystem};
+use crate::output::draw::{self, BLACK, DARK_GREY, WHITE};
 use crate::output::OutputError;
 use crate::photometry::Quantity;
 

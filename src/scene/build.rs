@@ -1,10 +1,10 @@
 //! From parsed scene to [`World`]: check every value, resolve spectra, convert photometric
 //! amounts to radiometric light spectra, build the BVH.
 
-use super::context::{Context, SceneError};
-use super::schema::*;
 use crate::bxdf::{Material, MaterialFlags};
 use crate::camera::{Camera, PixelFilter};
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::*;
 use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
 use crate::light::{AreaLight, Light, LightFlags, LightSampler};
 use crate::spectrum::DenseSpectrum;

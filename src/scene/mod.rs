@@ -1,17 +1,16 @@
-//! Scene files: RON in ([`schema`]), a render-ready [`crate::world::World`] out ([`build`]).
+//! Scene files: RON in (parsed into [`crate::description::schema`]), a render-ready
+//! [`crate::world::World`] out ([`build`]).
 //!
 //! Every problem is reported as a [`SceneError`] naming the file, the position (line:column)
 //! where the parser knows it, and the field path (e.g. `objects[3] "floor".emission.amount`).
 
 pub mod build;
-pub mod context;
-pub mod schema;
 
 use std::path::Path;
 
+pub use crate::description::context::SceneError;
+pub use crate::description::schema::SceneFile;
 pub use build::{build, build_for, load_world, load_world_for, Overrides, RunMode};
-pub use context::SceneError;
-pub use schema::SceneFile;
 
 /// Parse a scene file (syntax, types and unknown fields; values are checked by [`build`]).
 pub fn load(path: &Path) -> Result<SceneFile, SceneError> {

@@ -3,8 +3,8 @@
 //! meters (a work plane) with their point layout and the files their results go to, and the
 //! sample budget. Measuring them is the `meter` module's.
 
-use crate::scene::context::{Context, SceneError};
-use crate::scene::schema::{GridDesc, MeasureDesc, MeterDesc};
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{GridDesc, MeasureDesc, MeterDesc};
 use glam::Vec3;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};

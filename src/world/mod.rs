@@ -62,7 +62,7 @@ impl Default for RenderSettings {
             filter: PixelFilter::Box,
             illuminance: false,
             caustics: Caustics::LightTracing,
-            light_paths_per_sample: crate::scene::schema::DEFAULT_LIGHT_PATHS_PER_SAMPLE,
+            light_paths_per_sample: crate::description::schema::DEFAULT_LIGHT_PATHS_PER_SAMPLE,
         }
     }
 }

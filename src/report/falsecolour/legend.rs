@@ -4,7 +4,7 @@
 use image::{Rgb, RgbImage};
 
 use super::{ColourScale, HATCH_PERIOD, LABEL_PX, UNDEFINED_HATCH};
-use crate::report::draw::{self, BLACK, DARK_GREY};
+use crate::output::draw::{self, BLACK, DARK_GREY};
 use crate::report::units::format_sig;
 
 const BAR_W: u32 = 26;

@@ -10,11 +10,11 @@ use super::{
     describe_scale, ColourScale, FalsecolourSettings, Legend, LegendInfo, HATCH_PERIOD, LABEL_PX,
     UNDEFINED_HATCH,
 };
+use crate::output::draw::{self, BLACK, DARK_GREY, WHITE};
 use crate::output::{
     write_atomic, Layers, OutputError, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_Y, ILLUMINANCE_SENTINEL,
 };
 use crate::photometry::Quantity;
-use crate::report::draw::{self, BLACK, DARK_GREY, WHITE};
 use crate::report::units::format_sig;
 
 const PAD: u32 = 16;

@@ -16,8 +16,8 @@ mod scale;
 
 use image::Rgb;
 
-use super::draw::Colour;
 use super::units::UnitSystem;
+use crate::output::draw::Colour;
 use crate::photometry::Quantity;
 
 pub use legend::describe_scale;
