@@ -34,6 +34,7 @@
 //! ```
 
 mod bvh;
+mod desc;
 mod io;
 mod prim;
 mod query;

@@ -5,7 +5,7 @@ use crate::bxdf::{Material, MaterialFlags};
 use crate::camera::{Camera, PixelFilter};
 use crate::description::context::{Context, SceneError};
 use crate::description::schema::*;
-use crate::geometry::{self, SceneGeometry, Shape, Transform, TriangleMesh};
+use crate::geometry::{self, SceneGeometry, Shape, Transform};
 use crate::light::{AreaLight, Light, LightFlags, LightSampler};
 use crate::spectrum::DenseSpectrum;
 use crate::world::{Object, RenderSettings, World};
@@ -141,151 +141,6 @@ fn object_field(i: usize, o: &ObjectDesc) -> String {
     }
 }
 
-/// A mesh file's error; an unreadable file's hint says where relative paths are resolved.
-fn mesh_err(ctx: &Context, field: &str, rel: &str, e: geometry::GeometryError) -> SceneError {
-    match e {
-        geometry::GeometryError::Io { path, source } => ctx.err(
-            field,
-            format!(
-                "cannot read mesh file '{}': {source}. Check that the path is correct{} and that the file is readable.",
-                path.display(),
-                if !Path::new(rel).is_relative() {
-                    String::new()
-                } else if ctx.dir.as_os_str().is_empty() {
-                    format!(" ({rel:?} is resolved against the scene file's directory)")
-                } else {
-                    format!(
-                        " ({rel:?} is resolved against the scene file's directory, {})",
-                        ctx.dir.display()
-                    )
-                }
-            ),
-        ),
-        e => ctx.err(field, e.to_string()),
-    }
-}
-
-fn build_shape(ctx: &Context, field: &str, desc: &ShapeDesc) -> Result<Shape, SceneError> {
-    let f = |s: &str| format!("{field}.{s}");
-    Ok(match desc {
-        ShapeDesc::Sphere { center, radius } => Shape::Sphere {
-            center: ctx.vec3(&f("center"), *center)?,
-            radius: ctx.positive(&f("radius"), *radius as f64)? as f32,
-        },
-        ShapeDesc::Quad {
-            origin,
-            edge_u,
-            edge_v,
-        } => {
-            let eu = ctx.vec3(&f("edge_u"), *edge_u)?;
-            let ev = ctx.vec3(&f("edge_v"), *edge_v)?;
-            if eu.cross(ev).length_squared() == 0.0 {
-                return Err(ctx.err(
-                    field,
-                    "the quad has zero area (edge_u and edge_v are parallel or zero)",
-                ));
-            }
-            Shape::Quad {
-                origin: ctx.vec3(&f("origin"), *origin)?,
-                edge_u: eu,
-                edge_v: ev,
-            }
-        }
-        ShapeDesc::Disk {
-            center,
-            normal,
-            radius,
-        } => {
-            let n = ctx.vec3(&f("normal"), *normal)?;
-            if n.length_squared() == 0.0 {
-                return Err(ctx.err(f("normal"), "the normal is the zero vector"));
-            }
-            Shape::Disk {
-                center: ctx.vec3(&f("center"), *center)?,
-                normal: n.normalize(),
-                radius: ctx.positive(&f("radius"), *radius as f64)? as f32,
-            }
-        }
-        ShapeDesc::Triangles {
-            positions,
-            indices,
-            normals,
-        } => {
-            let mut mesh = TriangleMesh::default();
-            for (k, p) in positions.iter().enumerate() {
-                mesh.positions
-                    .push(ctx.vec3(&format!("{field}.positions[{k}]"), *p)?);
-            }
-            for (k, tri) in indices.iter().enumerate() {
-                for &ix in tri {
-                    if ix as usize >= positions.len() {
-                        return Err(ctx.err(
-                            format!("{field}.indices[{k}]"),
-                            format!(
-                                "vertex index {ix} is out of range (the mesh has {} positions)",
-                                positions.len()
-                            ),
-                        ));
-                    }
-                }
-                mesh.indices.push(*tri);
-            }
-            if mesh.indices.is_empty() {
-                return Err(ctx.err(f("indices"), "the mesh has no triangles"));
-            }
-            if let Some(ns) = normals {
-                if ns.len() != positions.len() {
-                    return Err(ctx.err(
-                        f("normals"),
-                        format!(
-                            "{} normals given for {} positions; give one per position",
-                            ns.len(),
-                            positions.len()
-                        ),
-                    ));
-                }
-                let mut v = Vec::with_capacity(ns.len());
-                for (k, n) in ns.iter().enumerate() {
-                    v.push(
-                        ctx.vec3(&format!("{field}.normals[{k}]"), *n)?
-                            .normalize_or_zero(),
-                    );
-                }
-                mesh.normals = Some(v);
-            }
-            Shape::Mesh(mesh)
-        }
-        ShapeDesc::Obj(rel) => Shape::Mesh(
-            geometry::load_obj(&ctx.resolve(rel)).map_err(|e| mesh_err(ctx, field, rel, e))?,
-        ),
-        ShapeDesc::Ply(rel) => Shape::Mesh(
-            geometry::load_ply(&ctx.resolve(rel)).map_err(|e| mesh_err(ctx, field, rel, e))?,
-        ),
-    })
-}
-
-fn build_transform(ctx: &Context, field: &str, t: &TransformDesc) -> Result<Transform, SceneError> {
-    let tr = match t.translate {
-        Some(v) => ctx.vec3(&format!("{field}.translate"), v)?,
-        None => Vec3::ZERO,
-    };
-    let rot = match t.rotate_deg {
-        Some(v) => ctx.vec3(&format!("{field}.rotate_deg"), v)?,
-        None => Vec3::ZERO,
-    };
-    let sc = match t.scale {
-        Some(v) => ctx.vec3(&format!("{field}.scale"), v)?,
-        None => Vec3::ONE,
-    };
-    if sc.min_element() <= 0.0 {
-        return Err(ctx.err(
-            format!("{field}.scale"),
-            format!("scale factors must be greater than 0, got {sc}"),
-        ));
-    }
-    Ok(Transform::from_trs(tr, rot, sc))
-}
-
 /// Check one scene and build the world (for a plain render; see [`build_for`]).
 pub fn build(scene: &SceneFile, path: &Path, overrides: &Overrides) -> Result<World, SceneError> {
     build_for(scene, path, overrides, &RunMode::default())
@@ -382,9 +237,9 @@ pub fn build_for(
                 ),
             )
         })?;
-        let mut shape = build_shape(&ctx, &format!("{field}.shape"), &o.shape)?;
+        let mut shape = Shape::build(&ctx, &format!("{field}.shape"), &o.shape)?;
         if let Some(t) = &o.transform {
-            let tf = build_transform(&ctx, &format!("{field}.transform"), t)?;
+            let tf = Transform::build(&ctx, &format!("{field}.transform"), t)?;
             shape = shape
                 .to_world(&tf)
                 .map_err(|e| ctx.err(format!("{field}.transform"), e.to_string()))?;
