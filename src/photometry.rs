@@ -111,7 +111,7 @@ pub fn blackbody_total_radiance(temperature_k: f64) -> f64 {
 /// Luminous efficacy of blackbody radiation, lm/W: K_m Σ L_λ V Δλ (360–830 nm, 1 nm) divided
 /// by the *total* radiance over all wavelengths ([`blackbody_total_radiance`]).
 ///
-/// Reference: closed-form table in `/work/shared/reference/closed-forms.md` §2.9 (e.g.
+/// Reference: closed-form table in closed-forms.md (the project's reference of closed forms) §2.9 (e.g.
 /// 2856 K → 16.446 lm/W, 6500 K → 95.363 lm/W, from CODATA 2018 constants). candela uses CIE
 /// 015's c1 and c2, as colour-science does, which gives 16.44495 lm/W at 2856 K (−6.4e-5).
 pub fn blackbody_luminous_efficacy(temperature_k: f64) -> f64 {

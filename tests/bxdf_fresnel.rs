@@ -1,5 +1,5 @@
 //! Fresnel equations and refractive-index data against closed forms and catalogue values
-//! (reference: /work/shared/reference/closed-forms.md §2.8).
+//! (reference: closed-forms.md (the project's reference of closed forms) §2.8).
 
 use candela::bxdf::fresnel::{fr_conductor, fr_dielectric, fr_dielectric_sp};
 use candela::bxdf::ior;

@@ -2,7 +2,7 @@
 //! documented in docs/colour.md, and their values against closed forms.
 //!
 //! References:
-//! * /work/shared/reference/closed-forms.md §2.1 (photometric quantities, K_m = 683 lm/W,
+//! * closed-forms.md (the project's reference of closed forms) §2.1 (photometric quantities, K_m = 683 lm/W,
 //!   K′_m = 1700 lm/W, Y = K_m ∫ L ȳ dλ with no normalisation) and §2.9 (luminous efficacy of
 //!   blackbody radiation K = K_m Σ L_λ V Δλ (360–830 nm, 1 nm) / (σT⁴/π), printed to 3
 //!   decimals; scotopic efficacy with K′_m = 1700 and V′ on 380–780 nm).

@@ -1,6 +1,6 @@
 //! The Cornell box spectra shipped in data/cornell-box.csv (named spectra "cornell-white",
 //! "cornell-green", "cornell-red", "cornell-light") against the measured data as transcribed
-//! in /work/shared/reference/cornell-box.md (Cornell University Program of Computer Graphics,
+//! in the project's Cornell box reference (cornell-box.md) (Cornell University Program of Computer Graphics,
 //! "Cornell Box Data", graphics.cornell.edu/online/box/data.html), and the light's
 //! chromaticity against colour-science 0.4.7 (run in the project venv, as in
 //! tests/colour_science.rs).
