@@ -278,3 +278,18 @@ fn wrong_amount(ctx: &Context, afield: &str, a: &Amount, allowed: &str) -> Scene
         format!("{a:?} is not an amount for this light; use {allowed}"),
     )
 }
+
+/// The intensity (cd) of a point-like source given as `Intensity(cd)` or as `Flux(lm)`, where
+/// `flux_per_cd` is the flux (lm) it sends per candela of its axial intensity.
+fn intensity_cd(
+    ctx: &Context,
+    afield: &str,
+    amount: Amount,
+    flux_per_cd: f64,
+) -> Result<f64, SceneError> {
+    match amount {
+        Amount::Intensity(i) => ctx.nonneg(afield, i),
+        Amount::Flux(phi) => Ok(ctx.nonneg(afield, phi)? / flux_per_cd),
+        a => Err(wrong_amount(ctx, afield, &a, "Intensity(cd) or Flux(lm)")),
+    }
+}

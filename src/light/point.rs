@@ -33,18 +33,7 @@ impl PointLight {
         amount: Amount,
     ) -> Result<Self, SceneError> {
         let afield = format!("{field}.amount");
-        let cd = match amount {
-            Amount::Intensity(i) => ctx.nonneg(&afield, i)?,
-            Amount::Flux(phi) => ctx.nonneg(&afield, phi)? / flux_lm(1.0),
-            a => {
-                return Err(super::wrong_amount(
-                    ctx,
-                    &afield,
-                    &a,
-                    "Intensity(cd) or Flux(lm)",
-                ))
-            }
-        };
+        let cd = super::intensity_cd(ctx, &afield, amount, flux_lm(1.0))?;
         Ok(Self {
             position: ctx.vec3(&format!("{field}.position"), position)?,
             intensity: ctx.emission(&format!("{field}.spectrum"), &afield, spectrum, cd)?,

@@ -62,18 +62,7 @@ impl SpotLight {
             ));
         }
         let (ci, co) = (inner.to_radians().cos(), outer.to_radians().cos());
-        let cd = match amount {
-            Amount::Intensity(i) => ctx.nonneg(&afield, i)?,
-            Amount::Flux(phi) => ctx.nonneg(&afield, phi)? / flux_lm(1.0, ci, co),
-            a => {
-                return Err(super::wrong_amount(
-                    ctx,
-                    &afield,
-                    &a,
-                    "Intensity(cd) or Flux(lm)",
-                ))
-            }
-        };
+        let cd = super::intensity_cd(ctx, &afield, amount, flux_lm(1.0, ci, co))?;
         Ok(Self {
             position: p,
             frame: Frame::from_normal((t - p).normalize()),
