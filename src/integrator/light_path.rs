@@ -1,49 +1,8 @@
-//! Caustics by light tracing: the paths whose light leaves the source by a *specular*
-//! scattering (smooth glass, mirror) and reaches the camera from a *non-specular* surface —
-//! L S (S|D)* D E in Heckbert's notation: the caustic under a glass sphere, and the light that
-//! caustic sends on to walls and ceiling, directly or again through the glass — are traced
-//! from the light and connected to the camera at every non-specular surface they reach
-//! (Veach 1997, §10.2, the t = 1 strategy of bidirectional path tracing; pbrt-v4's
-//! `LightPathIntegrator`), instead of being found by the camera paths' BSDF sampling.
-//!
-//! A camera path finds such a path only when BSDF sampling at its last surface happens to aim
-//! through the specular surface at the (small) light: rare samples of very large value, the
-//! bright speckles of caustics. Next-event estimation cannot help (the light is behind glass).
-//! A light path finds the same light transport with an ordinary density, so caustics converge
-//! like direct light. Point and spot lights, whose caustics camera paths cannot find at all (a
-//! delta light behind a delta surface), get theirs here.
-//!
-//! **Partition, not combination.** Path space is split by two vertices: the one next to the
-//! light and the one next to the camera. Paths whose light-side vertex scattered specularly
-//! and whose camera-side vertex scattered non-specularly (with at least two scattering
-//! events), from a light this module starts paths from ([`CausticLights::handles`]), are light
-//! tracing's; the camera paths' estimator ([`super::path::trace`]) drops the emission it
-//! finds along them and keeps every other path (next-event estimation only ever connects a
-//! non-specular vertex to the light, so it keeps all of its own). Each estimator is unbiased on
-//! its part, so the sum is unbiased, without MIS weights. Paths the camera sees through glass
-//! (camera-side vertex specular) stay with the camera paths. The same max depth applies.
-//! Passing straight through a window pane ([`crate::bxdf::MaterialFlags::STRAIGHT_THROUGH`]) is a
-//! null event on both sides, not a scattering: it neither counts as a vertex nor decides the
-//! split, and next-event estimation and the camera connections cross panes with their
-//! transmittance ([`super::transmit::transmittance`]). Sunlight through a window is thus the
-//! camera paths' (light sampling) part; the pane's mirror reflection stays light tracing's.
-//!
-//! **Estimator.** A light path starts at a point on a light and leaves toward the bounding
-//! sphere of one of the objects that can scatter specularly (the other directions cannot start
-//! a path of this part). Its weight β is the emission toward that direction (radiance × cos,
-//! or intensity) over the densities of point and direction ([`crate::light::EmissionPoint`]),
-//! times f·|cos|/pdf at each scattering, with the
-//! adjoint BSDF: refraction is not scaled by 1/η′²) reaching the non-specular point x adds,
-//! to every pixel whose reconstruction filter covers x's film position,
-//! `β · f(x; →camera, →light) · |cos θ_x| · importance · filter density`
-//! ([`crate::camera::CameraConnection::importance`]). The mean over N light paths is the
-//! pixel's value from these paths; its variance is estimated per pixel from Σ and Σ² of the
-//! splats with N in the denominator (most light paths add nothing to a given pixel).
-//! Shading normals get Veach's adjoint correction |wo·ns||wi·ng| / (|wo·ng||wi·ns|).
-//!
-//! Light paths are indexed like camera samples and traced in fixed chunks whose splats are
-//! applied in order, so images do not depend on the number of threads, and a resumed render
-//! equals an uninterrupted one.
+//! Caustics by light tracing: paths whose light leaves the source by a specular scattering
+//! (smooth glass, mirror) and reaches the camera from a non-specular surface are traced from
+//! the light and connected to the camera (Veach 1997 §10.2, pbrt-v4's `LightPathIntegrator`).
+//! They are a partition of path space with the camera paths ([`super::path::trace`]), so the
+//! sum is unbiased without MIS weights; the method is in docs/methods.md.
 
 use super::stats::RayStats;
 use super::transmit::{choose_pane_lobe, transmittance_counted, PaneLobe, MAX_STRAIGHT_THROUGH};

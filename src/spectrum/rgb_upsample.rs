@@ -1,67 +1,7 @@
-//! sRGB → smooth reflectance spectrum ("spectral upsampling") after Jakob & Hanika 2019.
-//!
-//! # Method
-//!
-//! W. Jakob and J. Hanika, "A Low-Dimensional Function Space for Efficient Spectral
-//! Upsampling", *Computer Graphics Forum* 38(2) (Eurographics 2019), represent a reflectance
-//! spectrum by three coefficients:
-//!
-//! ```text
-//! R(λ) = S(c0·λ² + c1·λ + c2),    S(x) = ½ + x / (2·√(1 + x²))
-//! ```
-//!
-//! The sigmoid `S` maps the whole real line into (0, 1), so every coefficient vector is a
-//! physically valid (energy-conserving) reflectance, smooth in λ. For a target colour the
-//! coefficients are found by minimising the CIELAB difference between the target and the
-//! colour of `R(λ)` lit by CIE D65 and seen by the CIE 1931 2° observer, as in the paper.
-//! The paper tabulates the solutions over a 64³ RGB grid; scenes have few colours, so candela
-//! solves each colour directly when a scene is loaded (a few milliseconds).
-//!
-//! ## Colour of a spectrum
-//!
-//! With the CIE 1931 2° colour-matching functions x̄, ȳ, z̄ and the CIE D65 spectral power
-//! distribution tabulated at 1 nm over 360–830 nm (`crate::colour::tables`),
-//!
-//! ```text
-//! XYZ(R) = Σλ R(λ)·D65(λ)·(x̄, ȳ, z̄)(λ) / Σλ D65(λ)·ȳ(λ)
-//! ```
-//!
-//! so the perfect reflector (R ≡ 1) has `Y = 1`. Its linear sRGB
-//! `W = xyz_to_linear_srgb(XYZ(1))` differs from (1, 1, 1) by at most 1.7·10⁻⁴ per channel
-//! (the tabulated D65 and the rounded IEC 61966-2-1 matrix do not agree exactly), so the
-//! colour of `R` is defined white-balanced per channel:
-//!
-//! ```text
-//! rgb(R) = xyz_to_linear_srgb(XYZ(R)) / W
-//! ```
-//!
-//! This makes a flat spectrum of value g have exactly the colour (g, g, g): greys are exactly
-//! flat, black is exactly 0 and white exactly 1. CIELAB (CIE 1976 L\*a\*b\*) is taken
-//! relative to `XYZ(1)`; the target's XYZ is `M⁻¹ (rgb ⊙ W)` with `M` the sRGB matrix.
-//!
-//! ## Solver
-//!
-//! Levenberg–Marquardt on the 3 residuals `Lab(XYZ(R_c)) − Lab_target` with an analytic
-//! Jacobian (`dS/dx = ½ (1 + x²)^(−3/2)`), in the normalised wavelength
-//! `t = (λ − 360 nm) / 470 nm ∈ [0, 1]` for conditioning. It starts from the flat spectrum of
-//! the target's luminance; if that does not converge it follows a continuation path from that
-//! grey to the target (the paper's table is built by the same kind of continuation).
-//! Coefficients are finally converted to λ in nm.
-//!
-//! ## Edges
-//!
-//! * (0, 0, 0) and (1, 1, 1) are the limits c2 → ∓∞; they are returned as exact constant
-//!   spectra 0 and 1 ([`SigmoidSpectrum::constant`]).
-//! * Greys (r = g = b) are flat: `c = (0, 0, S⁻¹(g))`, exactly.
-//! * Every other colour of the sRGB cube is fitted, including its faces: a linear sRGB
-//!   component of 0 is not a limit of the family (a positive spectrum can have a negative
-//!   sRGB component), so pure primaries and secondaries converge too. On an 11³ grid over
-//!   the whole cube (levels 0, 0.001, 0.01, …, 0.999, 1) and a 17³ grid inside, every fit
-//!   reached ΔE\*ab < 10⁻⁹. Should a colour only be approachable (coefficients growing
-//!   without bound; they are kept below 10⁴ in normalised units), the fit stops at the best
-//!   spectrum found and the returned residual ΔE\*ab says how far it is: check it.
-//!
-//! Everything is deterministic (no randomness, no threads).
+//! sRGB → smooth reflectance spectrum ("spectral upsampling") after Jakob & Hanika 2019:
+//! R(λ) = S(c0·λ² + c1·λ + c2) with a sigmoid S, its coefficients fitted per colour by
+//! Levenberg–Marquardt in CIELAB when a scene is loaded. Greys are exactly flat, black exactly
+//! 0, white exactly 1; the method, its colour definition and its edges are in docs/methods.md.
 
 use std::sync::OnceLock;
 
