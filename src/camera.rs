@@ -163,13 +163,16 @@ pub struct CameraRay {
 /// A thin lens: aperture radius and focus distance, metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ThinLens {
+    /// Aperture radius, m.
     pub radius: f32,
+    /// Distance to the plane in focus, m.
     pub focus_distance: f32,
 }
 
 /// Pinhole or thin-lens perspective camera.
 #[derive(Clone, Debug)]
 pub struct Camera {
+    /// Position of the pinhole or lens centre, m.
     pub position: Vec3,
     forward: Vec3,
     right: Vec3,

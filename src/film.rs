@@ -66,12 +66,14 @@ pub fn radiance_to_xyz(l: &SampledSpectrum, wl: &SampledWavelengths) -> [f64; 3]
 /// Running sums for one pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PixelSums {
+    /// Σ of the samples' absolute XYZ (Y in cd/m²).
     pub sum_xyz: [f64; 3],
-    /// Σ Y², for the sample variance of luminance.
+    /// Σ Y² ((cd/m²)²), for the sample variance of luminance.
     pub sum_y2: f64,
     pub count: u64,
     /// Σ E (lx) over the samples whose camera ray found a receiving surface.
     pub sum_e: f64,
+    /// Σ E² (lx²) over the same samples.
     pub sum_e2: f64,
     pub count_e: u64,
     /// Σ of the caustic light paths' splats on this pixel (XYZ, Y²) and the number of light
@@ -79,6 +81,7 @@ pub struct PixelSums {
     /// `splat_xyz / light_paths` to the camera samples' mean.
     #[serde(default)]
     pub splat_xyz: [f64; 3],
+    /// Σ of the splats' Y² ((cd/m²)²).
     #[serde(default)]
     pub splat_y2: f64,
     #[serde(default)]

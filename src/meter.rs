@@ -14,16 +14,20 @@ use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// A measured value with its standard error.
+/// A measured value with its standard error, both in the meter's SI unit: lx for illuminance,
+/// cd/m² for luminance.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Estimate {
+    /// The estimate (lx or cd/m²).
     pub mean: f64,
+    /// Its standard error (lx or cd/m²).
     pub stderr: f64,
+    /// Samples taken.
     pub samples: u64,
 }
 
 impl Estimate {
-    /// Half-width of the 95 % confidence interval (normal approximation).
+    /// Half-width of the 95 % confidence interval (normal approximation), in the unit of `mean`.
     pub fn ci95(&self) -> f64 {
         1.959_963_984_540_054 * self.stderr
     }

@@ -9,11 +9,13 @@ use glam::Vec3;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
+/// What a meter measures, where (positions in m) and in which directions.
 #[derive(Clone, Debug)]
 pub enum MeterKind {
-    /// Illuminance (lx) on the hemisphere around the unit `normal`.
+    /// Illuminance (lx) on the hemisphere around the unit `normal`, at `position` (m).
     Illuminance { position: Vec3, normal: Vec3 },
-    /// Mean luminance (cd/m²) over a cone of directions around the unit `direction`.
+    /// Mean luminance (cd/m²) over a cone of directions around the unit `direction`, seen from
+    /// `position` (m); the cone's half-angle in radians.
     Luminance {
         position: Vec3,
         direction: Vec3,
@@ -21,20 +23,27 @@ pub enum MeterKind {
     },
 }
 
+/// A named meter of the scene.
 #[derive(Clone, Debug)]
 pub struct Meter {
     pub name: String,
     pub kind: MeterKind,
 }
 
+/// A calculation grid of illuminance meters: `nx` × `ny` cells of the parallelogram
+/// `origin + s·edge_u + t·edge_v` (m), one meter at each cell's centre facing `normal`.
 #[derive(Clone, Debug)]
 pub struct Grid {
     pub name: String,
+    /// Corner of the grid, m.
     pub origin: Vec3,
+    /// Edge along the u (i) axis, m.
     pub edge_u: Vec3,
+    /// Edge along the v (j) axis, m.
     pub edge_v: Vec3,
     pub nx: u32,
     pub ny: u32,
+    /// Unit normal the meters face.
     pub normal: Vec3,
 }
 
