@@ -7,7 +7,9 @@
 //! the `*_trapezoid` functions reproduce those exactly.
 
 use crate::colour::planck::{C1, C2};
-use crate::colour::tables::{photopic_v, scotopic_v, LEN};
+use crate::colour::tables::{photopic_v, scotopic_v};
+
+use crate::colour::grid::LEN;
 use crate::spectrum::DenseSpectrum;
 
 /// Maximum luminous efficacy for photopic vision, lm/W; defined beside the tristimulus

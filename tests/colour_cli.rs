@@ -15,7 +15,9 @@
 #[allow(dead_code)]
 mod colour;
 
-use candela::colour::tables::{cmfs, named_spectrum, photopic_v, scotopic_v, Observer, LEN};
+use candela::colour::tables::{cmfs, named_spectrum, photopic_v, scotopic_v, Observer};
+
+use candela::colour::grid::LEN;
 use colour::{convert_command, spectrum_command};
 use serde_json::Value;
 

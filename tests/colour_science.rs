@@ -28,7 +28,9 @@ use candela::colour::models::{
 };
 use candela::colour::planck::blackbody_table;
 use candela::colour::rgb::{xyz_to_rgb, RgbColourspace};
-use candela::colour::tables::{named_spectrum, Observer, LEN};
+use candela::colour::tables::{named_spectrum, Observer};
+
+use candela::colour::grid::LEN;
 use candela::colour::temperature::{uv_to_cct_ohno2013, uv_to_cct_robertson1968};
 use candela::photometry::{
     luminous_efficiency_trapezoid, luminous_flux_trapezoid, scotopic_luminous_efficiency_trapezoid,

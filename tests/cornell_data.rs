@@ -10,7 +10,9 @@ use std::process::Command;
 
 use candela::colour::colorimetry::sd_to_xyz_emissive;
 use candela::colour::models::xyz_to_xy;
-use candela::colour::tables::{named_spectrum, Observer, LEN};
+use candela::colour::tables::{named_spectrum, Observer};
+
+use candela::colour::grid::LEN;
 
 /// Rows of the reflectance table in cornell-box.md: (nm, white, green, red). Both ends, the
 /// green peak (528 nm), the red rise (584–600 nm), the red maximum (644 nm) and others.

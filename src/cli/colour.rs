@@ -6,7 +6,9 @@
 
 use serde_json::json;
 
-use candela::colour::tables::{Observer, END_NM, START_NM};
+use candela::colour::tables::Observer;
+
+use candela::colour::grid::{END_NM, START_NM};
 use candela::photometry::{Quantity, UNITS};
 use candela::report::spectrum::{resolve_source, spectrum_colorimetry};
 

@@ -14,7 +14,9 @@
 //! [`XyzMethod::AstmE308`] reproduces colour-science's default (360–780 nm) bit for bit
 //! in method; the difference is the 780–830 nm tail (≤ ~1e-4 relative for deep reds).
 
-use crate::colour::tables::{cmfs, Observer, LEN};
+use crate::colour::tables::{cmfs, Observer};
+
+use crate::colour::grid::LEN;
 
 /// Maximum luminous efficacy for photopic vision, lm/W (CIE; colour-science
 /// `CONSTANT_K_M`): absolute Y in cd/m² from a radiance. Re-exported by

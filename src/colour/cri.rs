@@ -6,7 +6,9 @@ use crate::colour::colorimetry::{sd_to_xyz_emissive_with, sd_to_xyz_relative_wit
 use crate::colour::illuminants::sd_cie_illuminant_d_series;
 use crate::colour::models::{xyz_to_uv1960, xyz_to_xyy};
 use crate::colour::planck::blackbody_table;
-use crate::colour::tables::{named_spectrum, Observer, LEN};
+use crate::colour::tables::{named_spectrum, Observer};
+
+use crate::colour::grid::LEN;
 use crate::colour::temperature::{cct_to_xy_cie_d, uv_to_cct_robertson1968};
 
 /// Result of [`colour_rendering_index`].

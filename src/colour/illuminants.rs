@@ -1,7 +1,9 @@
 //! Illuminant generation: CIE daylight (D series) at any chromaticity or CCT, and CIE standard
 //! illuminant A from its formula.
 
-use crate::colour::tables::{daylight_basis, LEN};
+use crate::colour::tables::daylight_basis;
+
+use crate::colour::grid::LEN;
 use crate::colour::temperature::cct_to_xy_cie_d;
 
 /// numpy's `around(x, 3)` (round half to even at the third decimal).

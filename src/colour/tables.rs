@@ -8,7 +8,7 @@ use std::sync::LazyLock;
 use crate::colour::sd::SpectralDistribution;
 
 /// The tables' wavelength grid.
-pub use crate::colour::grid::{END_NM, LEN, START_NM};
+use crate::colour::grid::{LEN, START_NM};
 
 /// CIE standard colorimetric observer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -287,7 +287,7 @@ fn in_range(
     sd: &SpectralDistribution,
     what: &str,
 ) -> Result<(), SceneError> {
-    use crate::colour::tables::{END_NM, START_NM};
+    use crate::colour::grid::{END_NM, START_NM};
     let (Some(&first), Some(&last)) = (sd.wavelengths_nm.first(), sd.wavelengths_nm.last()) else {
         return Ok(());
     };

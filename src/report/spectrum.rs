@@ -9,14 +9,13 @@ use anyhow::{bail, Context};
 
 use crate::colour::colorimetry::{sd_to_xyz_absolute, sd_to_xyz_emissive, sd_to_xyz_relative};
 use crate::colour::cri::{colour_rendering_index, Cri};
+use crate::colour::grid::{END_NM, LEN, START_NM};
 use crate::colour::illuminants::sd_cie_daylight;
 use crate::colour::models::{xyz_to_lab, xyz_to_upvp, xyz_to_uv1960, xyz_to_xy};
 use crate::colour::planck::blackbody_table;
 use crate::colour::rgb::{srgb_encode, xyz_to_linear_srgb};
 use crate::colour::sd::SpectralDistribution;
-use crate::colour::tables::{
-    named_spectrum, named_spectrum_names, Observer, END_NM, LEN, START_NM,
-};
+use crate::colour::tables::{named_spectrum, named_spectrum_names, Observer};
 use crate::colour::temperature::{uv_to_cct_ohno2013, uv_to_cct_robertson1968};
 use crate::photometry::{blackbody_luminous_efficacy, luminous_efficacy, sp_ratio};
 
