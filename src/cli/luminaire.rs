@@ -110,7 +110,8 @@ pub fn run(file: &Path, diagram: Option<&Path>) -> anyhow::Result<String> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    candela::luminaire::diagram::write_png(&path, &p.distribution(), &title)?;
+    candela::luminaire::diagram::write_png(&path, &p.distribution(), &title)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
     let _ = writeln!(out, "polar diagram: {}", path.display());
     Ok(out)
 }

@@ -1,7 +1,7 @@
 //! Polar candela diagram like a manufacturer's data sheet: nadir (γ = 0) at the bottom, the
 //! C0–C180 plane in solid red (C0 on the right), the C90–C270 plane in dashed blue (C90 on the
 //! right), rings at round candela values labelled in cd, spokes every 30° labelled in degrees.
-//! Drawn with the report module's helpers ([`crate::output::draw`]: `imageproc` lines and
+//! Drawn with the image helpers ([`crate::output::draw`]: `imageproc` lines and
 //! circles, text in the bundled DejaVu Sans).
 
 use super::{polar_value, Distribution};
@@ -21,6 +21,10 @@ const TEXT: Rgb<u8> = Rgb([60, 60, 60]);
 const RED: Rgb<u8> = Rgb([210, 30, 30]);
 const BLUE: Rgb<u8> = Rgb([30, 70, 210]);
 
+/// Smallest positive peak intensity (cd) the diagram is drawn for: the scale from candela to
+/// pixels (about 300 / peak) must stay finite.
+pub const MIN_PEAK_CD: f64 = 1e-300;
+
 /// A "nice" ring spacing: 1, 2 or 5 × 10^k such that about 5 rings fit `max`.
 pub fn ring_step(max: f64) -> f64 {
     if max <= 0.0 || !max.is_finite() {
@@ -38,7 +42,10 @@ pub fn ring_step(max: f64) -> f64 {
 
 /// Draws the diagram of `dist` titled `title` and writes it to `path` as a PNG (atomically).
 pub fn write_png(path: &Path, dist: &Distribution, title: &str) -> Result<(), OutputError> {
-    let img = draw(dist, title);
+    let img = draw(dist, title).map_err(|reason| OutputError::InvalidImage {
+        path: path.to_path_buf(),
+        reason,
+    })?;
     write_atomic(path, |wr| {
         PngEncoder::new(wr)
             .write_image(
@@ -51,8 +58,10 @@ pub fn write_png(path: &Path, dist: &Distribution, title: &str) -> Result<(), Ou
     })
 }
 
-/// Render the diagram.
-pub fn draw(dist: &Distribution, title: &str) -> RgbImage {
+/// Render the diagram; refused (with the reason) when the intensity in the two planes is
+/// undefined or infinite, or its peak too small to scale rings by (below [`MIN_PEAK_CD`]), as a
+/// file's multipliers can make it.
+pub fn draw(dist: &Distribution, title: &str) -> Result<RgbImage, String> {
     let mut img = RgbImage::from_pixel(SIZE, SIZE, BG);
     let (cx, cy) = (SIZE as f64 / 2.0, SIZE as f64 / 2.0 + 10.0);
     let radius = SIZE as f64 * 0.40;
@@ -68,6 +77,15 @@ pub fn draw(dist: &Distribution, title: &str) -> RgbImage {
         })
         .collect();
     let vmax = curves.iter().flatten().map(|p| p.1).fold(0.0, f64::max);
+    let undefined = curves.iter().flatten().any(|p| p.1.is_nan());
+    if undefined {
+        return Err("cannot draw the polar diagram: the intensity in the C0-C180 and C90-C270 planes is undefined after the file's multipliers (infinite values)".into());
+    }
+    if !(vmax == 0.0 || (vmax.is_finite() && vmax >= MIN_PEAK_CD)) {
+        return Err(format!(
+            "cannot draw the polar diagram: the peak intensity in the C0-C180 and C90-C270 planes is {vmax:e} cd after the file's multipliers; it must be finite and at least {MIN_PEAK_CD:e} cd"
+        ));
+    }
     let step = ring_step(vmax);
     let nrings = ((vmax / step).ceil() as usize).max(1);
     let full = step * nrings as f64;
@@ -146,7 +164,7 @@ pub fn draw(dist: &Distribution, title: &str) -> RgbImage {
     }
     draw::draw_text(&mut img, 248, ty, FONT_PX, "C90–C270", TEXT);
     draw::draw_text(&mut img, SIZE as i32 - 60, ty, FONT_PX, "cd", TEXT);
-    img
+    Ok(img)
 }
 
 fn format_cd(v: f64) -> String {
@@ -169,5 +187,29 @@ fn thick_line(img: &mut RgbImage, a: (f64, f64), b: (f64, f64), c: Rgb<u8>) {
             (b.1 + dy).round() as i32,
             c,
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::luminaire::Kind;
+
+    /// A rotationally symmetric table of intensity `cd` at every angle.
+    fn flat(cd: f64) -> Distribution {
+        Distribution::new(Kind::C, vec![0.0], vec![0.0, 90.0, 180.0], vec![cd; 3])
+    }
+
+    /// Infinite and subnormal peaks are refused at once (their ring step would be 0, or 1 for
+    /// ∞ rings: a loop without end); zero, tiny normal and the largest finite peaks draw.
+    #[test]
+    fn undrawable_peaks_are_refused_not_looped_over() {
+        for cd in [f64::INFINITY, 1e-301, 1e-310, 5e-324] {
+            let e = draw(&flat(cd), "t").err().unwrap_or_default();
+            assert!(e.contains("cannot draw the polar diagram"), "{cd}: {e:?}");
+        }
+        for cd in [0.0, MIN_PEAK_CD, 1000.0, f64::MAX / 4.0] {
+            assert!(draw(&flat(cd), "t").is_ok(), "{cd}");
+        }
     }
 }

@@ -280,7 +280,8 @@ fn log_ticks(min: f64, max: f64) -> Vec<f64> {
     };
     let mut ticks = vec![min];
     let mut e = min.log10().floor() as i32;
-    while 10f64.powi(e) <= max * 1.000001 {
+    // Decades past 10^308 are infinite: the bound ends the loop for a range up to f64::MAX.
+    while e <= f64::MAX_10_EXP && 10f64.powi(e) <= max * 1.000001 {
         for m in mults {
             let v: f64 = format!("{:.12e}", m * 10f64.powi(e)).parse().unwrap_or(0.0);
             let last = *ticks.last().unwrap_or(&min);
@@ -322,6 +323,23 @@ pub fn nice_ceil(v: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A log range up to the largest f64 ends, with finite increasing ticks and both ends.
+    #[test]
+    fn log_ticks_of_the_widest_range_end() {
+        for (lo, hi) in [
+            (1.0, f64::MAX),
+            (f64::MIN_POSITIVE, f64::MAX),
+            (1e300, 1.797e308),
+        ] {
+            let t = log_ticks(lo, hi);
+            assert_eq!((t[0], *t.last().unwrap()), (lo, hi));
+            assert!(
+                t.windows(2).all(|w| w[0] < w[1] && w[1].is_finite()),
+                "{t:?}"
+            );
+        }
+    }
 
     #[test]
     fn banded_steps_and_nice_automatic_maximum() {
