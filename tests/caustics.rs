@@ -1,4 +1,4 @@
-//! Caustics by light tracing (src/caustics.rs) against a closed form and against the path
+//! Caustics by light tracing (src/integrator/light_path.rs) against a closed form and against the path
 //! tracer, with tolerances from the estimated standard errors.
 
 mod common;

@@ -29,7 +29,7 @@ K_M = 683.0  # lm/W, src/photometry.rs
 NM = list(range(360, 831))  # candela's dense grid (src/spectrum/mod.rs)
 
 # Candela max_depth counts scattering events, Mitsuba's counts path segments (camera segment
-# included): candela's longest path has max_depth + 1 segments (src/integrator.rs).
+# included): candela's longest path has max_depth + 1 segments (src/integrator/path.rs).
 MITSUBA_DEPTH_OFFSET = 1
 
 

@@ -228,8 +228,10 @@ pub fn render(a: &RenderOpts) -> Result<()> {
         bar: ProgressBar::hidden(),
         quiet: a.quiet,
     };
-    let out = job::run(&job, &mut bar, &STOP)?;
+    let out = job::run(&job, &mut bar, &STOP);
+    // Cleared before any message, error or not.
     bar.bar.finish_and_clear();
+    let out = out?;
     let elapsed = out.render.elapsed.as_secs_f64();
     match out.outcome {
         Outcome::Finished => {}

@@ -46,7 +46,7 @@ pub struct Context<'a> {
     pub path: &'a Path,
     /// Directory relative paths are resolved against.
     pub dir: PathBuf,
-    /// Every file the scene refers to, in the order first resolved (see [`World::sources`]).
+    /// Every file the scene refers to, in the order first resolved (see [`crate::world::World::sources`]).
     pub sources: std::cell::RefCell<Vec<PathBuf>>,
 }
 
@@ -165,27 +165,26 @@ impl Context<'_> {
         desc: &SpectrumDesc,
         role: Role,
     ) -> Result<DenseSpectrum, SceneError> {
-        let ctx = self;
         let dense = match desc {
             SpectrumDesc::Constant(v) => {
-                let v = ctx.finite(field, *v)?;
+                let v = self.finite(field, *v)?;
                 DenseSpectrum::constant(v as f32)
             }
             SpectrumDesc::Blackbody(t) => {
                 if role == Role::Reflectance {
-                    return Err(ctx.err(
+                    return Err(self.err(
                         field,
                         "a blackbody spectrum describes emission, not a reflectance",
                     ));
                 }
-                let t = ctx.positive(field, *t)?;
+                let t = self.positive(field, *t)?;
                 // Relative shape only: normalise to 1 at 560 nm to keep f32 in range.
                 let norm = planck_law(560e-9, t);
                 DenseSpectrum::from_fn(|nm| planck_law(nm * 1e-9, t) / norm)
             }
             SpectrumDesc::Named(name) => {
                 let sd = tables::named_spectrum(name).ok_or_else(|| {
-                    ctx.err(
+                    self.err(
                         field,
                         format!(
                             "unknown spectrum name {name:?}; known names: {}",
@@ -198,14 +197,14 @@ impl Context<'_> {
             SpectrumDesc::Tabulated(pairs) => {
                 let (w, v): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
                 let sd =
-                    SpectralDistribution::new(w, v).map_err(|e| ctx.err(field, e.to_string()))?;
+                    SpectralDistribution::new(w, v).map_err(|e| self.err(field, e.to_string()))?;
                 in_range(self, field, &sd, "the table")?;
                 DenseSpectrum::from_fn(|nm| sd.value(nm))
             }
             SpectrumDesc::Csv(rel) => {
-                let p = ctx.resolve(rel);
+                let p = self.resolve(rel);
                 let sd = SpectralDistribution::from_csv_path(&p)
-                    .map_err(|e| ctx.err(field, e.to_string()))?;
+                    .map_err(|e| self.err(field, e.to_string()))?;
                 in_range(self, field, &sd, &format!("{}", p.display()))?;
                 DenseSpectrum::from_fn(|nm| sd.value(nm))
             }
@@ -216,9 +215,9 @@ impl Context<'_> {
                     _ => unreachable!(),
                 };
                 for (k, c) in rgb.iter().enumerate() {
-                    ctx.finite(field, *c)?;
+                    self.finite(field, *c)?;
                     if !(0.0..=1.0).contains(c) {
-                        return Err(ctx.err(
+                        return Err(self.err(
                             field,
                             format!(
                                 "RGB component {} is {c}; sRGB components must lie in [0, 1]",
@@ -233,7 +232,7 @@ impl Context<'_> {
                     rgb
                 };
                 let (sig, _residual) =
-                    fit_linear_srgb(rgb).map_err(|e| ctx.err(field, e.to_string()))?;
+                    fit_linear_srgb(rgb).map_err(|e| self.err(field, e.to_string()))?;
                 match role {
                     Role::Reflectance => DenseSpectrum::from_fn(|nm| sig.value(nm)),
                     Role::Emission => {
@@ -246,11 +245,11 @@ impl Context<'_> {
             }
         };
         if dense.values.iter().any(|v| !v.is_finite()) {
-            return Err(ctx.err(field, "the spectrum has non-finite values"));
+            return Err(self.err(field, "the spectrum has non-finite values"));
         }
         let min = dense.min_value();
         if min < 0.0 {
-            return Err(ctx.err(
+            return Err(self.err(
                 field,
                 format!("the spectrum is negative (minimum {min}); spectra must be ≥ 0"),
             ));
@@ -259,7 +258,7 @@ impl Context<'_> {
             let max = dense.max_value();
             if max > 1.0 {
                 let at = dense.values.iter().position(|&v| v == max).unwrap_or(0) + 360;
-                return Err(ctx.err(
+                return Err(self.err(
                     field,
                     format!(
                         "reflectance {max} at {at} nm is above 1; a passive surface cannot reflect more light than it receives"

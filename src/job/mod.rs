@@ -1,16 +1,14 @@
 //! The whole render job as one library call: load and check the scene, render progressively
 //! (resume, checkpoints, target error, time limit, cancellation), write the image files, run
 //! the meters and grids, and write grid CSVs, heat maps, false-colour maps and the report.
-//! The command line, tests and other front ends call [`run`] and [`merge`]; what they show
+//! The command line, tests and other front ends call [`run`] and [`merge()`]; what they show
 //! while it runs comes through [`Progress`].
 
 mod files;
 mod merge;
 
-pub use files::{
-    check_exposure, check_output_dir, film_layers, output_stem, with_suffix, write_exr, write_png,
-    MAX_ABS_EXPOSURE_EV,
-};
+pub use files::{check_exposure, MAX_ABS_EXPOSURE_EV};
+use files::{check_output_dir, output_stem, with_suffix, write_exr, write_png};
 pub use merge::{merge, MergeOutputs};
 
 use crate::film::Film;

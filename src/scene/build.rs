@@ -13,7 +13,7 @@ use glam::Vec3;
 use std::collections::HashMap;
 use std::path::Path;
 
-/// Command-line overrides of the scene's render settings.
+/// Overrides of the scene's render settings by the job (`candela render`'s options).
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
     pub spp: Option<u32>,
@@ -28,7 +28,7 @@ pub struct Overrides {
 /// Largest image the renderer accepts (pixels), so a typo cannot exhaust memory.
 pub const MAX_PIXELS: u64 = 1 << 28;
 
-/// How the command line runs the render, beyond [`Overrides`]: what the memory guard needs to
+/// How the job runs the render, beyond [`Overrides`]: what the memory guard needs to
 /// know (see [`bytes_per_pixel`]). The default is a plain render.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RunMode {

@@ -197,7 +197,7 @@ impl CausticLights {
         if total >= 4.0 * PI {
             return Some((
                 crate::sampling::uniform_sphere(u),
-                (1.0 / (4.0 * PI)) as f32,
+                crate::sampling::UNIFORM_SPHERE_PDF,
             ));
         }
         // Choose a cone in proportion to its solid angle.

@@ -1,6 +1,6 @@
 //! The built, render-ready scene: geometry in one BVH, materials, lights in radiometric units,
 //! the camera, the render settings, the meters and grids ([`measure`]) and where light tracing
-//! starts and aims ([`caustic_lights`]). Plain data, produced by `scene::build`; the
+//! starts and aims ([`caustic_lights`]). Read-only data, produced by `scene::build`; the
 //! integrators, the renderer and the meters read it and are not imported by it.
 
 pub mod caustic_lights;
