@@ -2,7 +2,8 @@
 # Check that two builds of candela give the same outputs (a refactor must not move a pixel):
 #   bash scripts/same-output.sh OLD_BIN NEW_BIN [WORK_DIR]
 # Renders every scene in scenes/ at a fixed seed and a few samples per pixel (with and without
-# --illuminance/--falsecolour/--save-state), one adaptive render, a merge, and runs probe,
+# --illuminance/--falsecolour/--save-state), one adaptive render, a resumed render, a merge,
+# refused options (messages and exit codes), and runs probe,
 # falsecolour, luminaire, spectrum and convert with both binaries; then compares EXR pixel
 # data and PNG/CSV bytes exactly, report JSON numbers exactly (timings excepted) and standard
 # output with timings removed (scripts/same_output.py). Exit 0 when everything matches.
@@ -29,6 +30,15 @@ run_all() {
     [ -f "$f" ] || continue
     "$bin" luminaire "$f" --diagram "$out/$(basename "$f").polar.png" >"$out/luminaire-$(basename "$f").txt" 2>&1
   done
+  "$bin" render "$root/scenes/cornell-box.ron" --spp 1 --seed 5 --quiet --checkpoint-interval 0s --save-state --out "$out/resumed" >"$out/resume.txt" 2>&1
+  "$bin" render "$root/scenes/cornell-box.ron" --spp 3 --seed 5 --quiet --checkpoint-interval 0s --resume --out "$out/resumed" >>"$out/resume.txt" 2>&1
+  # Refusals: their messages and exit codes.
+  for args in "--threads 0" "--exposure 1e9" "--target-error 5% --target-fraction 2" "--max-spp 0" "--resume --seed 99"; do
+    # shellcheck disable=SC2086
+    "$bin" render "$root/scenes/cornell-box.ron" --quiet --out "$out/resumed" $args >>"$out/refusals.txt" 2>&1 && echo "exit 0" >>"$out/refusals.txt" || echo "exit $?" >>"$out/refusals.txt"
+  done
+  "$bin" render "$out/no-such-scene.ron" >>"$out/refusals.txt" 2>&1 || echo "exit $?" >>"$out/refusals.txt"
+  "$bin" merge "$out/furnace-e.state" "$out/furnace-e.state" -o "$out/twice" >>"$out/refusals.txt" 2>&1 || echo "exit $?" >>"$out/refusals.txt"
   "$bin" spectrum D65 --json >"$out/spectrum.txt" 2>&1
   "$bin" spectrum blackbody:3000K >>"$out/spectrum.txt" 2>&1
   "$bin" convert 100 lx fc >"$out/convert.txt" 2>&1
