@@ -298,6 +298,11 @@ impl Film {
     pub fn total_samples(&self) -> u64 {
         self.pixels.iter().map(|p| p.count).sum()
     }
+
+    /// Image samples per pixel: all samples over the number of pixels.
+    pub fn samples_per_pixel(&self) -> f64 {
+        self.total_samples() as f64 / (self.width * self.height) as f64
+    }
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use candela::output::read_exr;
 use candela::photometry::Quantity;
 use candela::report::check_photometric_layers;
 use candela::report::falsecolour::{
-    describe_scale, render_falsecolour, write_png, FalsecolourSettings, Palette, Scale,
+    describe_scale, render_falsecolour, FalsecolourSettings, Palette, Scale,
 };
 use candela::report::units::UnitSystem;
 
@@ -85,9 +85,10 @@ pub fn run(args: &FalsecolourArgs) -> anyhow::Result<String> {
         None => (None, None),
     };
     let out = args.out.clone().unwrap_or_else(|| {
-        let mut p = args.exr.with_extension("").into_os_string();
-        p.push(format!(".{}.png", args.quantity.name()));
-        PathBuf::from(p)
+        candela::output::with_suffix(
+            &args.exr.with_extension(""),
+            &format!(".{}.png", args.quantity.name()),
+        )
     });
     if out == args.exr {
         anyhow::bail!("{}: refusing to overwrite the input image", out.display());
@@ -117,7 +118,7 @@ pub fn run(args: &FalsecolourArgs) -> anyhow::Result<String> {
     };
     let (img, info) = render_falsecolour(&layers, &settings)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.exr.display()))?;
-    write_png(&out, &img).map_err(|e| anyhow::anyhow!("{e}"))?;
+    candela::output::write_rgb_png(&out, &img).map_err(|e| anyhow::anyhow!("{e}"))?;
     Ok(format!(
         "wrote {}: {} {}\n",
         out.display(),

@@ -6,13 +6,6 @@ use crate::output::{self, Layers, PngSettings};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 
-/// `stem` followed by `suffix` (`room` + `.exr` → `room.exr`; the stem may contain dots).
-pub fn with_suffix(stem: &Path, suffix: &str) -> PathBuf {
-    let mut p = stem.as_os_str().to_owned();
-    p.push(suffix);
-    PathBuf::from(p)
-}
-
 /// The output stem of `--out` / `-o`: `name` if none is given; `DIR/name` for an existing
 /// directory (or a path ending in `/`); otherwise the path, with one of `extensions` removed.
 pub fn output_stem(out: Option<&Path>, name: &str, extensions: &[&str]) -> PathBuf {
@@ -76,7 +69,7 @@ pub fn film_layers(scene: &str, film: &Film, illuminance: bool) -> Layers {
         ),
         (
             "spp".to_string(),
-            format!("{:.2}", film.total_samples() as f64 / (film.width * film.height) as f64),
+            format!("{:.2}", film.samples_per_pixel()),
         ),
     ]);
     if illuminance {

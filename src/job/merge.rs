@@ -1,10 +1,8 @@
 //! Merging independent renders of one scene (different seeds) from their state files into one
 //! estimate: the sums add, so the merged film is the render with all their samples.
 
-use super::files::{
-    check_exposure, check_output_dir, film_layers, output_stem, with_suffix, write_png,
-};
-use crate::output;
+use super::files::{check_exposure, check_output_dir, film_layers, output_stem, write_png};
+use crate::output::{self, with_suffix};
 use crate::state::RenderState;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -95,8 +93,7 @@ pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result
         png_path,
         state_path,
         renders: loaded.len(),
-        samples_per_pixel: merged.film.total_samples() as f64
-            / (merged.film.width * merged.film.height) as f64,
+        samples_per_pixel: merged.film.samples_per_pixel(),
         seeds,
     })
 }

@@ -7,8 +7,9 @@
 mod files;
 mod merge;
 
+use crate::output::with_suffix;
 pub use files::{check_exposure, MAX_ABS_EXPOSURE_EV};
-use files::{check_output_dir, output_stem, with_suffix, write_exr, write_png};
+use files::{check_output_dir, output_stem, write_exr, write_png};
 pub use merge::{merge, MergeOutputs};
 
 use crate::film::Film;
@@ -309,7 +310,7 @@ pub fn run(
         },
         &mut |f| write_checkpoint(f),
     )?;
-    let spp = result.film.total_samples() as f64 / (w * h) as f64;
+    let spp = result.film.samples_per_pixel();
     let mut outputs = RenderOutputs {
         outcome: Outcome::Finished,
         exr_path: exr_path.clone(),

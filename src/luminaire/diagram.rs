@@ -6,8 +6,7 @@
 
 use super::{polar_value, Distribution};
 use crate::output::draw;
-use crate::output::{write_atomic, OutputError};
-use image::{codecs::png::PngEncoder, ExtendedColorType, ImageEncoder};
+use crate::output::{write_rgb_png, OutputError};
 use image::{Rgb, RgbImage};
 use std::path::Path;
 
@@ -46,16 +45,7 @@ pub fn write_png(path: &Path, dist: &Distribution, title: &str) -> Result<(), Ou
         path: path.to_path_buf(),
         reason,
     })?;
-    write_atomic(path, |wr| {
-        PngEncoder::new(wr)
-            .write_image(
-                img.as_raw(),
-                img.width(),
-                img.height(),
-                ExtendedColorType::Rgb8,
-            )
-            .map_err(std::io::Error::other)
-    })
+    write_rgb_png(path, &img)
 }
 
 /// Render the diagram; refused (with the reason) when the intensity in the two planes is

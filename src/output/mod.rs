@@ -19,9 +19,16 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 pub use exr_io::{read_exr, write_exr, Layers};
 pub use png::{
-    auto_exposure_ev, ev_to_scale, log_average_luminance, write_srgb_png, PngInfo, PngSettings,
-    CALIBRATION_K, ISO_SPEED, MIDDLE_GREY,
+    auto_exposure_ev, ev_to_scale, log_average_luminance, write_rgb_png, write_srgb_png, PngInfo,
+    PngSettings, CALIBRATION_K, ISO_SPEED, MIDDLE_GREY,
 };
+
+/// `stem` followed by `suffix` (`room` + `.exr` → `room.exr`; the stem may contain dots).
+pub fn with_suffix(stem: &Path, suffix: &str) -> PathBuf {
+    let mut p = stem.as_os_str().to_owned();
+    p.push(suffix);
+    PathBuf::from(p)
+}
 
 /// Channel name of CIE 1931 X (same units as `Y`).
 pub const CHANNEL_X: &str = "X";

@@ -21,10 +21,10 @@
 //! over pixels with `Y > 0`, after leaving out the brightest 1 % of them, and picks the EV the
 //! meter would read for that luminance, so the log-average maps to 0.18.
 
-use std::io;
+use std::io::{self, Cursor};
 use std::path::Path;
 
-use image::{codecs::png::PngEncoder, ExtendedColorType, ImageEncoder};
+use image::{codecs::png::PngEncoder, ExtendedColorType, ImageEncoder, ImageFormat, RgbImage};
 
 use super::{write_atomic, OutputError};
 use crate::colour::rgb::{srgb_encode, xyz_to_linear_srgb};
@@ -163,4 +163,14 @@ pub fn write_srgb_png(
             })
     })?;
     Ok(PngInfo { exposure_ev, scale })
+}
+/// Encodes `img` as PNG and writes it atomically.
+pub fn write_rgb_png(path: &Path, img: &RgbImage) -> Result<(), OutputError> {
+    let mut bytes = Vec::new();
+    img.write_to(&mut Cursor::new(&mut bytes), ImageFormat::Png)
+        .map_err(|e| OutputError::Png {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    write_atomic(path, |w| w.write_all(&bytes))
 }

@@ -11,9 +11,10 @@ use std::path::Path;
 
 use image::{Rgb, RgbImage};
 
-use super::falsecolour::{describe_scale, write_png, ColourScale, FalsecolourSettings, Legend};
+use super::falsecolour::{describe_scale, ColourScale, FalsecolourSettings, Legend};
 use super::units::{format_sig, UnitSystem};
 use crate::output::draw::{self, BLACK, DARK_GREY, WHITE};
+use crate::output::write_rgb_png;
 use crate::output::OutputError;
 use crate::photometry::Quantity;
 
@@ -334,6 +335,6 @@ pub fn write_grid_heatmap(
 ) -> Result<HeatmapInfo, OutputError> {
     let (img, info) =
         render_grid_heatmap(grid, settings).map_err(|e| OutputError::invalid(path, e))?;
-    write_png(path, &img)?;
+    write_rgb_png(path, &img)?;
     Ok(info)
 }

@@ -253,7 +253,5 @@ pub fn slug(name: &str) -> String {
 
 /// Path of the CSV of grid `name` next to the report whose outputs share `stem`.
 pub fn grid_csv_path(stem: &Path, name: &str) -> PathBuf {
-    let mut p = stem.as_os_str().to_owned();
-    p.push(format!(".grid-{}.csv", slug(name)));
-    p.into()
+    crate::output::with_suffix(stem, &format!(".grid-{}.csv", slug(name)))
 }

@@ -1,10 +1,9 @@
 //! The false-colour image: the values of the chosen channel, the coloured (banded, contoured,
 //! hatched where undefined) map, title, subtitle and footer, and the PNG file.
 
-use std::io::Cursor;
 use std::path::Path;
 
-use image::{ImageFormat, Rgb, RgbImage};
+use image::{Rgb, RgbImage};
 
 use super::{
     describe_scale, ColourScale, FalsecolourSettings, Legend, LegendInfo, HATCH_PERIOD, LABEL_PX,
@@ -12,7 +11,7 @@ use super::{
 };
 use crate::output::draw::{self, BLACK, DARK_GREY, WHITE};
 use crate::output::{
-    write_atomic, Layers, OutputError, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_Y, ILLUMINANCE_SENTINEL,
+    Layers, OutputError, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_Y, ILLUMINANCE_SENTINEL,
 };
 use crate::photometry::Quantity;
 use crate::report::units::format_sig;
@@ -259,17 +258,6 @@ pub fn write_falsecolour(
 ) -> Result<LegendInfo, OutputError> {
     let (img, info) =
         render_falsecolour(layers, settings).map_err(|e| OutputError::invalid(path, e))?;
-    write_png(path, &img)?;
+    crate::output::write_rgb_png(path, &img)?;
     Ok(info)
-}
-
-/// Encodes `img` as PNG and writes it atomically.
-pub fn write_png(path: &Path, img: &RgbImage) -> Result<(), OutputError> {
-    let mut bytes = Vec::new();
-    img.write_to(&mut Cursor::new(&mut bytes), ImageFormat::Png)
-        .map_err(|e| OutputError::Png {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
-    write_atomic(path, |w| w.write_all(&bytes))
 }
