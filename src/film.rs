@@ -299,6 +299,11 @@ impl Film {
         self.pixels.iter().map(|p| p.count).sum()
     }
 
+    /// Mean luminance of the image, cd/m²: the pixels' mean Y averaged over the pixels.
+    pub fn mean_luminance_cd_m2(&self) -> f64 {
+        self.pixels.iter().map(|p| p.mean_xyz()[1]).sum::<f64>() / (self.width * self.height) as f64
+    }
+
     /// Image samples per pixel: all samples over the number of pixels.
     pub fn samples_per_pixel(&self) -> f64 {
         self.total_samples() as f64 / (self.width * self.height) as f64

@@ -64,8 +64,8 @@ fn a_whole_job_writes_every_output_and_measures_the_closed_form() {
     assert_eq!(out.outcome, Outcome::Finished);
     assert_eq!((count.started, count.rendered), (1, 1));
     assert!(count.passes >= 1);
-    assert_eq!((out.width, out.height), (16, 12));
-    assert_eq!(out.samples_per_pixel, 4.0);
+    assert_eq!((out.render.film.width, out.render.film.height), (16, 12));
+    assert_eq!(out.render.film.samples_per_pixel(), 4.0);
     for p in [&out.exr_path, &out.png_path, &out.report_path] {
         assert!(p.is_file(), "{} missing", p.display());
     }
@@ -130,7 +130,7 @@ fn resume_continues_and_merge_adds_the_samples() {
     job.resume = true;
     job.max_spp = Some(8);
     let out = job::run(&job, &mut Silent, &AtomicBool::new(false)).expect("resumed");
-    assert_eq!(out.samples_per_pixel, 8.0);
+    assert_eq!(out.render.film.samples_per_pixel(), 8.0);
     // A second seed, then a merge of the two states.
     let mut other = job_in(dir.path(), "other");
     other.save_state = true;

@@ -294,14 +294,14 @@ pub fn render(a: &RenderOpts) -> Result<()> {
     let r = &out.render;
     say!(
         "rendered {}×{} at {:.1} spp (image samples) in {:.2} s on {} threads: {:.3} M samples/s, {:.3} M rays/s; mean luminance {:.4} cd/m²; wrote {} and {}",
-        out.width,
-        out.height,
-        out.samples_per_pixel,
+        r.film.width,
+        r.film.height,
+        r.film.samples_per_pixel(),
         elapsed,
         r.threads,
         r.samples_per_second() / 1e6,
         r.rays_per_second() / 1e6,
-        out.mean_luminance_cd_m2,
+        r.film.mean_luminance_cd_m2(),
         out.exr_path.display(),
         out.png_path.display()
     );

@@ -138,7 +138,8 @@ pub enum Outcome {
     InterruptedMeasuring,
 }
 
-/// What a job wrote and measured.
+/// What a job wrote and measured. The image's size, samples per pixel and mean luminance are
+/// those of `render.film`.
 pub struct RenderOutputs {
     pub outcome: Outcome,
     pub exr_path: PathBuf,
@@ -148,13 +149,7 @@ pub struct RenderOutputs {
     pub report_path: PathBuf,
     /// Every file written at the end (images, grid CSVs and heat maps, false-colour maps).
     pub outputs: Vec<String>,
-    pub width: usize,
-    pub height: usize,
-    /// Image samples per pixel.
-    pub samples_per_pixel: f64,
     pub render: RenderResult,
-    /// Mean luminance of the image, cd/m².
-    pub mean_luminance_cd_m2: f64,
     pub meters: Vec<MeterResult>,
     pub grids: Vec<GridResult>,
 }
@@ -318,16 +313,6 @@ pub fn run(
         state_path: state_path.clone(),
         report_path: report_path.clone(),
         outputs: Vec::new(),
-        width: w,
-        height: h,
-        samples_per_pixel: spp,
-        mean_luminance_cd_m2: result
-            .film
-            .pixels
-            .iter()
-            .map(|p| p.mean_xyz()[1])
-            .sum::<f64>()
-            / (w * h) as f64,
         render: result,
         meters: Vec::new(),
         grids: Vec::new(),
