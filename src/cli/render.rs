@@ -1,7 +1,7 @@
 //! `candela render` and `candela merge`: their options, the progress bar, Ctrl-C, and the
 //! closing summary; the work is [`candela::job::run`] and [`candela::job::merge`].
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use candela::job::{self, ImageDone, Outcome, Progress, RenderJob};
 use candela::photometry::Quantity;
 use candela::render::{StopReason, TargetError};
@@ -213,17 +213,7 @@ pub fn render(a: &RenderOpts) -> Result<()> {
         job::check_threads("--threads", n)?;
     }
     job::check_exposure(job.exposure_ev)?;
-    if !(a.target_fraction > 0.0 && a.target_fraction <= 1.0) {
-        bail!(
-            "--target-fraction must lie in (0, 1], got {}",
-            a.target_fraction
-        );
-    }
-    if let Some(f) = a.target_floor {
-        if !(f.is_finite() && f >= 0.0) {
-            bail!("--target-floor must be a luminance ≥ 0 in cd/m², got {f}");
-        }
-    }
+    job::check_target(a.target_fraction, a.target_floor)?;
     let mut bar = Bar {
         bar: ProgressBar::hidden(),
         quiet: a.quiet,

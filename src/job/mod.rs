@@ -176,6 +176,20 @@ pub fn check_threads(flag: &str, n: usize) -> Result<()> {
     Ok(())
 }
 
+/// Refuses a target fraction outside (0, 1] or a luminance floor (cd/m²) that is negative or
+/// not finite; the messages name the command-line options.
+pub fn check_target(fraction: f64, floor_cd_m2: Option<f64>) -> Result<()> {
+    if !(fraction > 0.0 && fraction <= 1.0) {
+        bail!("--target-fraction must lie in (0, 1], got {fraction}");
+    }
+    if let Some(f) = floor_cd_m2 {
+        if !(f.is_finite() && f >= 0.0) {
+            bail!("--target-floor must be a luminance ≥ 0 in cd/m², got {f}");
+        }
+    }
+    Ok(())
+}
+
 /// Checks the job's own settings (before the scene is read).
 fn check_job(job: &RenderJob) -> Result<()> {
     if let Some(n) = job.threads {
@@ -183,14 +197,7 @@ fn check_job(job: &RenderJob) -> Result<()> {
     }
     check_exposure(job.exposure_ev)?;
     if let Some(t) = &job.target {
-        if !(t.fraction > 0.0 && t.fraction <= 1.0) {
-            bail!("--target-fraction must lie in (0, 1], got {}", t.fraction);
-        }
-        if let Some(f) = t.floor_cd_m2 {
-            if !(f.is_finite() && f >= 0.0) {
-                bail!("--target-floor must be a luminance ≥ 0 in cd/m², got {f}");
-            }
-        }
+        check_target(t.fraction, t.floor_cd_m2)?;
     }
     if job.max_spp == Some(0) {
         bail!("--max-spp must be at least 1");
