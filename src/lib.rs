@@ -15,6 +15,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod job;
 pub mod light;
+pub mod limits;
 pub mod luminaire;
 pub mod meter;
 pub mod output;

@@ -63,28 +63,6 @@ pub fn bytes_per_pixel(mode: &RunMode, illuminance: bool) -> u64 {
     }
 }
 
-/// Memory this process may still allocate (Linux: MemAvailable and the cgroup limit), if known.
-fn available_memory() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let kb: u64 = meminfo
-        .lines()
-        .find_map(|l| l.strip_prefix("MemAvailable:"))?
-        .trim()
-        .trim_end_matches("kB")
-        .trim()
-        .parse()
-        .ok()?;
-    let mut avail = kb * 1024;
-    let cg = |f: &str| -> Option<u64> { std::fs::read_to_string(f).ok()?.trim().parse().ok() };
-    if let (Some(max), Some(cur)) = (
-        cg("/sys/fs/cgroup/memory.max"),
-        cg("/sys/fs/cgroup/memory.current"),
-    ) {
-        avail = avail.min(max.saturating_sub(cur));
-    }
-    Some(avail)
-}
-
 /// Refuse a film of `w`×`h` pixels beyond [`MAX_PIXELS`] or the memory available to a render
 /// in `mode` (see [`bytes_per_pixel`]).
 fn check_film(
@@ -104,7 +82,7 @@ fn check_film(
         ));
     }
     let need = w as u64 * h as u64 * bytes_per_pixel(mode, illuminance);
-    if let Some(avail) = available_memory() {
+    if let Some(avail) = crate::limits::available_memory_bytes() {
         if need > avail {
             return Err(ctx.err(
                 "camera.resolution",
