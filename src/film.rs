@@ -198,6 +198,143 @@ impl PixelSums {
     }
 }
 
+/// Most samples a film may hold, summed over its pixels and both buffers (and the most light
+/// paths per buffer): far beyond any render (2²⁸ pixels × 2³² samples is 2⁶⁰), and small
+/// enough that counts, their sums and a merge of two films never overflow a u64.
+pub const MAX_SAMPLES: u64 = 1 << 62;
+
+/// Largest X/Y and Z/Y of any sample. Radiance is ≥ 0 and the CIE 1931 x̄, ȳ, z̄ are ≥ 0 with
+/// ȳ > 0 over the table, so a sample's X/Y lies between the table's smallest and largest x̄/ȳ
+/// (a weighted sum of ratios, and a lerp between two table points stays between theirs); the
+/// same holds for sums of samples. Infinite if ȳ were 0 where x̄ or z̄ is not.
+static XYZ_OVER_Y: LazyLock<[f64; 2]> = LazyLock::new(|| {
+    let c = &*FILM_CMFS;
+    let mut r = [0.0f64; 2];
+    for i in 0..DENSE_LEN {
+        let y = c.y[i] as f64;
+        for (k, v) in [c.x[i], c.z[i]].into_iter().enumerate() {
+            let ratio = if v == 0.0 { 0.0 } else { v as f64 / y };
+            r[k] = r[k].max(ratio);
+        }
+    }
+    r
+});
+
+/// Whether Σx and Σx² of n samples that are each ≥ 0 agree: Σx² ≤ (Σx)² (no cross terms are
+/// negative) and (Σx)² ≤ n·Σx² (Cauchy–Schwarz), compared through square roots so that nothing
+/// overflows. The relative slack covers the rounding of n additions; the absolute one, samples
+/// so small (below 1e-150) that their squares underflow.
+fn sums_agree(sum: f64, sum2: f64, n: u64) -> bool {
+    if n == 0 {
+        return sum == 0.0 && sum2 == 0.0;
+    }
+    let nf = n as f64;
+    let rel = 1.0 + 1e-9_f64.max(4.0 * nf * f64::EPSILON);
+    let abs = nf * 1e-150;
+    sum2.sqrt() <= sum * rel + abs && sum <= (nf * sum2).sqrt() * rel + abs
+}
+
+impl PixelSums {
+    /// Whether these sums can come from a render whose buffer traced `light_paths` light paths
+    /// (with per-pixel illuminance if `illuminance`); the message names the field at fault.
+    fn check(&self, light_paths: u64, illuminance: bool) -> Result<(), String> {
+        let fields = [
+            ("Σ X", self.sum_xyz[0]),
+            ("Σ Y", self.sum_xyz[1]),
+            ("Σ Z", self.sum_xyz[2]),
+            ("Σ Y²", self.sum_y2),
+            ("Σ E", self.sum_e),
+            ("Σ E²", self.sum_e2),
+            ("light-path Σ X", self.splat_xyz[0]),
+            ("light-path Σ Y", self.splat_xyz[1]),
+            ("light-path Σ Z", self.splat_xyz[2]),
+            ("light-path Σ Y²", self.splat_y2),
+            ("light-path Σ E", self.splat_e),
+            ("light-path Σ E²", self.splat_e2),
+        ];
+        for (name, v) in fields {
+            // XYZ of spectra ≥ 0 under the (non-negative) CIE 1931 functions, illuminance and
+            // squares are all ≥ 0.
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} is {v:e}, but sums of XYZ, illuminance and their squares are finite and ≥ 0"));
+            }
+        }
+        if self.light_paths != light_paths {
+            return Err(format!(
+                "it counts {} light paths, but the film traced {light_paths} for this buffer",
+                self.light_paths
+            ));
+        }
+        if self.count_e > self.count {
+            return Err(format!(
+                "{} illuminance samples but only {} samples",
+                self.count_e, self.count
+            ));
+        }
+        if !illuminance && (self.count_e > 0 || self.sum_e > 0.0 || self.splat_e > 0.0) {
+            return Err("it holds illuminance, but the render did not estimate illuminance".into());
+        }
+        let ratio = *XYZ_OVER_Y;
+        let tol = 1.0 + 1e-5;
+        for (what, xyz, n) in [
+            ("", &self.sum_xyz, self.count),
+            ("light-path ", &self.splat_xyz, self.light_paths),
+        ] {
+            if n == 0 && xyz.iter().any(|&v| v != 0.0) {
+                return Err(format!("{what}Σ XYZ is not 0 over 0 samples"));
+            }
+            for (k, c) in [(0, 'X'), (2, 'Z')] {
+                let bound = ratio[k / 2] * xyz[1] * tol + n as f64 * 1e-150;
+                if xyz[k] > bound {
+                    return Err(format!(
+                        "{what}Σ {c} = {:e} exceeds {:.1} × Σ Y = {:e}, the most any spectrum gives",
+                        xyz[k],
+                        ratio[k / 2],
+                        xyz[1]
+                    ));
+                }
+            }
+        }
+        for (what, sum, sum2, n, count) in [
+            (
+                "Σ Y and Σ Y²",
+                self.sum_xyz[1],
+                self.sum_y2,
+                self.count,
+                "samples",
+            ),
+            (
+                "Σ E and Σ E²",
+                self.sum_e,
+                self.sum_e2,
+                self.count_e,
+                "illuminance samples",
+            ),
+            (
+                "light-path Σ Y and Σ Y²",
+                self.splat_xyz[1],
+                self.splat_y2,
+                self.light_paths,
+                "light paths",
+            ),
+            (
+                "light-path Σ E and Σ E²",
+                self.splat_e,
+                self.splat_e2,
+                self.light_paths,
+                "light paths",
+            ),
+        ] {
+            if !sums_agree(sum, sum2, n) {
+                return Err(format!(
+                    "{what} ({sum:e}, {sum2:e}) cannot both come from {n} {count} (Σx² ≤ (Σx)² ≤ n·Σx² for x ≥ 0)"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// √(s²/n) from Σx, Σx² and n, with the unbiased sample variance s² (0 for n < 2).
 pub fn standard_error(sum: f64, sum2: f64, n: u64) -> f64 {
     if n < 2 {
@@ -260,6 +397,87 @@ impl Film {
                 x.merge(y);
             }
         }
+    }
+    /// Whether this film can be the result of a render (with per-pixel illuminance if
+    /// `illuminance`), as read from a file: sizes that match, counts that a render produces
+    /// (every pixel the same number of samples, or in adaptive mode as many in each buffer; as
+    /// many light paths on every pixel as the buffer traced; at most [`MAX_SAMPLES`]), and sums
+    /// that are finite, ≥ 0, and agree with their sums of squares and counts. The message
+    /// names the pixel, the buffer and what is wrong.
+    pub fn check(&self, illuminance: bool) -> Result<(), String> {
+        let n = self
+            .width
+            .checked_mul(self.height)
+            .filter(|&n| n > 0)
+            .ok_or_else(|| {
+                format!(
+                    "its size {}×{} is empty or too large",
+                    self.width, self.height
+                )
+            })?;
+        let lengths = [
+            Some(self.pixels.len()),
+            self.decision.as_ref().map(Vec::len),
+        ];
+        for (buffer, len) in ["image", "decision"].iter().zip(lengths) {
+            if len.is_some_and(|len| len != n) {
+                return Err(format!(
+                    "its {buffer} buffer has {} pixels, but the film is {}×{}",
+                    len.unwrap_or(0),
+                    self.width,
+                    self.height
+                ));
+            }
+        }
+        if self.decision.is_none() && self.light_paths[1] != 0 {
+            return Err("it counts light paths of a decision buffer it does not have".into());
+        }
+        if let Some(b) = (0..2).find(|&b| self.light_paths[b] > MAX_SAMPLES) {
+            return Err(format!(
+                "{} light paths for one buffer exceeds the limit of {MAX_SAMPLES}",
+                self.light_paths[b]
+            ));
+        }
+        let total: u128 = self
+            .pixels
+            .iter()
+            .chain(self.decision.iter().flatten())
+            .map(|p| p.count as u128)
+            .sum();
+        if total > MAX_SAMPLES as u128 {
+            return Err(format!(
+                "{total} samples in all exceeds the limit of {MAX_SAMPLES}"
+            ));
+        }
+        let at = |i: usize| (i % self.width, i / self.width);
+        let first = self.pixels[0].count;
+        for (i, p) in self.pixels.iter().enumerate() {
+            // Passes give every pixel the same number of samples, or, in adaptive mode, the same
+            // number to each buffer of a pixel.
+            let expected = self.decision.as_ref().map_or(first, |d| d[i].count);
+            if p.count != expected {
+                let (x, y) = at(i);
+                return Err(if self.decision.is_some() {
+                    format!("pixel ({x}, {y}) has {} image samples but {expected} decision samples (adaptive passes give both buffers as many)", p.count)
+                } else {
+                    format!("pixel ({x}, {y}) has {} samples but pixel (0, 0) has {expected} (every pass gives every pixel as many)", p.count)
+                });
+            }
+        }
+        let buffers = std::iter::once(("image", &self.pixels, self.light_paths[0])).chain(
+            self.decision
+                .iter()
+                .map(|d| ("decision", d, self.light_paths[1])),
+        );
+        for (buffer, pixels, light_paths) in buffers {
+            for (i, p) in pixels.iter().enumerate() {
+                p.check(light_paths, illuminance).map_err(|e| {
+                    let (x, y) = at(i);
+                    format!("pixel ({x}, {y}) of the {buffer} buffer: {e}")
+                })?;
+            }
+        }
+        Ok(())
     }
     /// Mean XYZ per pixel as f32 (row-major).
     pub fn xyz_image(&self) -> Vec<[f32; 3]> {

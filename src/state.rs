@@ -2,20 +2,43 @@
 //! buffers in adaptive mode), the scene's hash and the settings that determine the random
 //! sequence, so a render can be resumed exactly or merged with independent renders.
 //!
-//! Binary, little-endian [postcard](https://docs.rs/postcard) encoding of [`RenderState`];
-//! written atomically.
+//! A file is the little-endian [postcard](https://docs.rs/postcard) encoding of [`RenderState`]
+//! followed by the 8-byte little-endian [`checksum`] of those bytes; written atomically.
+//! Reading checks, in this order, before a pixel is used: a regular file of at most
+//! [`MAX_STATE_BYTES`]; the checksum (so a flipped bit, a truncation or an extension is refused);
+//! the signature and format version; the sizes the file claims (film size, buffer lengths, seed
+//! list) against the limits, the bytes present and the memory available, before anything is
+//! allocated for them; then the values ([`Film::check`]).
 
-use crate::film::Film;
+use crate::film::{Film, PixelSums};
 use crate::output::write_atomic;
 use crate::sampling::mix64;
+use crate::scene::build::MAX_PIXELS;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &str = "candela-render-state";
-pub const VERSION: u32 = 3;
+/// Format version: 4 added the checksum; earlier versions are refused with a message.
+pub const VERSION: u32 = 4;
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// Bytes of the checksum at the end of the file.
+const CHECKSUM_BYTES: usize = 8;
+/// Encoded size of one [`PixelSums`]: 11 f64 of 8 bytes and 3 u64 varints of 1 to 10 bytes.
+const MIN_PIXEL_BYTES: u64 = 11 * 8 + 3;
+const MAX_PIXEL_BYTES: u64 = 11 * 8 + 3 * 10;
+/// Longest scene name (the path the state was rendered from) and longest merged-seed list a
+/// state may hold; the seed list is checked against itself when merging.
+pub const MAX_SCENE_NAME_BYTES: u64 = 64 << 10;
+pub const MAX_MERGED_SEEDS: u64 = 1 << 20;
+/// Largest state file read: that of the largest film allowed ([`MAX_PIXELS`], adaptive: two
+/// buffers), with the longest name and seed list, the fixed fields and the checksum.
+pub const MAX_STATE_BYTES: u64 =
+    2 * MAX_PIXELS * MAX_PIXEL_BYTES + MAX_SCENE_NAME_BYTES + 10 * MAX_MERGED_SEEDS + 1024;
+
+/// The contents of a state file. Reading decodes the fields in this order by hand (see
+/// [`RenderState::decode`]); a change here is a new [`VERSION`] and a change there.
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RenderState {
     pub magic: String,
     pub version: u32,
@@ -33,9 +56,92 @@ pub struct RenderState {
 
 /// The leading fields of every version, read first so an old file gets a clear message.
 #[derive(Deserialize)]
-struct Header {
-    magic: String,
+struct Header<'a> {
+    magic: &'a str,
     version: u32,
+}
+
+/// The fields before the pixel buffers, read to check the sizes the file claims.
+#[derive(Deserialize)]
+struct Prefix<'a> {
+    magic: &'a str,
+    version: u32,
+    scene_hash: u64,
+    scene: &'a str,
+    seed: u64,
+    max_depth: u32,
+    illuminance: bool,
+    width: u64,
+    height: u64,
+}
+
+/// 64-bit checksum of `bytes`: four interleaved chains `h ← mix64(h ⊕ word)` over the 8-byte
+/// little-endian words (word k to chain k mod 4, the last word zero-padded), folded with the
+/// length. Every step is a bijection of `h` ([`mix64`] is invertible), so a change confined to
+/// one 8-byte word (any single flipped bit, any damaged byte) always changes the checksum;
+/// other changes of the same length go unnoticed with a probability of about 2⁻⁶⁴. Four
+/// independent chains run about four times as fast as one.
+pub fn checksum(bytes: &[u8]) -> u64 {
+    // Digits of π: the chains start apart.
+    let mut lanes = [
+        0x243f_6a88_85a3_08d3_u64,
+        0x1319_8a2e_0370_7344,
+        0xa409_3822_299f_31d0,
+        0x082e_fa98_ec4e_6c89,
+    ];
+    let word = |b: &[u8]| {
+        let mut w = [0u8; 8];
+        w[..b.len()].copy_from_slice(b);
+        u64::from_le_bytes(w)
+    };
+    let mut blocks = bytes.chunks_exact(32);
+    for block in &mut blocks {
+        for (lane, w) in lanes.iter_mut().zip(block.chunks_exact(8)) {
+            *lane = mix64(*lane ^ word(w));
+        }
+    }
+    for (lane, w) in lanes.iter_mut().zip(blocks.remainder().chunks(8)) {
+        *lane = mix64(*lane ^ word(w));
+    }
+    lanes
+        .iter()
+        .fold(bytes.len() as u64, |h, &lane| mix64(h ^ lane))
+}
+
+/// Reads one postcard value from the front of `bytes`.
+fn take<'a, T: Deserialize<'a>>(bytes: &mut &'a [u8], what: &str) -> Result<T, String> {
+    let (v, rest) =
+        postcard::take_from_bytes(bytes).map_err(|e| format!("cannot read {what}: {e}"))?;
+    *bytes = rest;
+    Ok(v)
+}
+
+/// Reads a buffer of `n` pixels after checking the length the file gives it against `n`, the
+/// bytes left and the memory available, so a false length allocates nothing.
+fn take_pixels(bytes: &mut &[u8], n: u64, buffer: &str) -> Result<Vec<PixelSums>, String> {
+    let len: u64 = take(bytes, &format!("the length of the {buffer} buffer"))?;
+    if len != n {
+        return Err(format!(
+            "its {buffer} buffer claims {len} pixels, but its film has {n}"
+        ));
+    }
+    if (bytes.len() as u64) < n * MIN_PIXEL_BYTES {
+        return Err(format!(
+            "its {buffer} buffer of {n} pixels needs at least {} bytes, but only {} remain (truncated?)",
+            n * MIN_PIXEL_BYTES,
+            bytes.len()
+        ));
+    }
+    let size = n * std::mem::size_of::<PixelSums>() as u64;
+    crate::limits::check_memory(size, &format!("the {buffer} buffer of {n} pixels"))?;
+    let mut pixels = Vec::with_capacity(n as usize);
+    for i in 0..n {
+        let (p, rest) = postcard::take_from_bytes(bytes)
+            .map_err(|e| format!("cannot read pixel {i} of the {buffer} buffer: {e}"))?;
+        pixels.push(p);
+        *bytes = rest;
+    }
+    Ok(pixels)
 }
 
 /// Hash of the scene text, the contents of every file it refers to ([`World::sources`]) and the
@@ -92,45 +198,169 @@ impl RenderState {
             .collect()
     }
 
+    /// Writes the state with its checksum, atomically.
     pub fn save(&self, path: &Path) -> anyhow::Result<()> {
-        let bytes = postcard::to_stdvec(self)?;
+        let mut bytes = postcard::to_stdvec(self)?;
+        let sum = checksum(&bytes);
+        bytes.extend_from_slice(&sum.to_le_bytes());
         write_atomic(path, |w| w.write_all(&bytes))?;
         Ok(())
     }
 
+    /// Reads and checks a state file (see the module's description); errors name the file and
+    /// what is wrong with it.
     pub fn load(path: &Path) -> anyhow::Result<Self> {
-        let bytes = std::fs::read(path)
+        let bytes = crate::limits::read_file(path, MAX_STATE_BYTES)
             .map_err(|e| anyhow::anyhow!("cannot read state file {}: {e}", path.display()))?;
-        if let Ok((h, _)) = postcard::take_from_bytes::<Header>(&bytes) {
-            anyhow::ensure!(
-                h.magic != MAGIC || h.version == VERSION,
-                "{} is a candela render state of format version {}; this candela reads version {VERSION} (finish or merge it with the candela that wrote it, or render again)",
-                path.display(),
+        Self::decode(&bytes, path)
+    }
+
+    /// Checks and decodes the bytes of a state file; `path` names it in errors.
+    pub fn decode(bytes: &[u8], path: &Path) -> anyhow::Result<Self> {
+        let name = path.display();
+        let header = postcard::take_from_bytes::<Header>(bytes)
+            .ok()
+            .map(|(h, _)| h);
+        let signed = header.as_ref().filter(|h| h.magic == MAGIC);
+        let intact = bytes.len() >= CHECKSUM_BYTES && {
+            let (payload, stored) = bytes.split_at(bytes.len() - CHECKSUM_BYTES);
+            stored == checksum(payload).to_le_bytes()
+        };
+        match signed {
+            None if bytes.is_empty() => {
+                anyhow::bail!("{name} is empty, not a candela render state")
+            }
+            None if postcard::to_stdvec(MAGIC).is_ok_and(|sig| sig.starts_with(bytes)) => {
+                anyhow::bail!(
+                    "{name} is corrupt or truncated: it ends within the signature of a candela render state"
+                )
+            }
+            None => anyhow::bail!(
+                "{name} is not a candela render state (it does not begin with one's signature)"
+            ),
+            // Versions before the checksum: their last bytes are no checksum, so the version
+            // is read unchecked (a damaged current file cannot read as one of these: its
+            // version byte is 4, and no single flipped bit makes it 1, 2 or 3).
+            Some(h) if (1..VERSION).contains(&h.version) && !intact => anyhow::bail!(
+                "{name} is a candela render state of format version {}; this candela reads version {VERSION} only (which carries a checksum): finish or merge it with the candela that wrote it, or render again",
                 h.version
-            );
+            ),
+            Some(_) if !intact => anyhow::bail!(
+                "{name} is corrupt or truncated: its checksum does not match its contents (a changed, missing or added byte)"
+            ),
+            Some(h) if h.version != VERSION => anyhow::bail!(
+                "{name} is a candela render state of format version {}; this candela reads version {VERSION} (read it with the candela that wrote it)",
+                h.version
+            ),
+            Some(_) => {}
         }
-        let s: RenderState = postcard::from_bytes(&bytes).map_err(|e| {
-            anyhow::anyhow!(
-                "{} is not a candela render state (or is corrupt or truncated): {e}",
-                path.display()
-            )
-        })?;
-        anyhow::ensure!(
-            s.magic == MAGIC && s.version == VERSION,
-            "{} is not a candela render state of version {VERSION}",
-            path.display()
-        );
-        // checked: a corrupt size must not wrap to the length of the arrays.
-        let n = s.film.width.checked_mul(s.film.height).unwrap_or(0);
-        anyhow::ensure!(
-            n > 0
-                && s.film.pixels.len() == n
-                && s.film.decision.as_ref().is_none_or(|d| d.len() == n),
-            "{} is corrupt: its pixel arrays do not match its {}×{} size",
-            path.display(),
-            s.film.width,
-            s.film.height
-        );
-        Ok(s)
+        let payload = &bytes[..bytes.len() - CHECKSUM_BYTES];
+        Self::decode_payload(payload).map_err(|e| anyhow::anyhow!("{name} is corrupt: {e}"))
+    }
+
+    /// The fields of an intact, current file, with the sizes it claims checked before they are
+    /// allocated and the film's values checked after.
+    fn decode_payload(mut bytes: &[u8]) -> Result<Self, String> {
+        let p: Prefix = take(&mut bytes, "its header")?;
+        if p.scene.len() as u64 > MAX_SCENE_NAME_BYTES {
+            return Err(format!(
+                "its scene name is {} bytes long, more than the limit of {MAX_SCENE_NAME_BYTES}",
+                p.scene.len()
+            ));
+        }
+        let n = p.width as u128 * p.height as u128;
+        if n == 0 || n > MAX_PIXELS as u128 {
+            return Err(format!(
+                "its film is {}×{} pixels{}",
+                p.width,
+                p.height,
+                if n == 0 {
+                    String::new()
+                } else {
+                    format!(", more than the limit of {MAX_PIXELS}")
+                }
+            ));
+        }
+        let n = n as u64;
+        let pixels = take_pixels(&mut bytes, n, "image")?;
+        let decision = match take::<u8>(&mut bytes, "whether it has a decision buffer")? {
+            0 => None,
+            1 => Some(take_pixels(&mut bytes, n, "decision")?),
+            t => return Err(format!("its decision-buffer tag is {t}, not 0 or 1")),
+        };
+        let light_paths: [u64; 2] = take(&mut bytes, "its light-path counts")?;
+        let seeds: u64 = take(&mut bytes, "the length of its merged-seed list")?;
+        if seeds > MAX_MERGED_SEEDS || seeds > bytes.len() as u64 {
+            return Err(format!(
+                "its merged-seed list claims {seeds} seeds (at most {MAX_MERGED_SEEDS}, one byte or more each, and {} bytes remain)",
+                bytes.len()
+            ));
+        }
+        let mut merged_seeds = Vec::with_capacity(seeds as usize);
+        for _ in 0..seeds {
+            merged_seeds.push(take(&mut bytes, "a merged seed")?);
+        }
+        if !bytes.is_empty() {
+            return Err(format!("{} bytes follow its last field", bytes.len()));
+        }
+        let mut seen = std::collections::HashSet::from([p.seed]);
+        if let Some(s) = merged_seeds.iter().find(|&&s| !seen.insert(s)) {
+            return Err(format!("it lists seed {s} twice"));
+        }
+        let film = Film {
+            width: p.width as usize,
+            height: p.height as usize,
+            pixels,
+            decision,
+            light_paths,
+        };
+        film.check(p.illuminance)?;
+        Ok(Self {
+            magic: p.magic.into(),
+            version: p.version,
+            scene_hash: p.scene_hash,
+            scene: p.scene.into(),
+            seed: p.seed,
+            max_depth: p.max_depth,
+            illuminance: p.illuminance,
+            film,
+            merged_seeds,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checksum_sees_every_change_within_one_word() {
+        // Lengths around the 32-byte blocks; every word, 64 changes each (single bits and
+        // random masks) and a byte appended or removed.
+        for len in [0usize, 1, 7, 8, 31, 32, 33, 100] {
+            let bytes: Vec<u8> = (0..len as u64).map(|i| mix64(i) as u8).collect();
+            let sum = checksum(&bytes);
+            for w in 0..len.div_ceil(8) {
+                for k in 0..64u64 {
+                    let mask = if k % 2 == 0 { 1u64 << k } else { mix64(k) | 1 };
+                    let mut b = bytes.clone();
+                    for (i, m) in mask.to_le_bytes().iter().enumerate() {
+                        if let Some(x) = b.get_mut(8 * w + i) {
+                            *x ^= m;
+                        }
+                    }
+                    assert!(
+                        b == bytes || checksum(&b) != sum,
+                        "len {len} word {w} mask {mask:x}"
+                    );
+                }
+            }
+            let mut longer = bytes.clone();
+            longer.push(0);
+            assert_ne!(checksum(&longer), sum);
+            if len > 0 {
+                assert_ne!(checksum(&bytes[..len - 1]), sum);
+            }
+        }
     }
 }

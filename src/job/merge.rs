@@ -5,6 +5,7 @@ use super::files::{check_exposure, check_output_dir, film_layers, output_stem, w
 use crate::output::{self, with_suffix};
 use crate::state::RenderState;
 use anyhow::{bail, Context, Result};
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 /// What a merge wrote.
@@ -52,8 +53,11 @@ pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result
     let (p0, first) = &loaded[0];
     let mut film = first.film.clone();
     let mut seeds = first.seeds();
+    let mut seen: HashSet<u64> = seeds.iter().copied().collect();
     for (p, s) in &loaded[1..] {
         if s.scene_hash != first.scene_hash
+            || s.max_depth != first.max_depth
+            || s.illuminance != first.illuminance
             || s.film.width != film.width
             || s.film.height != film.height
             || s.film.decision.is_some() != film.decision.is_some()
@@ -64,14 +68,29 @@ pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result
                 p.display()
             );
         }
-        if let Some(seed) = s.seeds().into_iter().find(|x| seeds.contains(x)) {
+        if let Some(seed) = s.seeds().into_iter().find(|x| seen.contains(x)) {
             bail!(
                 "{} repeats seed {seed} of another input (directly or inside a merged state): renders with the same seed take the same samples, so merging them would count those samples twice; render with different --seed values",
                 p.display()
             );
         }
+        seen.extend(s.seeds());
         seeds.extend(s.seeds());
         film.merge(&s.film);
+        // Each input is within the limits, so this sum cannot overflow; the next one might.
+        film.check(first.illuminance).map_err(|e| {
+            anyhow::anyhow!(
+                "merging {} with the inputs before it: the merged film is out of range: {e}",
+                p.display()
+            )
+        })?;
+    }
+    if seeds.len() as u64 > crate::state::MAX_MERGED_SEEDS + 1 {
+        bail!(
+            "the merged state would hold {} seeds, more than the limit of {}",
+            seeds.len(),
+            crate::state::MAX_MERGED_SEEDS + 1
+        );
     }
     let mut layers = film_layers(&first.scene, &film, first.illuminance);
     layers
