@@ -7,16 +7,28 @@ use std::process::ExitCode;
 
 /// `println!` / `print!` that ignore a closed standard output (e.g. `candela … | head -1`): the
 /// outputs are files, and a reader that stopped early must not make the command fail or panic.
+/// Text from input files (names, headers) may hold control characters: every line is printed
+/// through [`cli::printable_lines`].
 macro_rules! say {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
+        let text = $crate::cli::printable_lines(&format!($($arg)*));
+        let _ = writeln!(std::io::stdout(), "{text}");
     }};
 }
 macro_rules! say_raw {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let _ = write!(std::io::stdout(), $($arg)*);
+        let text = $crate::cli::printable_lines(&format!($($arg)*));
+        let _ = write!(std::io::stdout(), "{text}");
+    }};
+}
+/// [`say_raw!`] for JSON, which must stay valid (see [`cli::printable_json`]).
+macro_rules! say_json {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let text = $crate::cli::printable_json(&format!($($arg)*));
+        let _ = write!(std::io::stdout(), "{text}");
     }};
 }
 
@@ -102,40 +114,50 @@ fn main() -> ExitCode {
             } else {
                 Observer::Cie1931_2
             };
-            cli::colour::spectrum_command(&source, obs, json).map(|s| say_raw!("{s}"))
+            cli::colour::spectrum_command(&source, obs, json).map(|s| {
+                if json {
+                    say_json!("{s}")
+                } else {
+                    say_raw!("{s}")
+                }
+            })
         }
-        Command::Convert { value, from, to } => {
-            cli::colour::convert_command(value, &from, &to).map(|s| say_raw!("{s}"))
-        }
+        // Every value of `convert` comes from the command line: any error is a usage error.
+        Command::Convert { value, from, to } => cli::colour::convert_command(value, &from, &to)
+            .map(|s| say_raw!("{s}"))
+            .map_err(|e| cli::usage(format!("{e:#}"))),
         Command::Luminaire { file, diagram } => {
             cli::luminaire::run(&file, diagram.as_deref()).map(|s| say_raw!("{s}"))
         }
         Command::Bench(args) => cli::bench::main(&args),
-        Command::Probe(args) => cli::probe::run(&args).map(|s| say_raw!("{s}")),
+        Command::Probe(args) => cli::probe::run(&args).map(|s| {
+            if args.json {
+                say_json!("{s}")
+            } else {
+                say_raw!("{s}")
+            }
+        }),
         Command::Falsecolour(args) => cli::falsecolour::run(&args).map(|s| say_raw!("{s}")),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", error_message(&e));
-            ExitCode::FAILURE
+            eprintln!(
+                "error: {}",
+                cli::printable_lines(&candela::job::error_text(&e))
+            );
+            exit_code(&e)
         }
     }
 }
 
-/// The error and its causes joined by ": ", like `{:#}`, but a cause whose text an outer
-/// message already contains (e.g. "cannot read scene file X: {source}" whose source is also
-/// the next cause in the chain) is not repeated.
-fn error_message(e: &anyhow::Error) -> String {
-    let mut msg = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if msg.is_empty() {
-            msg = text;
-        } else if !text.is_empty() && !msg.contains(&text) {
-            msg.push_str(": ");
-            msg.push_str(&text);
-        }
+/// Exit code of a failed command (docs/guarantees.md): 2 when the command line is wrong (clap
+/// exits with 2 for its own errors), 1 when an input file, an output or the run failed. An
+/// interrupted render exits with 130 (`cli::render`).
+fn exit_code(e: &anyhow::Error) -> ExitCode {
+    if e.chain().any(|c| c.is::<candela::job::InvalidOption>()) {
+        ExitCode::from(2)
+    } else {
+        ExitCode::FAILURE
     }
-    msg
 }

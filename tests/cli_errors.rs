@@ -1,5 +1,6 @@
 //! Bad input ends with one clear message (file, line:column or field), exit code 1 (not a
-//! panic's 101), and no output file.
+//! panic's 101), and no output file; a wrong command line ends with exit code 2, as clap's own
+//! usage errors do (docs/guarantees.md).
 
 mod common;
 use std::path::Path;
@@ -205,7 +206,16 @@ fn listing(dir: &Path) -> Vec<String> {
 
 /// Exit code 1, no panic, and every needle in the message.
 fn assert_refused(code: i32, stderr: &str, needles: &[&str]) {
-    assert_eq!(code, 1, "exit code {code}, stderr:\n{stderr}");
+    assert_refused_with(1, code, stderr, needles);
+}
+
+/// A wrong command line: exit code 2, one line, every needle in the message.
+fn assert_usage(code: i32, stderr: &str, needles: &[&str]) {
+    assert_refused_with(2, code, stderr, needles);
+}
+
+fn assert_refused_with(expected: i32, code: i32, stderr: &str, needles: &[&str]) {
+    assert_eq!(code, expected, "exit code {code}, stderr:\n{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_eq!(
         stderr.trim_end().lines().count(),
@@ -239,7 +249,7 @@ fn luminaire_diagram_over_the_input_is_refused() {
 #[test]
 fn absurd_thread_counts_are_refused() {
     let (code, stderr, files) = run_with(GOOD, &[], &["--threads", "100000"]);
-    assert_refused(code, &stderr, &["--threads", "100000"]);
+    assert_usage(code, &stderr, &["--threads", "100000"]);
     assert!(
         files.is_empty(),
         "output written despite the error: {files:?}"
@@ -251,7 +261,7 @@ fn absurd_thread_counts_are_refused() {
         &["bench", "traversal", "--threads", "1,100000"],
     ] {
         let (code, stderr) = candela_in(dir.path(), args);
-        assert_refused(code, &stderr, &["--threads", "100000"]);
+        assert_usage(code, &stderr, &["--threads", "100000"]);
     }
     assert!(listing(dir.path()).is_empty());
 }
@@ -260,7 +270,7 @@ fn absurd_thread_counts_are_refused() {
 fn render_exposure_out_of_range_is_refused() {
     for ev in ["-1e308", "1e308", "101", "nan"] {
         let (code, stderr, files) = run_with(GOOD, &[], &["--exposure", ev]);
-        assert_refused(code, &stderr, &["--exposure"]);
+        assert_usage(code, &stderr, &["--exposure"]);
         assert!(
             files.is_empty(),
             "output written despite the error: {files:?}"
@@ -287,7 +297,7 @@ fn merge_exposure_is_checked_before_writing() {
             dir.path(),
             &["merge", "a.state", "b.state", "-o", "out", "--exposure", ev],
         );
-        assert_refused(code, &stderr, &["--exposure"]);
+        assert_usage(code, &stderr, &["--exposure"]);
         assert_eq!(
             listing(dir.path()),
             before,
@@ -375,8 +385,174 @@ fn bench_bad_counts_are_refused_before_any_work() {
     ];
     for (args, flag) in cases {
         let (code, stderr) = candela_in(dir.path(), args);
-        assert_refused(code, &stderr, &[flag]);
+        assert_usage(code, &stderr, &[flag]);
         assert!(!stderr.contains("cornell-box.ron"), "{stderr}");
     }
     assert!(listing(dir.path()).is_empty());
+}
+
+#[test]
+fn exit_code_2_for_the_command_line_1_for_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.ron"), GOOD).unwrap();
+    // Parsed by clap: its own message shape (several lines), exit 2.
+    for args in [
+        &["render", "--bogus", "s.ron"][..],
+        &["render", "--spp", "many", "s.ron"],
+        &["render", "--resume", "--overwrite", "s.ron"],
+        &["probe"],
+    ] {
+        let (code, _, stderr) = common::cli(args, d);
+        assert_eq!(code, 2, "{args:?}: exit code {code}, stderr:\n{stderr}");
+    }
+    // Values clap accepts and candela refuses: exit 2 too, before any file is read (the files
+    // named here do not exist).
+    let cases: &[(&[&str], &str)] = &[
+        (&["render", "--spp", "0", "s.ron"], "--spp"),
+        (&["render", "--max-spp", "0", "s.ron"], "--max-spp"),
+        (
+            &["render", "--target-fraction", "2", "s.ron"],
+            "--target-fraction",
+        ),
+        (
+            &["render", "--target-floor", "-1", "s.ron"],
+            "--target-floor",
+        ),
+        (&["render", "--threads", "0", "missing.ron"], "--threads"),
+        (
+            &["probe", "missing.exr", "0", "0", "--radius", "-1"],
+            "--radius",
+        ),
+        (
+            &["probe", "missing.exr", "0", "0", "--radius", "nan"],
+            "--radius",
+        ),
+        (&["falsecolour", "missing.exr", "--range", "5:1"], "--range"),
+        (&["falsecolour", "missing.exr", "--range", "a:b"], "--range"),
+        (
+            &["falsecolour", "missing.exr", "--steps", "5000"],
+            "--steps",
+        ),
+        (
+            &[
+                "falsecolour",
+                "missing.exr",
+                "--scale",
+                "log",
+                "--range",
+                "0:10",
+            ],
+            "--scale log",
+        ),
+        (
+            &[
+                "merge",
+                "x.state",
+                "y.state",
+                "-o",
+                "m",
+                "--exposure",
+                "inf",
+            ],
+            "--exposure",
+        ),
+        (&["convert", "1", "lx", "cd"], "lux"),
+        (&["convert", "1", "furlong", "lx"], "furlong"),
+    ];
+    for (args, flag) in cases {
+        let (code, _, stderr) = common::cli(args, d);
+        assert_usage(code, &stderr, &[flag]);
+    }
+    // Files that are missing or wrong: exit 1.
+    std::fs::write(d.join("bad.exr"), "not an image").unwrap();
+    for args in [
+        &["render", "--quiet", "missing.ron"][..],
+        &["probe", "missing.exr", "0", "0"],
+        &["probe", "bad.exr", "0", "0"],
+        &["falsecolour", "bad.exr"],
+        &["luminaire", "missing.ies"],
+        &["merge", "x.state", "y.state", "-o", "m"],
+        &["spectrum", "missing.csv"],
+    ] {
+        let (code, _, stderr) = common::cli(args, d);
+        assert_eq!(code, 1, "{args:?}: exit code {code}, stderr:\n{stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+    assert_eq!(listing(d), vec!["bad.exr", "s.ron"]);
+}
+
+/// No carriage return, NUL or escape byte in `bytes`, and the escape sequence shown escaped.
+fn assert_escaped(bytes: &[u8]) {
+    let shown = String::from_utf8_lossy(bytes);
+    for byte in [b'\r', 0, 0x1b] {
+        assert!(!bytes.contains(&byte), "raw byte {byte:#x} in:\n{shown:?}");
+    }
+    assert!(shown.contains("gr\\u{d}\\u{0}\\u{1b}[31m"), "{shown:?}");
+}
+
+#[test]
+fn control_characters_from_the_input_are_escaped_in_messages() {
+    // A carriage return, a NUL and ANSI escape sequences (red text, clear screen): in a scene
+    // field (a spectrum file name), in a value of a CSV spectrum, in a luminaire's header.
+    let evil = "gr\r\0\u{1b}[31m\u{1b}[2Jey";
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/luminaires");
+    let mut ies = std::fs::read_to_string(data.join("narrow-spot.ies")).unwrap();
+    ies.insert_str(ies.find('\n').unwrap() + 1, &format!("[TEST] {evil}\n"));
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let field = GOOD.replace("Constant(0.5)", &format!("Csv(\"{evil}.csv\")"));
+    std::fs::write(d.join("field.ron"), field).unwrap();
+    std::fs::write(
+        d.join("value.ron"),
+        GOOD.replace("Constant(0.5)", r#"Csv("w.csv")"#),
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("w.csv"),
+        format!("nm,value\n360,0.5\n400,{evil}\n830,0.5\n"),
+    )
+    .unwrap();
+    std::fs::write(d.join("evil.ies"), ies).unwrap();
+    for scene in ["field.ron", "value.ron"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_candela"))
+            .current_dir(d)
+            .args(["render", "--quiet", scene])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1));
+        assert_escaped(&out.stderr);
+        let shown = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(shown.trim_end().lines().count(), 1, "{shown:?}");
+    }
+    // Standard output too: the header line is printed, escaped.
+    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
+        .current_dir(d)
+        .args(["luminaire", "evil.ies", "--diagram", "d.png"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert_escaped(&out.stdout);
+}
+
+#[test]
+fn falsecolour_over_its_input_is_refused_by_any_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.ron"), GOOD).unwrap();
+    let (code, stderr) = candela_in(d, &["render", "--quiet", "s.ron"]);
+    assert_eq!(code, 0, "{stderr}");
+    std::fs::create_dir(d.join("sub")).unwrap();
+    let original = std::fs::read(d.join("s.exr")).unwrap();
+    let before = listing(d);
+    for out in ["s.exr", "./s.exr", "sub/../s.exr"] {
+        let (code, stderr) = candela_in(d, &["falsecolour", "s.exr", "-o", out]);
+        assert_refused(
+            code,
+            &stderr,
+            &["refusing to overwrite the input image", "s.exr"],
+        );
+        assert_eq!(std::fs::read(d.join("s.exr")).unwrap(), original);
+        assert_eq!(listing(d), before);
+    }
 }

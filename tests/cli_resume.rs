@@ -238,3 +238,45 @@ fn target_error_run_reports_what_was_reached() {
         "{mean} ± {se_mean}"
     );
 }
+
+/// (seconds, M samples/s) of the closing line of a render.
+fn closing_rate(stdout: &str) -> (f64, f64) {
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("rendered "))
+        .unwrap_or_else(|| panic!("no closing line in {stdout}"));
+    let number_before = |marker: &str| -> f64 {
+        let head = &line[..line.find(marker).unwrap()];
+        head.rsplit(' ').next().unwrap().parse().unwrap()
+    };
+    (number_before(" s on "), number_before(" M samples/s"))
+}
+
+#[test]
+fn samples_per_second_counts_only_the_samples_of_this_run() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("s.ron"), SCENE).unwrap();
+    let first = candela(
+        dir.path(),
+        &["render", "--quiet", "--spp", "32", "--save-state", "s.ron"],
+    );
+    assert!(first.status.success());
+    // Resumed from 32 to 64 spp: this run renders 32 × 32 × 32 samples.
+    let resumed = candela(
+        dir.path(),
+        &["render", "--quiet", "--resume", "--spp", "64", "s.ron"],
+    );
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let (seconds, rate) = closing_rate(&String::from_utf8_lossy(&resumed.stdout));
+    let counted = rate * 1e6 * seconds;
+    let rendered = 32.0 * 32.0 * 32.0;
+    // The printed figures are rounded (seconds to 0.01, rate to 0.001 M/s): a few per cent.
+    assert!(
+        (counted / rendered - 1.0).abs() < 0.15,
+        "{rate} M samples/s × {seconds} s = {counted} samples, rendered {rendered}"
+    );
+}

@@ -58,9 +58,9 @@ pub const MAX_TRIANGLES: usize = 100_000_000;
 /// Refuses a triangle count (of option `flag`) above [`MAX_TRIANGLES`].
 pub fn check_triangles(flag: &str, n: usize) -> anyhow::Result<()> {
     if n > MAX_TRIANGLES {
-        anyhow::bail!(
+        return Err(super::usage(format!(
             "{flag} {n} is too many: at most {MAX_TRIANGLES} triangles are generated (each needs about 100 bytes of mesh and BVH)"
-        );
+        )));
     }
     Ok(())
 }
@@ -73,9 +73,9 @@ pub const MAX_RESOLUTION: u32 = 8192;
 pub fn check_resolution(res: u32) -> anyhow::Result<()> {
     check_positive("--resolution", res.into())?;
     if res > MAX_RESOLUTION {
-        anyhow::bail!(
+        return Err(super::usage(format!(
             "--resolution {res} is too large: at most {MAX_RESOLUTION} ({MAX_RESOLUTION}² primary rays per batch)"
-        );
+        )));
     }
     Ok(())
 }
@@ -93,7 +93,7 @@ pub fn cell(x: f64, decimals: usize) -> String {
 /// Refuses 0 for a count option (`flag`) that needs at least 1.
 pub fn check_positive(flag: &str, n: u64) -> anyhow::Result<()> {
     if n == 0 {
-        anyhow::bail!("{flag} must be at least 1, got 0");
+        return Err(super::usage(format!("{flag} must be at least 1, got 0")));
     }
     Ok(())
 }

@@ -78,20 +78,52 @@ pub fn parse_range(s: &str) -> Result<(Option<f64>, Option<f64>), String> {
     Ok((num(a)?, num(b)?))
 }
 
+/// What the command line alone can tell is wrong with the scale: an empty range, a log scale
+/// from 0 or below, too many steps (the checks [`candela::report::falsecolour`] makes again).
+fn check_settings(
+    scale: Scale,
+    min: Option<f64>,
+    max: Option<f64>,
+    steps: Option<usize>,
+) -> Result<(), String> {
+    if let (Some(a), Some(b)) = (min, max) {
+        if a >= b {
+            return Err(format!("--range {a}:{b} is empty: MIN must be below MAX"));
+        }
+    }
+    match (scale, min) {
+        (Scale::Log, Some(m)) if m <= 0.0 => {
+            return Err(format!(
+                "--scale log needs a positive minimum, got --range {m}:…"
+            ))
+        }
+        _ => {}
+    }
+    if let Some(n) = steps.filter(|&n| n > 1000) {
+        return Err(format!("--steps {n} is too many (at most 1000)"));
+    }
+    Ok(())
+}
+
 /// `candela falsecolour`: writes the PNG and returns the line to print.
 pub fn run(args: &FalsecolourArgs) -> anyhow::Result<String> {
     let (min, max) = match &args.range {
-        Some(r) => parse_range(r).map_err(anyhow::Error::msg)?,
+        Some(r) => parse_range(r).map_err(super::usage)?,
         None => (None, None),
     };
+    check_settings(args.scale, min, max, args.steps).map_err(super::usage)?;
     let out = args.out.clone().unwrap_or_else(|| {
         candela::output::with_suffix(
             &args.exr.with_extension(""),
             &format!(".{}.png", args.quantity.name()),
         )
     });
-    if out == args.exr {
-        anyhow::bail!("{}: refusing to overwrite the input image", out.display());
+    if candela::job::would_replace(&out, &args.exr) {
+        anyhow::bail!(
+            "-o {}: refusing to overwrite the input image {} with the PNG map; choose another -o",
+            out.display(),
+            args.exr.display()
+        );
     }
     let layers = read_exr(&args.exr).map_err(|e| anyhow::anyhow!("{e}"))?;
     check_photometric_layers(&args.exr, &layers).map_err(|e| anyhow::anyhow!(e))?;

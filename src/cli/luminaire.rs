@@ -20,7 +20,7 @@ pub fn run(file: &Path, diagram: Option<&Path>) -> anyhow::Result<String> {
     let path = diagram
         .map(Path::to_path_buf)
         .unwrap_or_else(|| default_diagram_path(file));
-    if candela::output::same_file(&path, file) {
+    if candela::job::would_replace(&path, file) {
         anyhow::bail!(
             "--diagram {}: refusing to overwrite the input photometric file {} with the PNG diagram; choose another --diagram path",
             path.display(),

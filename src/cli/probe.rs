@@ -40,6 +40,13 @@ pub fn parse_units(s: &str) -> Result<UnitSystem, String> {
 
 /// `candela probe`: returns the text (or JSON) to print.
 pub fn run(args: &ProbeArgs) -> anyhow::Result<String> {
+    if let Some(r) = args.radius {
+        if !(r.is_finite() && r >= 0.0) {
+            return Err(super::usage(format!(
+                "--radius must be a finite number of pixels ≥ 0, got {r}"
+            )));
+        }
+    }
     // Flatten to one line: the messages already name the file and their cause.
     let r = probe_file(&args.exr, args.x, args.y, args.radius, args.units)
         .map_err(|e| anyhow!("{e}"))?;

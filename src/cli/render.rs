@@ -48,10 +48,10 @@ pub struct RenderOpts {
     #[arg(long, value_parser = parse_fraction)]
     target_error: Option<f64>,
     /// With --target-error: fraction of the eligible pixels that must meet it (default 1).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     target_fraction: f64,
     /// With --target-error: pixels darker than this luminance (cd/m²) need not meet it (default: 0.1 % of the image's mean luminance).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     target_floor: Option<f64>,
     /// Upper bound of samples per pixel (default: --spp if given, else the scene's spp, or 65536 with --target-error; with --target-error it counts the decision buffer's samples too).
     #[arg(long)]
@@ -63,8 +63,11 @@ pub struct RenderOpts {
     #[arg(long, value_parser = humantime::parse_duration, default_value = "60s")]
     checkpoint_interval: std::time::Duration,
     /// Continue from NAME.state (refused if the scene or its settings changed).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "overwrite")]
     resume: bool,
+    /// Start afresh even if NAME.state exists, replacing it (without this or --resume an existing NAME.state is never replaced: the render is refused).
+    #[arg(long)]
+    overwrite: bool,
     /// Also write NAME.state at the end (for --resume to more samples, or `candela merge`).
     #[arg(long)]
     save_state: bool,
@@ -129,6 +132,7 @@ impl RenderOpts {
             checkpoint_interval: (!self.checkpoint_interval.is_zero())
                 .then_some(self.checkpoint_interval),
             resume: self.resume,
+            overwrite: self.overwrite,
             save_state: self.save_state,
             falsecolour: self.falsecolour,
         }
@@ -174,6 +178,11 @@ impl Progress for Bar {
             self.bar
                 .set_message(format!("{:.1} % of pixels at target", 100.0 * f));
         }
+    }
+
+    fn warning(&mut self, message: &str) {
+        let text = super::printable_lines(message);
+        self.bar.suspend(|| eprintln!("warning: {text}"));
     }
 
     fn rendered(&mut self, done: &ImageDone) {
@@ -223,6 +232,7 @@ pub fn render(a: &RenderOpts) -> Result<()> {
     bar.bar.finish_and_clear();
     let out = out?;
     let elapsed = out.render.elapsed.as_secs_f64();
+    let shown = |p: &Path| super::printable_lines(&p.display().to_string());
     match out.outcome {
         Outcome::Finished => {}
         Outcome::InterruptedBeforeFirstPass => {
@@ -234,16 +244,16 @@ pub fn render(a: &RenderOpts) -> Result<()> {
         Outcome::InterruptedRender => {
             eprintln!(
                 "interrupted after {elapsed:.1} s: wrote {} and {}; continue with --resume",
-                out.exr_path.display(),
-                out.state_path.display()
+                shown(&out.exr_path),
+                shown(&out.state_path)
             );
             std::process::exit(130);
         }
         Outcome::InterruptedMeasuring => {
             eprintln!(
                 "interrupted during the meter and grid measurements: wrote {} and {} (the render had finished); no meter, grid or report output",
-                out.exr_path.display(),
-                out.png_path.display()
+                shown(&out.exr_path),
+                shown(&out.png_path)
             );
             std::process::exit(130);
         }
@@ -289,7 +299,7 @@ pub fn render(a: &RenderOpts) -> Result<()> {
         r.film.samples_per_pixel(),
         elapsed,
         r.threads,
-        r.samples_per_second() / 1e6,
+        out.samples_per_second() / 1e6,
         r.rays_per_second() / 1e6,
         r.film.mean_luminance_cd_m2(),
         out.exr_path.display(),

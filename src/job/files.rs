@@ -29,6 +29,205 @@ pub fn check_output_dir(stem: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Fewest bytes a render state of a `width`×`height` film takes (both buffers when
+/// `adaptive`): every pixel's sums are fixed-size floats; its counts take at least a byte.
+pub fn state_bytes_at_least(width: usize, height: usize, adaptive: bool) -> u64 {
+    let pixel = postcard::to_stdvec(&crate::film::PixelSums::default()).map_or(0, |b| b.len());
+    (pixel * width * height * (1 + adaptive as usize)) as u64
+}
+
+/// The directory of outputs at `path` ("." for a bare file name).
+fn dir_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// The directory entry `path` names: its directory resolved (links, `..`) and its file name.
+fn entry(path: &Path) -> Option<PathBuf> {
+    Some(dir_of(path).canonicalize().ok()?.join(path.file_name()?))
+}
+
+/// Whether writing `output` (a new file renamed over the entry, see
+/// [`crate::output::write_atomic`]) would replace or change `input`: the same directory entry,
+/// the entry a link at `input` resolves to, or the same file by another name (inode).
+pub fn would_replace(output: &Path, input: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(output), std::fs::metadata(input)) {
+            if a.dev() == b.dev() && a.ino() == b.ino() {
+                return true;
+            }
+        }
+    }
+    let Some(out) = entry(output) else {
+        return output == input;
+    };
+    entry(input).is_some_and(|e| e == out) || input.canonicalize().is_ok_and(|c| c == out)
+}
+
+/// One file a job may write, and what it is for messages ("the EXR image", "the CSV of grid
+/// \"desk\"").
+pub struct Planned {
+    pub path: PathBuf,
+    pub what: String,
+}
+
+/// Longest file name the file system holding `dir` accepts, in bytes.
+fn name_max(dir: &Path) -> usize {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        if let Ok(c) = std::ffi::CString::new(dir.as_os_str().as_bytes()) {
+            // SAFETY: `c` is a valid NUL-terminated path; pathconf only reads it.
+            let n = unsafe { libc::pathconf(c.as_ptr(), libc::_PC_NAME_MAX) };
+            if n > 0 {
+                return n as usize;
+            }
+        }
+    }
+    255
+}
+
+/// Bytes free for this user on the file system holding `dir`, where the system says.
+fn free_bytes(dir: &Path) -> Option<u64> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+        // SAFETY: statvfs fills the zeroed struct it is given and reads only the path.
+        let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
+        if unsafe { libc::statvfs(c.as_ptr(), &mut st) } != 0 {
+            return None;
+        }
+        #[allow(clippy::unnecessary_cast)] // the field types differ between platforms
+        Some((st.f_bavail as u64).saturating_mul(st.f_frsize as u64))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        None
+    }
+}
+
+/// A size in bytes for messages: "304 kB", "12.5 MB", "3.2 GB".
+fn bytes_text(n: u64) -> String {
+    let n = n as f64;
+    if n < 1e6 {
+        format!("{:.0} kB", (n / 1e3).ceil())
+    } else if n < 1e9 {
+        format!("{:.1} MB", n / 1e6)
+    } else {
+        format!("{:.1} GB", n / 1e9)
+    }
+}
+
+/// The name of the temporary file [`crate::output::write_atomic`] writes beside `name`, at its
+/// longest (a six-digit counter): `.NAME.PID.COUNTER.NONCE.tmp`.
+fn temporary_name(name: &std::ffi::OsStr) -> std::ffi::OsString {
+    let mut t = std::ffi::OsString::from(".");
+    t.push(name);
+    t.push(format!(".{}.999999.ffffffff.tmp", std::process::id()));
+    t
+}
+
+/// Checks, before anything is rendered, that the planned outputs can be written and lose
+/// nothing: none is one of `inputs` (path, what it is) or another output, each file name fits
+/// the file system, no output path is a directory or special file, the directory accepts a new
+/// file (a probe is created and removed), and at least `state_bytes` are free there (what the
+/// render state written at the end takes at the least; 0 when none is written).
+pub fn check_outputs(
+    outputs: &[Planned],
+    inputs: &[(PathBuf, String)],
+    state_bytes: u64,
+) -> Result<()> {
+    let shown = |p: &Path| crate::limits::printable(&p.display().to_string(), 300);
+    for o in outputs {
+        if let Some((input, what)) = inputs.iter().find(|(i, _)| would_replace(&o.path, i)) {
+            bail!(
+                "refusing to overwrite {what} {} with {} {}; choose another --out (or rename the file)",
+                shown(input),
+                o.what,
+                shown(&o.path)
+            );
+        }
+    }
+    let mut seen: std::collections::HashMap<PathBuf, &Planned> = Default::default();
+    for o in outputs {
+        let key = entry(&o.path).unwrap_or_else(|| o.path.clone());
+        if let Some(other) = seen.insert(key, o) {
+            bail!(
+                "{} and {} would both be written to {}",
+                other.what,
+                o.what,
+                shown(&o.path)
+            );
+        }
+    }
+    let mut longest: Option<&Planned> = None;
+    for o in outputs {
+        let Some(name) = o.path.file_name() else {
+            bail!("{} {} is not a file name", o.what, shown(&o.path));
+        };
+        let dir = dir_of(&o.path);
+        let (len, max) = (temporary_name(name).len(), name_max(dir));
+        if len > max {
+            bail!(
+                "{} {} has a file name of {} bytes: with the temporary file written beside it ({len} bytes) that is more than the {max} bytes the file system allows; choose a shorter --out, scene file name or grid name",
+                o.what,
+                shown(&o.path),
+                name.len()
+            );
+        }
+        match std::fs::metadata(&o.path) {
+            Ok(m) if !m.is_file() => bail!(
+                "{} {} exists and is not a regular file (a directory or special file); choose another --out",
+                o.what,
+                shown(&o.path)
+            ),
+            _ => {}
+        }
+        if longest.is_none_or(|l| l.path.file_name().map_or(0, |n| n.len()) < name.len()) {
+            longest = Some(o);
+        }
+    }
+    let Some(longest) = longest else {
+        return Ok(());
+    };
+    let dir = dir_of(&longest.path);
+    // A file with the longest name the job will create: the directory is writable and takes
+    // such names, before hours of rendering depend on it.
+    let probe = dir.join(temporary_name(longest.path.file_name().unwrap_or_default()));
+    match std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+    {
+        Ok(f) => {
+            drop(f);
+            let _ = std::fs::remove_file(&probe);
+        }
+        Err(e) => bail!(
+            "cannot write {} in {}: creating a file there failed: {e}",
+            longest.what,
+            shown(dir)
+        ),
+    }
+    if let Some(free) = free_bytes(dir) {
+        if free < state_bytes {
+            bail!(
+                "not enough free disk space in {}: the render state alone needs at least {}, {} are free; free some space or choose another --out",
+                shown(dir),
+                bytes_text(state_bytes),
+                bytes_text(free)
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Largest |EV| accepted for a PNG's exposure: ±100 EV is already 2^100 away from any real
 /// scene.
 pub const MAX_ABS_EXPOSURE_EV: f64 = 100.0;
@@ -44,9 +243,9 @@ pub fn check_exposure(exposure_ev: Option<f64>) -> Result<()> {
             } else {
                 format!("{ev}")
             };
-            bail!(
+            return Err(super::invalid_option(format!(
                 "--exposure must be a finite number of EV between -{MAX_ABS_EXPOSURE_EV} and {MAX_ABS_EXPOSURE_EV}, got {got}"
-            );
+            )));
         }
     }
     Ok(())

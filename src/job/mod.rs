@@ -8,8 +8,12 @@ mod files;
 mod merge;
 
 use crate::output::with_suffix;
+pub use files::would_replace;
 pub use files::{check_exposure, MAX_ABS_EXPOSURE_EV};
-use files::{check_output_dir, output_stem, write_exr, write_png};
+use files::{
+    check_output_dir, check_outputs, output_stem, state_bytes_at_least, write_exr, write_png,
+    Planned,
+};
 pub use merge::{merge, MergeOutputs};
 
 use crate::film::Film;
@@ -54,6 +58,9 @@ pub struct RenderJob {
     pub checkpoint_interval: Option<Duration>,
     /// Continue from NAME.state.
     pub resume: bool,
+    /// Start afresh even if NAME.state exists, replacing it (without this or `resume`, an
+    /// existing state is never replaced: the job is refused).
+    pub overwrite: bool,
     /// Also write NAME.state at the end.
     pub save_state: bool,
     /// Also write false-colour maps of luminance (and illuminance).
@@ -76,6 +83,7 @@ impl RenderJob {
             max_time: None,
             checkpoint_interval: Some(Duration::from_secs(60)),
             resume: false,
+            overwrite: false,
             save_state: false,
             falsecolour: false,
         }
@@ -93,6 +101,8 @@ pub trait Progress {
     fn pass(&mut self, _status: &PassStatus) {}
     /// The image is finished (before the meters and grids are measured).
     fn rendered(&mut self, _image: &ImageDone) {}
+    /// Something went wrong and the job goes on (a checkpoint that could not be written).
+    fn warning(&mut self, _message: &str) {}
 }
 
 /// A [`Progress`] that shows nothing.
@@ -149,9 +159,55 @@ pub struct RenderOutputs {
     pub report_path: PathBuf,
     /// Every file written at the end (images, grid CSVs and heat maps, false-colour maps).
     pub outputs: Vec<String>,
+    /// Image samples the film held from NAME.state before this run (0 unless resumed).
+    pub resumed_samples: u64,
     pub render: RenderResult,
     pub meters: Vec<MeterResult>,
     pub grids: Vec<GridResult>,
+}
+
+impl RenderOutputs {
+    /// Image samples rendered by this run per second of its render (resumed samples excluded).
+    pub fn samples_per_second(&self) -> f64 {
+        let new = self.render.film.total_samples() - self.resumed_samples;
+        new as f64 / self.render.elapsed.as_secs_f64().max(1e-9)
+    }
+}
+
+/// An option of a job with a value that no input can make valid (a thread count of 0, an
+/// exposure of NaN, …). The command line exits with code 2 for it, as for its other usage
+/// errors; the message names the command-line option.
+#[derive(Debug)]
+pub struct InvalidOption(pub String);
+
+impl std::fmt::Display for InvalidOption {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for InvalidOption {}
+
+/// An [`InvalidOption`] error.
+pub fn invalid_option(message: impl Into<String>) -> anyhow::Error {
+    InvalidOption(message.into()).into()
+}
+
+/// The error and its causes joined by ": ", like `{:#}`, but a cause whose text an outer
+/// message already contains (e.g. "cannot read scene file X: {source}" whose source is also
+/// the next cause in the chain) is not repeated.
+pub fn error_text(e: &anyhow::Error) -> String {
+    let mut msg = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if msg.is_empty() {
+            msg = text;
+        } else if !text.is_empty() && !msg.contains(&text) {
+            msg.push_str(": ");
+            msg.push_str(&text);
+        }
+    }
+    msg
 }
 
 /// Largest worker-thread count accepted: 16 per available core
@@ -164,14 +220,14 @@ pub fn max_threads() -> usize {
 /// Refuses a thread count (named `flag` in the message) of 0 or above [`max_threads`].
 pub fn check_threads(flag: &str, n: usize) -> Result<()> {
     if n == 0 {
-        bail!("{flag} must be at least 1, got 0");
+        return Err(invalid_option(format!("{flag} must be at least 1, got 0")));
     }
     let max = max_threads();
     if n > max {
-        bail!(
+        return Err(invalid_option(format!(
             "{flag} {n} is too many: at most {max} threads are accepted (16 per available core, {} cores here)",
             max / 16
-        );
+        )));
     }
     Ok(())
 }
@@ -180,11 +236,15 @@ pub fn check_threads(flag: &str, n: usize) -> Result<()> {
 /// not finite; the messages name the command-line options.
 pub fn check_target(fraction: f64, floor_cd_m2: Option<f64>) -> Result<()> {
     if !(fraction > 0.0 && fraction <= 1.0) {
-        bail!("--target-fraction must lie in (0, 1], got {fraction}");
+        return Err(invalid_option(format!(
+            "--target-fraction must lie in (0, 1], got {fraction}"
+        )));
     }
     if let Some(f) = floor_cd_m2 {
         if !(f.is_finite() && f >= 0.0) {
-            bail!("--target-floor must be a luminance ≥ 0 in cd/m², got {f}");
+            return Err(invalid_option(format!(
+                "--target-floor must be a luminance ≥ 0 in cd/m², got {f}"
+            )));
         }
     }
     Ok(())
@@ -200,7 +260,15 @@ fn check_job(job: &RenderJob) -> Result<()> {
         check_target(t.fraction, t.floor_cd_m2)?;
     }
     if job.max_spp == Some(0) {
-        bail!("--max-spp must be at least 1");
+        return Err(invalid_option("--max-spp must be at least 1"));
+    }
+    if job.overrides.spp == Some(0) {
+        return Err(invalid_option("--spp must be at least 1"));
+    }
+    if job.resume && job.overwrite {
+        return Err(invalid_option(
+            "--resume continues NAME.state and --overwrite replaces it: give one of them",
+        ));
     }
     Ok(())
 }
@@ -246,8 +314,49 @@ fn initial_film(job: &RenderJob, world: &World, hash: u64, state_path: &Path) ->
     Ok(st.film)
 }
 
+/// Every file the job may write, with what it is (for messages): images, state, report, each
+/// grid's CSV and heat map, and the false-colour maps.
+fn planned_outputs(job: &RenderJob, world: &World, stem: &Path) -> Vec<Planned> {
+    let plan = |suffix: &str, what: &str| Planned {
+        path: with_suffix(stem, suffix),
+        what: what.to_string(),
+    };
+    let mut planned = vec![
+        plan(".exr", "the EXR image"),
+        plan(".png", "the PNG image"),
+        plan(".report.json", "the report"),
+        plan(".state", "the render state"),
+    ];
+    for g in &world.grids {
+        let csv = grid_csv_path(stem, &g.name);
+        let name = crate::limits::printable(&g.name, 60);
+        planned.push(Planned {
+            path: csv.with_extension("png"),
+            what: format!("the heat map of grid {name:?}"),
+        });
+        planned.push(Planned {
+            path: csv,
+            what: format!("the CSV of grid {name:?}"),
+        });
+    }
+    if job.falsecolour {
+        planned.push(plan(".luminance.png", "the luminance false-colour map"));
+        if world.settings.illuminance {
+            planned.push(plan(".illuminance.png", "the illuminance false-colour map"));
+        }
+    }
+    planned
+}
+
 /// Runs a whole render job. `stop` ends it early (at the end of the pass in progress; during
 /// the meters, at once): the outcome then says what was written.
+///
+/// Before anything is rendered it refuses outputs that would replace the scene file, a file
+/// the scene refers to or each other, names the file system would refuse, a directory that
+/// takes no new file, too little free space for the state, and an existing NAME.state unless
+/// the job resumes it or may overwrite it. Checkpoints that cannot be written are reported
+/// through [`Progress::warning`] and the render goes on; at the end every output is attempted
+/// (the small ones first, the state last) and the job fails if any could not be written.
 pub fn run(
     job: &RenderJob,
     progress: &mut dyn Progress,
@@ -276,6 +385,27 @@ pub fn run(
     let state_path = with_suffix(&stem, ".state");
     let report_path = with_suffix(&stem, ".report.json");
     let (w, h) = (world.camera.width, world.camera.height);
+    let state_existed = state_path.exists();
+    let save_state = job.save_state || job.resume || state_existed;
+    let mut inputs = vec![(job.scene.clone(), "the scene file".to_string())];
+    inputs.extend(
+        world
+            .sources
+            .iter()
+            .map(|p| (p.clone(), "the file the scene refers to".to_string())),
+    );
+    let need_bytes = if save_state {
+        state_bytes_at_least(w, h, job.target.is_some())
+    } else {
+        0
+    };
+    check_outputs(&planned_outputs(job, &world, &stem), &inputs, need_bytes)?;
+    if state_existed && !job.resume && !job.overwrite {
+        bail!(
+            "{} holds the samples of an earlier render: continue it with --resume, or start again and replace it with --overwrite (or choose another --out)",
+            crate::limits::printable(&state_path.display().to_string(), 300)
+        );
+    }
     let prog = Progressive {
         max_spp: job
             .max_spp
@@ -290,15 +420,23 @@ pub fn run(
         checkpoint_interval: job.checkpoint_interval,
     };
     let mut film = initial_film(job, &world, hash, &state_path)?;
+    let resumed_samples = film.total_samples();
     let illuminance = world.settings.illuminance;
-    let write_checkpoint = |film: &Film| -> Result<()> {
-        RenderState::new(scene_path, hash, &world, film.clone()).save(&state_path)?;
-        write_exr(scene_path, film, illuminance, &exr_path)?;
+    // The images before the state: on a nearly full disk the small files still get written.
+    let write_images = |film: &Film, writes: &mut Writes| {
+        writes.attempt(&exr_path, || {
+            write_exr(scene_path, film, illuminance, &exr_path)
+        });
         // The PNG too, so that the image pair on disk is always of the same estimate.
-        write_png(film, &png_path, job.exposure_ev)?;
-        Ok(())
+        writes.attempt(&png_path, || write_png(film, &png_path, job.exposure_ev));
+    };
+    let write_state = |film: &Film, writes: &mut Writes| {
+        writes.attempt(&state_path, || {
+            RenderState::new(scene_path, hash, &world, film.clone()).save(&state_path)
+        });
     };
     progress.start(prog.max_spp as u64 * (w * h) as u64)?;
+    let progress = std::cell::RefCell::new(progress);
     let mut last = PassStatus::default();
     let (result, reason) = crate::render::render_progressive(
         &world,
@@ -308,10 +446,21 @@ pub fn run(
         stop,
         &mut |s| {
             last = *s;
-            progress.pass(s);
+            progress.borrow_mut().pass(s);
         },
-        &mut |f| write_checkpoint(f),
+        &mut |f| {
+            let mut writes = Writes::default();
+            write_images(f, &mut writes);
+            write_state(f, &mut writes);
+            for e in &writes.failed {
+                progress
+                    .borrow_mut()
+                    .warning(&format!("checkpoint not written, the render goes on: {e}"));
+            }
+            Ok(())
+        },
     )?;
+    let progress = progress.into_inner();
     let spp = result.film.samples_per_pixel();
     let mut outputs = RenderOutputs {
         outcome: Outcome::Finished,
@@ -320,46 +469,50 @@ pub fn run(
         state_path: state_path.clone(),
         report_path: report_path.clone(),
         outputs: Vec::new(),
+        resumed_samples,
         render: result,
         meters: Vec::new(),
         grids: Vec::new(),
     };
     let result = &outputs.render;
+    let mut writes = Writes::default();
     if reason == StopReason::Interrupted {
-        outputs.outcome = if result.film.total_samples() == 0 {
-            // No pass finished: an all-zero image would replace the files of an earlier render.
+        outputs.outcome = if result.film.total_samples() == resumed_samples {
+            // No pass finished: an image of nothing new would replace the files of an earlier
+            // render (or the same state again).
             Outcome::InterruptedBeforeFirstPass
         } else {
-            write_checkpoint(&result.film)?;
+            write_images(&result.film, &mut writes);
+            write_state(&result.film, &mut writes);
             Outcome::InterruptedRender
         };
+        writes.finish()?;
         return Ok(outputs);
-    }
-    if job.save_state || job.resume || state_path.exists() {
-        RenderState::new(scene_path, hash, &world, result.film.clone()).save(&state_path)?;
     }
     progress.rendered(&ImageDone {
         reason,
         last,
         target: job.target,
     });
+    write_images(&result.film, &mut writes);
     let t_measure = std::time::Instant::now();
     let measurements = crate::meter::measure_all_until(&world, stop);
     let measure_seconds = t_measure.elapsed().as_secs_f64();
-    write_exr(scene_path, &result.film, illuminance, &exr_path)?;
-    write_png(&result.film, &png_path, job.exposure_ev)?;
     let Some(measurements) = measurements else {
+        if save_state {
+            write_state(&result.film, &mut writes);
+        }
         outputs.outcome = Outcome::InterruptedMeasuring;
+        writes.finish()?;
         return Ok(outputs);
     };
-    let mut written = vec![
-        exr_path.display().to_string(),
-        png_path.display().to_string(),
-    ];
-    write_grids(&world, &measurements, &stem, job.units, &mut written)?;
+    write_grids(&world, &measurements, &stem, job.units, &mut writes);
     if job.falsecolour {
-        write_falsecolour(&world, &exr_path, &stem, job.units, &mut written)?;
+        let layers =
+            files::film_layers(&scene_path.display().to_string(), &result.film, illuminance);
+        write_falsecolour(&world, &layers, &stem, job.units, &mut writes);
     }
+    let written = writes.written.clone();
     let report = report_json(&ReportInput {
         scene_path,
         world: &world,
@@ -380,7 +533,14 @@ pub fn run(
             "max_time_s": job.max_time.map(|d| d.as_secs_f64()),
         }),
     });
-    write_text(&report_path, &serde_json::to_string_pretty(&report)?)?;
+    writes.attempt(&report_path, || {
+        write_text(&report_path, &serde_json::to_string_pretty(&report)?)?;
+        Ok(())
+    });
+    if save_state {
+        write_state(&result.film, &mut writes);
+    }
+    writes.finish()?;
     outputs.outputs = written;
     outputs.meters = world
         .meters
@@ -406,18 +566,58 @@ pub fn run(
     Ok(outputs)
 }
 
+/// The outputs of the end of a job, each attempted whether or not an earlier one failed.
+#[derive(Default)]
+struct Writes {
+    /// Files written, in order.
+    written: Vec<String>,
+    /// One line per file that could not be written, naming it.
+    failed: Vec<String>,
+}
+
+impl Writes {
+    fn attempt(&mut self, path: &Path, write: impl FnOnce() -> Result<()>) {
+        let shown = path.display().to_string();
+        match write() {
+            Ok(()) => self.written.push(shown),
+            Err(e) => {
+                let e = error_text(&e);
+                self.failed.push(if e.contains(&shown) {
+                    e
+                } else {
+                    format!("{shown}: {e}")
+                });
+            }
+        }
+    }
+
+    /// One error listing every file that could not be written, if any.
+    fn finish(self) -> Result<()> {
+        match self.failed.len() {
+            0 => Ok(()),
+            1 => bail!("{}", self.failed[0]),
+            n => bail!(
+                "{n} files could not be written (the other outputs were):\n  {}",
+                self.failed.join("\n  ")
+            ),
+        }
+    }
+}
+
 /// Each grid's CSV and heat map, named after the grid.
 fn write_grids(
     world: &World,
     measurements: &crate::meter::Measurements,
     stem: &Path,
     units: UnitSystem,
-    written: &mut Vec<String>,
-) -> Result<()> {
+    writes: &mut Writes,
+) {
     for (k, (g, est)) in world.grids.iter().zip(&measurements.grids).enumerate() {
         let path = grid_csv_path(stem, &g.name);
-        write_text(&path, &grid_csv(world, k, est, units))?;
-        written.push(path.display().to_string());
+        writes.attempt(&path, || {
+            write_text(&path, &grid_csv(world, k, est, units))?;
+            Ok(())
+        });
         let png = path.with_extension("png");
         let values = crate::report::heatmap::GridValues {
             name: g.name.clone(),
@@ -432,21 +632,22 @@ fn write_grids(
             units,
             ..Default::default()
         };
-        crate::report::heatmap::write_grid_heatmap(&png, &values, &settings)?;
-        written.push(png.display().to_string());
+        writes.attempt(&png, || {
+            crate::report::heatmap::write_grid_heatmap(&png, &values, &settings)?;
+            Ok(())
+        });
     }
-    Ok(())
 }
 
-/// False-colour maps of the written EXR: luminance, and illuminance when it was estimated.
+/// False-colour maps of the image (the EXR's channels): luminance, and illuminance when it was
+/// estimated.
 fn write_falsecolour(
     world: &World,
-    exr_path: &Path,
+    layers: &crate::output::Layers,
     stem: &Path,
     units: UnitSystem,
-    written: &mut Vec<String>,
-) -> Result<()> {
-    let layers = crate::output::read_exr(exr_path)?;
+    writes: &mut Writes,
+) {
     let mut quantities = vec![(Quantity::Luminance, ".luminance.png")];
     if world.settings.illuminance {
         quantities.push((Quantity::Illuminance, ".illuminance.png"));
@@ -458,8 +659,9 @@ fn write_falsecolour(
             units,
             ..Default::default()
         };
-        crate::report::falsecolour::write_falsecolour(&path, &layers, &settings)?;
-        written.push(path.display().to_string());
+        writes.attempt(&path, || {
+            crate::report::falsecolour::write_falsecolour(&path, layers, &settings)?;
+            Ok(())
+        });
     }
-    Ok(())
 }
