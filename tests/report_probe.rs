@@ -359,8 +359,11 @@ fn errors_name_the_file() {
         (&["probe", "p.exr", "9", "0"], "outside the 9×7 image"),
         (&["probe", "p.exr", "0", "7"], "outside"),
         (&["probe", "p.exr", "-1", "2"], "outside"),
-        (&["probe", "p.exr", "1", "1", "--radius", "-2"], "radius"),
     ];
+    // A negative radius is a wrong command line: exit 2, before the file is read.
+    let (code, _, err) = cli(&["probe", "p.exr", "1", "1", "--radius", "-2"], d);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--radius"), "{err}");
     for (args, needle) in cases {
         let (code, _, err) = cli(args, d);
         assert_eq!(code, 1, "{args:?}: {err}");
