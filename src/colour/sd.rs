@@ -202,12 +202,16 @@ impl SpectralDistribution {
         Ok(())
     }
 
-    /// Reads a two-column CSV file (`nm,value`), see [`Self::from_csv_str`].
+    /// Reads a two-column CSV file (`nm,value`) of at most [`crate::limits::MAX_TEXT_BYTES`]
+    /// (a FIFO, device or directory is refused unread), see [`Self::from_csv_str`].
     pub fn from_csv_path(path: &Path) -> Result<Self, SpectrumError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SpectrumError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text =
+            crate::limits::read_text(path, crate::limits::MAX_TEXT_BYTES).map_err(|source| {
+                SpectrumError::Io {
+                    path: path.display().to_string(),
+                    source,
+                }
+            })?;
         Self::from_csv_str(&text, &path.display().to_string())
     }
 

@@ -1,22 +1,117 @@
 //! OBJ (tobj) and PLY (ply-rs-bw) loading. Every failure is a [`GeometryError`] naming the
 //! file; malformed input never panics.
+//!
+//! Files are read whole through [`crate::limits::read_file`] (so a FIFO, a device or a
+//! directory is refused unread). Meshes may be gigabytes and the parsers hold several times
+//! the file's size, in a proportion that depends on what the file holds (a 5 MB PLY of
+//! one-byte elements takes 1.8 GB in ply-rs), so before parsing, the memory the parse will need
+//! is estimated from the file's contents (OBJ: its statements; PLY: its header) and checked
+//! against the memory available.
 
 use super::{GeometryError, TriangleMesh};
+use crate::limits;
 use glam::Vec3;
 use std::path::Path;
 
-fn open_check(path: &Path) -> Result<std::fs::File, GeometryError> {
-    let f = std::fs::File::open(path).map_err(|source| GeometryError::Io {
+/// Largest mesh file read at all; below it, the memory available decides.
+const MAX_MESH_FILE_BYTES: u64 = 1 << 40;
+
+/// Largest material library (`mtllib`) read; real ones are kilobytes.
+const MAX_MTL_FILE_BYTES: u64 = 16 << 20;
+
+fn read_mesh(path: &Path) -> Result<Vec<u8>, GeometryError> {
+    limits::read_file(path, MAX_MESH_FILE_BYTES).map_err(|source| GeometryError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
-    match f.metadata() {
-        Ok(m) if m.is_dir() => Err(GeometryError::Io {
-            path: path.to_path_buf(),
-            source: std::io::Error::other("it is a directory, not a file"),
-        }),
-        _ => Ok(f),
+    })
+}
+
+fn check_memory(path: &Path, what: &str, need: u64) -> Result<(), GeometryError> {
+    limits::check_memory(need, what).map_err(|message| GeometryError::TooLarge {
+        path: path.to_path_buf(),
+        message,
+    })
+}
+
+/// Peak memory of loading OBJ text, in bytes, from a scan of its statements. The costs per
+/// statement are tobj's (faces are held as 104-byte records before triangulation; each distinct
+/// position/texture/normal index triple enters a hash map) and ours, with room for vector
+/// growth; measured peaks are 0.6–0.95 of this estimate (10⁷ one-triangle faces, 1.6·10⁷ quads,
+/// a 10⁶-vertex polygon, 3·10⁶ groups, 10⁷ vertices, a 10⁶-vertex grid).
+fn obj_memory(bytes: &[u8]) -> u64 {
+    let (mut v, mut vt, mut vn, mut faces, mut corners, mut extra, mut groups) =
+        (0u64, 0u64, 0u64, 0u64, 0u64, 0u64, 0u64);
+    for line in bytes.split(|&b| b == b'\n') {
+        let mut words = line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|w| !w.is_empty());
+        match words.next() {
+            Some(b"v") => v += 1,
+            Some(b"vt") => vt += 1,
+            Some(b"vn") => vn += 1,
+            Some(b"f") => {
+                let n = words.count() as u64;
+                faces += 1;
+                corners += n;
+                extra += n.saturating_sub(3);
+            }
+            Some(b"o") | Some(b"g") => groups += 1,
+            _ => {}
+        }
     }
+    // Distinct index triples: at most one per face corner, and at most every combination.
+    let triples = corners.min(v.saturating_mul(vt.max(1)).saturating_mul(vn.max(1)));
+    let utf8_copy = if std::str::from_utf8(bytes).is_ok() {
+        0
+    } else {
+        3 * bytes.len() as u64
+    };
+    (bytes.len() as u64 + utf8_copy)
+        .saturating_add(24 * v + 16 * vt + 24 * vn)
+        .saturating_add(130 * faces + 40 * extra)
+        .saturating_add(160 * triples + 350 * groups)
+}
+
+/// Peak memory of loading a PLY file whose payload is `payload` bytes, in bytes, from its
+/// header. ply-rs holds every element as a map from property name to value: about 250 bytes
+/// per element and 180 per property (measured peaks are 0.55–0.9 of this estimate: 2·10⁶
+/// vertices of 3 floats, 10⁶ of 9, 2·10⁶ faces, 5·10⁶ one-byte elements, ASCII and binary).
+/// The count of an element is taken as no more than the payload can hold, so a header that
+/// claims more than the file has is not refused for it (ply-rs stops at the end of the data).
+fn ply_memory(header: &ply_rs_bw::ply::Header, payload: usize) -> u64 {
+    use ply_rs_bw::ply::{Encoding, PropertyType, ScalarType};
+    let size = |t: &ScalarType| match t {
+        ScalarType::Char | ScalarType::UChar => 1u64,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    };
+    let ascii = matches!(header.encoding, Encoding::Ascii);
+    let payload = payload as u64;
+    let mut need = 6 * payload;
+    for (_, element) in header.elements.iter() {
+        let props = element.properties.len() as u64;
+        // Fewest bytes one element takes in the file: a value and a separator per property in
+        // ASCII (an element is a line), its scalars and list lengths in binary.
+        let min_bytes = if ascii {
+            (2 * props).max(1)
+        } else {
+            element
+                .properties
+                .iter()
+                .map(|(_, p)| match &p.data_type {
+                    PropertyType::Scalar(t) => size(t),
+                    PropertyType::List(count, _) => size(count),
+                })
+                .sum()
+        };
+        let count = match min_bytes {
+            0 => element.count as u64,
+            m => (element.count as u64).min(payload / m),
+        };
+        need = need.saturating_add(count.saturating_mul(250 + 180 * props));
+    }
+    need
 }
 
 /// Joins a multi-line parser message into one line without a trailing period.
@@ -71,9 +166,7 @@ fn validate(path: &Path, mesh: &TriangleMesh) -> Result<(), GeometryError> {
 /// The first OBJ face whose vertex reference is not a valid position index, described with
 /// its line, its face number (from 0, counting `f` lines) and the vertex count: OBJ indices
 /// are 1-based, or negative to count back from the last vertex defined so far.
-fn locate_bad_face(path: &Path) -> Option<String> {
-    let text = std::fs::read(path).ok()?;
-    let text = String::from_utf8_lossy(&text);
+fn locate_bad_face(text: &str) -> Option<String> {
     let is = |l: &str, tag: &str| {
         l.strip_prefix(tag)
             .is_some_and(|r| r.starts_with([' ', '\t']))
@@ -107,9 +200,20 @@ fn locate_bad_face(path: &Path) -> Option<String> {
 
 /// Loads a Wavefront OBJ file: polygons are triangulated (fan), all objects/groups are merged
 /// into one mesh, materials and texture coordinates are ignored. Vertex normals are kept only
-/// if every object in the file has them.
+/// if every object in the file has them. A UTF-8 byte-order mark is skipped; bytes that are not
+/// UTF-8 (only names and comments can hold them) are replaced.
+///
+/// Material libraries (`mtllib`) are not used, so one that does not exist is ignored; one that
+/// is a FIFO, a device, a directory or over 16 MiB is refused, naming it.
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
-    open_check(path)?;
+    let bytes = read_mesh(path)?;
+    check_memory(
+        path,
+        &format!("loading this OBJ file of {} bytes", bytes.len()),
+        obj_memory(&bytes),
+    )?;
+    let text = String::from_utf8_lossy(&bytes);
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -121,14 +225,36 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
         format: "OBJ",
         message,
     };
+    let mtl_error = std::cell::RefCell::new(None);
+    let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
+        let mtl = path.parent().unwrap_or(Path::new("")).join(name);
+        match limits::read_file(&mtl, MAX_MTL_FILE_BYTES) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                mtl_error
+                    .borrow_mut()
+                    .get_or_insert(GeometryError::Material {
+                        path: path.to_path_buf(),
+                        mtl,
+                        source: e,
+                    });
+            }
+            _ => {}
+        }
+        Ok(Default::default())
+    };
     // tobj should not panic on malformed input, but a mesh loader must never take the
     // renderer down: convert any panic into an error.
-    let loaded = std::panic::catch_unwind(|| tobj::load_obj(path, &opts))
-        .map_err(|_| parse("the OBJ parser failed on malformed input".into()))?;
+    let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut text.as_bytes(), &opts, load_mtl)
+    }))
+    .map_err(|_| parse("the OBJ parser failed on malformed input".into()))?;
+    if let Some(e) = mtl_error.into_inner() {
+        return Err(e);
+    }
     let (models, _materials) = loaded.map_err(|e| match e {
         tobj::LoadError::FaceVertexOutOfBounds | tobj::LoadError::FaceParseError => {
             // tobj does not say where: find the face ourselves.
-            parse(locate_bad_face(path).unwrap_or_else(|| {
+            parse(locate_bad_face(text).unwrap_or_else(|| {
                 match e {
                     tobj::LoadError::FaceVertexOutOfBounds => {
                         "a face refers to a vertex index that does not exist (index out of range)"
@@ -197,21 +323,40 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
 /// properties `x, y, z` (optionally `nx, ny, nz`), element `face` with a list property
 /// `vertex_indices` (or `vertex_index`); polygons are triangulated as fans.
 pub fn load_ply(path: &Path) -> Result<TriangleMesh, GeometryError> {
-    use ply_rs_bw::parser::Parser;
+    use ply_rs_bw::parser::{Parser, Reader};
     use ply_rs_bw::ply::{DefaultElement, Property};
-    let file = open_check(path)?;
+    let bytes = read_mesh(path)?;
     let parse = |message: String| GeometryError::Parse {
         path: path.to_path_buf(),
         format: "PLY",
         message,
     };
-    let mut reader = std::io::BufReader::new(file);
+    // A byte-order mark before the "ply" magic line (as some editors write) is skipped.
+    let mut reader = Reader::new(bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes));
     let parser = Parser::<DefaultElement>::new();
-    let ply = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        parser.read_ply(&mut reader)
+    let failed = |_| parse("the PLY parser failed on malformed input".into());
+    let header = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        parser.read_header(&mut reader)
     }))
-    .map_err(|_| parse("the PLY parser failed on malformed input".into()))?
+    .map_err(failed)?
     .map_err(|e| parse(one_paragraph(&e.to_string())))?;
+    let payload_bytes = reader.get_ref().len();
+    let elements =
+        (header.elements.iter()).fold(0u64, |n, (_, e)| n.saturating_add(e.count as u64));
+    check_memory(
+        path,
+        &format!(
+            "loading the {elements} elements its header declares (in a file of {} bytes)",
+            bytes.len()
+        ),
+        ply_memory(&header, payload_bytes),
+    )?;
+    let payload = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        parser.read_payload(&mut reader, &header)
+    }))
+    .map_err(failed)?
+    .map_err(|e| parse(one_paragraph(&e.to_string())))?;
+    let ply = ply_rs_bw::ply::Ply::<DefaultElement> { header, payload };
 
     let vertices = ply
         .payload

@@ -65,6 +65,18 @@ pub enum GeometryError {
         #[source]
         source: std::io::Error,
     },
+    /// Loading the mesh would need more memory than is available.
+    #[error("mesh file '{}' is too large to load: {message}.", path.display())]
+    TooLarge { path: PathBuf, message: String },
+    /// A material library named by an OBJ file's `mtllib` exists but cannot be read (a FIFO, a
+    /// device, a directory, too large, not permitted).
+    #[error("cannot read material library '{}' named by mesh file '{}': {source}.", mtl.display(), path.display())]
+    Material {
+        path: PathBuf,
+        mtl: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
     /// The file exists but its contents could not be parsed (corrupt, truncated, non-numeric...).
     #[error("mesh file '{}' is corrupt, truncated or not a valid {format} file: {message}.", path.display())]
     Parse {

@@ -69,8 +69,13 @@ impl<'a> Tokens<'a> {
             None => Err(self.err(line, field, format!("{v} is not one of {allowed:?}"))),
         }
     }
+    /// Room for `n` values, but no more than the file has left: a corrupt count then ends in
+    /// "unexpected end of file", not in a large allocation.
+    fn capacity(&self, n: usize) -> usize {
+        n.min(self.toks.len().saturating_sub(self.pos))
+    }
     fn angles(&mut self, n: usize, what: &str) -> Result<Vec<(usize, f64)>, ParseError> {
-        let mut out: Vec<(usize, f64)> = Vec::with_capacity(n);
+        let mut out: Vec<(usize, f64)> = Vec::with_capacity(self.capacity(n));
         for k in 0..n {
             let field = format!("{what} angle {}", k + 1);
             let (line, v) = self.num(&field)?;
@@ -179,7 +184,7 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
             t.int_in("lamp-to-luminaire geometry", &[1, 2, 3])?;
             let (_, n) = t.count("number of tilt angles")?;
             let angles = t.angles(n, "tilt")?;
-            let mut factors = Vec::with_capacity(n);
+            let mut factors = Vec::with_capacity(t.capacity(n));
             for k in 0..n {
                 let field = format!("tilt multiplying factor {}", k + 1);
                 let (line, v) = t.num(&field)?;
@@ -308,7 +313,7 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
     let scale = multiplier * ballast * blpf * tilt_factor;
     let mut candela = Vec::with_capacity(nh);
     for (i, &(_, h)) in horiz.iter().enumerate() {
-        let mut row = Vec::with_capacity(nv);
+        let mut row = Vec::with_capacity(t.capacity(nv));
         for (j, &(_, v)) in vert.iter().enumerate() {
             let field = format!(
                 "candela value {} of horizontal angle {} ({h}°), vertical angle {v}°",

@@ -106,10 +106,17 @@ pub struct Photometry {
     pub size_m: [f64; 3],
 }
 
+/// Largest photometric file read, in bytes. Real IES and EULUMDAT files are kilobytes to a few
+/// megabytes; the parsers hold about 24 bytes per number of the file, so this bounds their
+/// memory to under a gigabyte.
+pub const MAX_FILE_BYTES: u64 = 32 << 20;
+
 /// Read a photometric file; the format is chosen by the extension (`.ldt` → EULUMDAT,
-/// anything else → IES). Bytes that are not UTF-8 are read as Latin-1.
+/// anything else → IES). Bytes that are not UTF-8 are read as Latin-1; a UTF-8 byte-order mark
+/// is skipped. A file over [`MAX_FILE_BYTES`], a FIFO, a device or a directory is refused
+/// before it is read.
 pub fn load(path: &Path) -> Result<Photometry, LoadError> {
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+    let bytes = crate::limits::read_file(path, MAX_FILE_BYTES).map_err(|source| LoadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -125,10 +132,12 @@ pub fn load(path: &Path) -> Result<Photometry, LoadError> {
     })
 }
 
-/// UTF-8 if valid, otherwise Latin-1 (each byte one code point).
+/// UTF-8 if valid, otherwise Latin-1 (each byte one code point); a leading UTF-8 byte-order
+/// mark is dropped either way.
 pub fn decode(bytes: &[u8]) -> String {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     match std::str::from_utf8(bytes) {
-        Ok(s) => s.strip_prefix('\u{feff}').unwrap_or(s).to_string(),
+        Ok(s) => s.to_string(),
         Err(_) => bytes.iter().map(|&b| b as char).collect(),
     }
 }

@@ -249,22 +249,31 @@ pub fn write_exr(path: &Path, layers: &Layers) -> Result<(), OutputError> {
     write_atomic(path, |w| w.write_all(&bytes))
 }
 
+/// Largest EXR file read at all; below it, the memory available decides.
+const MAX_EXR_FILE_BYTES: u64 = 1 << 40;
+
 /// Reads an OpenEXR file into [`Layers`]: the largest resolution level of every channel
 /// (f16 and u32 samples are converted to f32) and every text header attribute.
 ///
 /// A multi-part file is flattened: channels of a named part are called `part.channel`. All
 /// parts must have the same size. A corrupt or truncated file gives
 /// [`OutputError::Exr`] or [`OutputError::Io`] naming the file; the decoder is additionally
-/// guarded against panics.
+/// guarded against panics. The file is read through [`crate::limits::read_file`] (a FIFO, a
+/// device or a directory is refused unread), and the header is read first: an image whose
+/// decoded samples would not fit in the memory available, or could not fit in the file at any
+/// compression, is refused before decoding, as [`OutputError::InvalidImage`] naming its size
+/// (the decoder allocates the whole image from the header alone).
 pub fn read_exr(path: &Path) -> Result<Layers, OutputError> {
     let exr_err = |message: String| OutputError::Exr {
         path: path.to_path_buf(),
         message,
     };
-    let bytes = std::fs::read(path).map_err(|source| OutputError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes =
+        crate::limits::read_file(path, MAX_EXR_FILE_BYTES).map_err(|source| OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    check_decoded_size(path, &bytes)?;
     let decoded = std::panic::catch_unwind(|| {
         read()
             .no_deep_data()
@@ -328,4 +337,56 @@ pub fn read_exr(path: &Path) -> Result<Layers, OutputError> {
     }
     out.attributes.sort();
     Ok(out)
+}
+
+/// Most bytes of samples one byte of an OpenEXR file can expand to: deflate (ZIP, PXR24) packs
+/// at most 1032 bytes into one, PXR24 then widens 24-bit floats to 32 bits (1376), and RLE,
+/// PIZ and B44 pack less. A header that promises more than this times the file's size
+/// describes pixels the file cannot hold.
+const MAX_EXPANSION: u64 = 2048;
+
+/// Refuses, from the header alone, an image whose samples would exceed the memory available
+/// (every channel of every part at its largest size, as the decoder stores it plus the f32 copy
+/// [`read_exr`] returns), or more than the file could hold at any compression
+/// ([`MAX_EXPANSION`]). A header that cannot be read is left to the decoder to report.
+fn check_decoded_size(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    let meta = std::panic::catch_unwind(|| {
+        exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+    });
+    let Ok(Ok(meta)) = meta else {
+        return Ok(());
+    };
+    let Some(first) = meta.headers.first() else {
+        return Ok(());
+    };
+    let (mut stored, mut need, mut samples) = (0u64, 0u64, 0u64);
+    for header in meta.headers.iter() {
+        let (w, h) = (header.layer_size.width(), header.layer_size.height());
+        for channel in header.channels.list.iter() {
+            let n =
+                (w / channel.sampling.x().max(1)) as u64 * (h / channel.sampling.y().max(1)) as u64;
+            let bytes_per_sample = channel.sample_type.bytes_per_sample() as u64;
+            samples = samples.saturating_add(n);
+            stored = stored.saturating_add(n.saturating_mul(bytes_per_sample));
+            need = need.saturating_add(n.saturating_mul(bytes_per_sample + 4));
+        }
+    }
+    let what = format!(
+        "the image ({}×{} pixels, {} part(s), {samples} samples in all)",
+        first.layer_size.width(),
+        first.layer_size.height(),
+        meta.headers.len()
+    );
+    let refuse = |reason: String| OutputError::InvalidImage {
+        path: path.to_path_buf(),
+        reason,
+    };
+    crate::limits::check_memory(need, &format!("decoding {what}")).map_err(refuse)?;
+    let len = bytes.len() as u64;
+    if stored > len.saturating_mul(MAX_EXPANSION) {
+        return Err(refuse(format!(
+            "the header describes {what}, {stored} bytes of samples, more than any OpenEXR compression fits in this file of {len} bytes: the file is truncated or corrupt"
+        )));
+    }
+    Ok(())
 }

@@ -12,11 +12,15 @@ pub use crate::description::context::SceneError;
 pub use crate::description::schema::SceneFile;
 pub use build::{build, build_for, load_world, load_world_for, Overrides, RunMode};
 
-/// Parse a scene file (syntax, types and unknown fields; values are checked by [`build`]).
+/// Parse a scene file (syntax, types and unknown fields; values are checked by [`build`]). The
+/// file is read through [`crate::limits::read_text`]: at most [`crate::limits::MAX_TEXT_BYTES`]
+/// of UTF-8, and never a FIFO, device or directory.
 pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
+    let text = crate::limits::read_text(path, crate::limits::MAX_TEXT_BYTES).map_err(|source| {
+        SceneError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
     })?;
     parse(&text, path)
 }
