@@ -6,6 +6,9 @@
 //! geometry_bvh_hostile -- --ignored --nocapture big_hostile_meshes`; `measure` builds any of
 //! the meshes at any size (`HOSTILE=fan:100000,coincident:30000`, see its kinds).
 
+#[path = "../src/cli/bench/generate.rs"]
+#[allow(dead_code)]
+mod generate;
 #[path = "../src/cli/bench/rng.rs"]
 #[allow(dead_code)]
 mod rng;
@@ -330,6 +333,8 @@ fn measure() {
             "cylinder" => cylinder(n),
             "hedgehog" => hedgehog(n, 1),
             "dup" => duplicated_grid(n as u32, 3),
+            // An ordinary mesh for comparison: a bumpy sphere of about n triangles.
+            "bumpy" => generate::bumpy_sphere(((n as f64 / 12.0).sqrt().ceil() as u32).max(1)),
             _ => panic!("unknown kind {kind}"),
         };
         let t = Instant::now();

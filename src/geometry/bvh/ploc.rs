@@ -24,6 +24,10 @@ const SEARCH_DEPTH_THRESHOLD: usize = 3;
 /// Most passes allowed: ordinary inputs need a few dozen (each pass merges a large fraction of
 /// the clusters), so this is only reached by inputs with chains of nearest neighbours.
 const MAX_PASSES: usize = 192;
+/// A pass over this many clusters or more that merges fewer than 1 in [`MIN_MERGE_RATIO`] of
+/// them gives up: ordinary inputs merge 1 in 5 to 1 in 9 per pass, chains 1 in 30 or fewer.
+const CHECK_MERGES_FROM: usize = 4096;
+const MIN_MERGE_RATIO: usize = 32;
 /// Most clusters visited over all passes: per primitive (ordinary inputs visit about 3), plus
 /// a few thousand so that small inputs with a short chain or two keep PLOC's tree.
 const MAX_WORK_PER_PRIM: usize = 8;
@@ -39,8 +43,8 @@ struct Morton64 {
 }
 
 /// The BVH2 obvhs's `PlocBuilder::build` gives for `aabbs` (primitive indices 0..n), or `None`
-/// if it would take more than [`MAX_PASSES`] passes or visit more than [`MAX_WORK_PER_PRIM`]
-/// clusters per primitive in all.
+/// if a large pass merges too few clusters, or it would take more than [`MAX_PASSES`] passes or
+/// visit more than [`MAX_WORK_PER_PRIM`] clusters per primitive in all.
 pub(super) fn build(aabbs: &[Aabb]) -> Option<Bvh2> {
     let n = aabbs.len();
     let mut bvh = Bvh2 {
@@ -151,6 +155,9 @@ pub(super) fn build(aabbs: &[Aabb]) -> Option<Bvh2> {
             bvh.nodes[insert + 1] = right;
             next[kept] = Bvh2Node::new(left.aabb().union(right.aabb()), 0, insert as u32);
             kept += 1;
+        }
+        if count >= CHECK_MERGES_FROM && (count - kept) * MIN_MERGE_RATIO < count {
+            return None;
         }
         std::mem::swap(&mut current, &mut next);
         count = kept;
