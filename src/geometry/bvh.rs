@@ -1,22 +1,38 @@
 //! Building the scene BVH: primitives from the shapes (validated, zero-area triangles
-//! dropped), their padded bounds, the obvhs CWBVH (8-wide, compressed nodes) over them with
-//! empty child slots made unhittable and its depth checked, and the primitives laid out in
-//! leaf order.
+//! dropped), their padded bounds, a binary BVH over them (obvhs's PLOC and reinsertion for
+//! ordinary inputs; a top-down SAH build of bounded height for the inputs PLOC handles badly),
+//! obvhs's CWBVH (8-wide, compressed nodes) from it with empty child slots made unhittable, and
+//! the primitives laid out in leaf order.
+//!
+//! Any set of valid primitives builds in O(n log n)-ish time into a tree at most
+//! [`MAX_DEPTH`] − 1 levels deep: PLOC gives up on inputs that would make it quadratic
+//! (`ploc`), and a tree too deep after reinsertion is built top-down instead (`sah`).
+
+mod ploc;
+mod sah;
 
 use super::prim::Prim;
 use super::robust::gamma;
 use super::{GeometryError, SceneGeometry, Shape};
 use glam::Vec3;
 use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
 use obvhs::cwbvh::CwBvh;
-use obvhs::BvhBuildParams;
 
 /// Largest distance from the origin (m, per axis) of any primitive's bounds: beyond it the
 /// BVH builder's f32 surface-area costs overflow (7 astronomical units: room for a sun).
 pub const MAX_COORDINATE: f32 = 1e12;
 
-/// Maximum supported BVH depth.
+/// Bound on the depth of the CWBVH (node levels), which sizes the traversal stack. The binary
+/// tree it is made from is kept below it, and no CWBVH is deeper than its binary tree.
 pub(super) const MAX_DEPTH: usize = 64;
+
+/// Most levels of the binary tree.
+const MAX_BVH2_HEIGHT: u32 = MAX_DEPTH as u32 - 1;
+
+/// obvhs's `BvhBuildParams::medium_build()` values for the steps after PLOC.
+const REINSERTION_BATCH_RATIO: f32 = 0.05;
+const MAX_PRIMS_PER_LEAF: u32 = 3;
 
 /// Depth of a CWBVH (1 for a single root node; 0 if empty).
 pub(super) fn cwbvh_depth(bvh: &CwBvh) -> u32 {
@@ -33,6 +49,40 @@ pub(super) fn cwbvh_depth(bvh: &CwBvh) -> u32 {
         }
     }
     max
+}
+
+/// Height of a binary tree (1 for a single leaf), or `None` once it exceeds `limit`.
+fn bvh2_height(bvh: &Bvh2, limit: u32) -> Option<u32> {
+    let mut max = 0;
+    let mut stack = vec![(0u32, 1u32)];
+    while let Some((n, d)) = stack.pop() {
+        if d > limit {
+            return None;
+        }
+        max = max.max(d);
+        let node = &bvh.nodes[n as usize];
+        if node.prim_count == 0 {
+            stack.push((node.first_index, d + 1));
+            stack.push((node.first_index + 1, d + 1));
+        }
+    }
+    Some(max)
+}
+
+/// The binary tree over `aabbs` (not empty): obvhs's PLOC and reinsertion where PLOC finishes
+/// in reasonable time and the result is not too deep, else the top-down build.
+fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
+    if let Some(mut bvh2) = ploc::build(aabbs) {
+        obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
+            &mut bvh2,
+            REINSERTION_BATCH_RATIO,
+            None,
+        );
+        if bvh2_height(&bvh2, MAX_BVH2_HEIGHT).is_some() {
+            return bvh2;
+        }
+    }
+    sah::build(aabbs, MAX_BVH2_HEIGHT)
 }
 
 fn invalid(shape: &Shape, object: u32, message: impl Into<String>) -> GeometryError {
@@ -57,16 +107,6 @@ impl SceneGeometry {
     /// vertex-normal count different from the vertex count) give an error naming the object.
     /// An empty scene is allowed (every ray misses).
     pub fn build(shapes: &[(Shape, u32)]) -> Result<SceneGeometry, GeometryError> {
-        Self::build_with_params(shapes, BvhBuildParams::medium_build())
-    }
-
-    /// [`SceneGeometry::build`] with explicit obvhs build parameters (spatial pre-splits are
-    /// always disabled).
-    pub fn build_with_params(
-        shapes: &[(Shape, u32)],
-        mut params: BvhBuildParams,
-    ) -> Result<SceneGeometry, GeometryError> {
-        params.pre_split = false;
         let mut prims: Vec<Prim> = Vec::new();
         let mut objects: Vec<u32> = Vec::new();
         let mut prim_normals: Vec<[u32; 3]> = Vec::new();
@@ -231,24 +271,9 @@ impl SceneGeometry {
         let mut bvh = if prims.is_empty() {
             CwBvh::default()
         } else {
-            // Same steps as `obvhs::cwbvh::builder::build_cwbvh`, minus its debug-build
-            // validation, which asserts a depth < 32 that degenerate scenes can exceed (we
-            // check the depth ourselves below).
-            let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(aabbs.len()).build(
-                params.ploc_search_distance,
-                &aabbs,
-                (0..aabbs.len() as u32).collect(),
-                params.sort_precision,
-                params.search_depth_threshold,
-            );
-            obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
-                &mut bvh2,
-                params.reinsertion_batch_ratio,
-                None,
-            );
             obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
-                &bvh2,
-                params.max_prims_per_leaf.clamp(1, 3),
+                &build_bvh2(&aabbs),
+                MAX_PRIMS_PER_LEAF,
                 true,
                 false,
             )
@@ -268,15 +293,16 @@ impl SceneGeometry {
                 }
             }
         }
-        // Our traversal stack holds MAX_DEPTH entries; refuse a pathological BVH deeper than that.
+        // The traversal stack's bound, which the binary tree's height already guarantees.
         let depth = cwbvh_depth(&bvh);
         if depth as usize >= MAX_DEPTH {
             return Err(GeometryError::InvalidShape {
                 shape: "scene",
                 object: 0,
                 message: format!(
-                    "the BVH over {} primitives is {depth} levels deep (at most 63 supported); the scene is probably degenerate (e.g. millions of coincident primitives)",
-                    prims.len()
+                    "internal error: the BVH over {} primitives is {depth} levels deep (at most {} supported)",
+                    prims.len(),
+                    MAX_DEPTH - 1
                 ),
             });
         }

@@ -7,8 +7,8 @@
 //! direction components below `f32::EPSILON` by ±1/ε, which can cull valid boxes for nearly
 //! axis-parallel rays; and its traversal stack (32 entries) is not bounds-checked in release
 //! builds. We therefore keep obvhs as the builder and node layout but traverse its nodes with
-//! our own loop ([`traverse`]: a distance-ordered stack whose size the build's depth check
-//! bounds) and our own node test ([`node_test`]): entry clamped to 0, exact reciprocal
+//! our own loop ([`traverse`]: a distance-ordered stack sized for the depth the build
+//! guarantees) and our own node test ([`node_test`]): entry clamped to 0, exact reciprocal
 //! directions, and per-node conservative padding of the slab distances by their
 //! floating-point error bound, so no box containing a valid hit is ever culled.
 
@@ -140,8 +140,8 @@ fn node_test(node: &CwBvhNode, r: &NodeRay, t_max: f32, tmin_out: &mut [f32; 8])
             _mm256_min_ps(tfz, _mm256_set1_ps(t_max)),
         );
         _mm256_storeu_ps(tmin_out.as_mut_ptr(), tmin);
-        // Empty slots have inverted boxes (see `SceneGeometry::build_with_params`), and should
-        // one still pass it decodes as an empty leaf.
+        // Empty slots have inverted boxes (see `SceneGeometry::build`), and should one still
+        // pass it decodes as an empty leaf.
         _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax)) as u32
     }
 
@@ -280,8 +280,8 @@ pub(super) fn traverse<const ORDERED: bool>(
     macro_rules! push {
         ($k:expr) => {{
             debug_assert!(sp < STACK_SIZE);
-            // SAFETY: at most 7 entries are pushed per level and the build rejects BVHs
-            // deeper than MAX_DEPTH.
+            // SAFETY: at most 7 entries are pushed per level, and the build makes no BVH
+            // deeper than MAX_DEPTH − 1 (and checks it).
             unsafe { stack.get_unchecked_mut(sp).write($k) };
             sp += 1;
         }};
