@@ -24,6 +24,9 @@ use std::time::Instant;
 
 const CORNELL: &str = include_str!("../../scenes/cornell-box.ron");
 
+/// Image size of the default benchmark's mesh scene.
+const MESH_SCENE_RESOLUTION: u32 = 256;
+
 /// Options of `candela bench`.
 #[derive(clap::Args, Debug, Clone)]
 #[command(args_conflicts_with_subcommands = true)]
@@ -52,21 +55,61 @@ pub enum BenchMode {
 
 pub use candela::job::check_threads;
 
-/// Largest triangle count of a generated benchmark mesh (about 10 GB of mesh and BVH).
-pub const MAX_TRIANGLES: usize = 100_000_000;
+/// Largest triangle count of a generated benchmark mesh: its peak memory,
+/// [`BYTES_PER_TRIANGLE`] a triangle, is then about 17 GiB.
+pub const MAX_TRIANGLES: usize = 50_000_000;
+
+/// Peak memory per triangle while a generated benchmark mesh and its BVH are built (the BVH
+/// builder's working memory; the finished geometry keeps about 53 bytes a triangle). Measured
+/// peak RSS: 337 bytes a triangle between 1 M and 4 M triangles, in all three modes.
+pub const BYTES_PER_TRIANGLE: u64 = 360;
+
+/// Peak memory per primary ray of `bench traversal` (RES² of them): the primary, diffuse and
+/// shadow batches while they are generated, or the batches and their bytes while they are
+/// exported. Measured peak RSS: 148 bytes a ray at 4096², 1 M triangles.
+pub const BYTES_PER_RAY: u64 = 200;
+
+/// Memory of a benchmark beyond its mesh, BVH and rays (measured: about 50 MB).
+const BASE_BYTES: u64 = 64 << 20;
+
+/// Refuses a benchmark that would need more than the memory available: `bytes` (its mesh,
+/// BVH, rays and images) for `what`, which names the options that asked for it.
+pub fn check_memory_for(what: &str, bytes: u64) -> anyhow::Result<()> {
+    candela::limits::check_memory(bytes.saturating_add(BASE_BYTES), what)
+        .map_err(anyhow::Error::msg)
+}
+
+/// Peak memory of generating `triangles` triangles and building their BVH.
+pub fn mesh_bytes(triangles: usize) -> u64 {
+    (triangles as u64).saturating_mul(BYTES_PER_TRIANGLE)
+}
+
+/// What `flag N` asks for, for [`check_memory_for`]'s message.
+pub fn mesh_what(flag: &str, triangles: usize) -> String {
+    format!(
+        "{flag} {triangles} (the generated mesh and its BVH, about {BYTES_PER_TRIANGLE} bytes a triangle)"
+    )
+}
+
+/// Peak memory of a render of `resolution`² pixels (the film and its pass buffers).
+pub fn render_bytes(resolution: u32) -> u64 {
+    let per_pixel =
+        candela::scene::build::bytes_per_pixel(&candela::scene::RunMode::default(), false);
+    (resolution as u64).pow(2) * per_pixel
+}
 
 /// Refuses a triangle count (of option `flag`) above [`MAX_TRIANGLES`].
 pub fn check_triangles(flag: &str, n: usize) -> anyhow::Result<()> {
     if n > MAX_TRIANGLES {
         return Err(super::usage(format!(
-            "{flag} {n} is too many: at most {MAX_TRIANGLES} triangles are generated (each needs about 100 bytes of mesh and BVH)"
+            "{flag} {n} is too many: at most {MAX_TRIANGLES} triangles are generated (building them needs about {BYTES_PER_TRIANGLE} bytes a triangle)"
         )));
     }
     Ok(())
 }
 
 /// Largest `--resolution` of the generated benchmarks (`bench traversal` holds RES² rays per
-/// batch).
+/// batch, [`BYTES_PER_RAY`] a primary ray: about 12.5 GiB at the largest).
 pub const MAX_RESOLUTION: u32 = 8192;
 
 /// Refuses a `--resolution` of 0 or above [`MAX_RESOLUTION`].
@@ -106,6 +149,10 @@ pub fn main(args: &BenchArgs) -> anyhow::Result<()> {
         }
         check_positive("--spp", args.spp.into())?;
         check_triangles("--triangles", args.triangles)?;
+        check_memory_for(
+            &mesh_what("--triangles", args.triangles),
+            mesh_bytes(args.triangles) + render_bytes(MESH_SCENE_RESOLUTION),
+        )?;
     }
     match &args.mode {
         None => run(args.threads, args.spp, args.triangles),
@@ -223,7 +270,7 @@ pub fn run(threads: Option<usize>, spp: u32, triangles: usize) -> anyhow::Result
     let t0 = Instant::now();
     let mesh = generate::bumpy_sphere(subdivisions_for(triangles));
     let n_tris = mesh.indices.len();
-    let scene = mesh_scene(mesh, spp, 256);
+    let scene = mesh_scene(mesh, spp, MESH_SCENE_RESOLUTION);
     let world = scene::build(&scene, Path::new("<generated>"), &overrides)?;
     drop(scene);
     println!(

@@ -13,10 +13,12 @@ use image::{Rgb, RgbImage};
 
 use super::falsecolour::{describe_scale, ColourScale, FalsecolourSettings, Legend};
 use super::units::{format_sig, UnitSystem};
+use crate::limits::{check_memory, printable};
 use crate::output::draw::{self, BLACK, DARK_GREY, WHITE};
 use crate::output::write_rgb_png;
 use crate::output::OutputError;
 use crate::photometry::Quantity;
+use crate::world::measure::{MAX_GRID_EDGE_POINTS, MAX_GRID_NAME_CHARS, MAX_GRID_POINTS};
 
 /// The values of one calculation grid, as the report JSON holds them.
 #[derive(Clone, Debug, PartialEq)]
@@ -87,14 +89,54 @@ const PAD: u32 = 16;
 const TITLE_PX: f32 = 20.0;
 const LABEL_PX: f32 = 14.0;
 
-fn validate(grid: &GridValues) -> Result<(), String> {
-    let n = grid.nx.checked_mul(grid.ny).unwrap_or(0);
-    if grid.nx == 0 || grid.ny == 0 || n > 1_000_000 {
+/// Side of the square the grid's cells are drawn in, at most, pixels.
+const MAX_GRID_PX: u32 = MAX_GRID_EDGE_POINTS;
+
+/// Largest heat map image, pixels: the cells' square with room for the title, axes and
+/// legend. It bounds the memory of any heat map (3 bytes a pixel, about 80 MB).
+pub const MAX_HEATMAP_PIXELS: u64 = (MAX_GRID_PX as u64 + 1600) * (MAX_GRID_PX as u64 + 600);
+
+/// Side of one cell in pixels: 28 to 96, so the value fits in it, unless the grid would then
+/// be wider or taller than [`MAX_GRID_PX`]; then as large as fits (at least 1).
+fn cell_px(nx: usize, ny: usize) -> u32 {
+    let (nx, ny) = (nx.max(1) as u32, ny.max(1) as u32);
+    let readable = (840 / nx).min(640 / ny).clamp(28, 96);
+    readable.min(MAX_GRID_PX / nx.max(ny)).max(1)
+}
+
+/// Refuses a grid whose heat map cannot be drawn: more than [`MAX_GRID_EDGE_POINTS`] points
+/// along an edge or [`MAX_GRID_POINTS`] in all, or a heat map that does not fit in the memory
+/// available. Cheap: the job calls it for every grid of the scene before rendering.
+pub fn check_heatmap(name: &str, nx: usize, ny: usize) -> Result<(), String> {
+    let shown = printable(name, 40);
+    let n = nx.saturating_mul(ny);
+    if nx == 0 || ny == 0 || n as u64 > MAX_GRID_POINTS {
         return Err(format!(
-            "grid '{}' has {}×{} points (need at least 1×1, at most 10⁶)",
-            grid.name, grid.nx, grid.ny
+            "grid {shown:?} has {nx}×{ny} points (need at least 1×1, at most {MAX_GRID_POINTS})"
         ));
     }
+    if nx.max(ny) > MAX_GRID_EDGE_POINTS as usize {
+        return Err(format!(
+            "grid {shown:?} has {nx}×{ny} points: its heat map draws at most {MAX_GRID_EDGE_POINTS} points along an edge"
+        ));
+    }
+    // The image, and per point its value in display units and the range's sorted copies.
+    check_memory(
+        MAX_HEATMAP_PIXELS * 3 + n as u64 * 24,
+        &format!("the heat map of grid {shown:?}"),
+    )
+}
+
+/// [`check_heatmap`] for every grid of a scene, before it is rendered.
+pub fn check_heatmaps(grids: &[crate::world::measure::Grid]) -> Result<(), String> {
+    grids
+        .iter()
+        .try_for_each(|g| check_heatmap(&g.name, g.nx as usize, g.ny as usize))
+}
+
+fn validate(grid: &GridValues) -> Result<(), String> {
+    check_heatmap(&grid.name, grid.nx, grid.ny)?;
+    let n = grid.nx * grid.ny;
     if grid.values.len() != n {
         return Err(format!(
             "grid '{}' has {} values, expected {}×{} = {n}",
@@ -152,12 +194,15 @@ pub fn render_grid_heatmap(
     let stats = stats_si.in_units(units);
 
     let (nx, ny) = (grid.nx, grid.ny);
-    let cell = (840 / nx as u32).min(640 / ny as u32).clamp(28, 96);
+    let cell = cell_px(nx, ny);
     let value_px = (cell as f32 * 0.30).min(16.0);
 
     let ratio = |r: Option<f64>| r.map_or("–".to_string(), |r| format!("{r:.2}"));
     let title_lines = vec![
-        format!("{} — illuminance ({unit})", grid.name),
+        format!(
+            "{} — illuminance ({unit})",
+            printable(&grid.name, MAX_GRID_NAME_CHARS)
+        ),
         format!(
             "Emin {}   Eavg {}   Emax {} {unit}   U₀ = Emin/Eavg = {}   Emin/Emax = {}",
             format_sig(stats.min, 4),
@@ -210,6 +255,16 @@ pub fn render_grid_heatmap(
     }
     width = width.max(2 * PAD + draw::text_width(TITLE_PX, &title_lines[0]));
     let height = header_h + body_h + footer_h;
+    if width as u64 * height as u64 > MAX_HEATMAP_PIXELS {
+        return Err(format!(
+            "the heat map of grid {:?} would be {width}×{height} pixels, more than the limit of {MAX_HEATMAP_PIXELS} pixels",
+            printable(&grid.name, 40)
+        ));
+    }
+    check_memory(
+        width as u64 * height as u64 * 3,
+        &format!("the heat map of grid {:?}", printable(&grid.name, 40)),
+    )?;
     let mut img = RgbImage::from_pixel(width, height, WHITE);
 
     // Title block.
@@ -239,7 +294,13 @@ pub fn render_grid_heatmap(
             let x0 = (gx + i as u32 * cell) as i32;
             let y0 = (gy + (ny - 1 - j) as u32 * cell) as i32;
             draw::fill_rect(&mut img, x0, y0, cell, cell, c);
-            draw::stroke_rect(&mut img, x0, y0, cell, cell, separator);
+            // Small cells (large grids) would be all separator.
+            if cell >= 8 {
+                draw::stroke_rect(&mut img, x0, y0, cell, cell, separator);
+            }
+            if value_px <= 7.0 {
+                continue; // no room for the value in the cells of a large grid
+            }
             let text = format_sig(v, 3);
             let mut px = value_px;
             while px > 7.0 && draw::text_width(px, &text) + 4 > cell {

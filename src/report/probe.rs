@@ -10,6 +10,7 @@ use super::units::UnitSystem;
 use crate::colour::models::{xyz_to_upvp, xyz_to_xy};
 use crate::colour::rgb::{srgb_encode, xyz_to_linear_srgb};
 use crate::colour::temperature::xyz_to_cct_ohno2013;
+use crate::limits::check_memory;
 use crate::output::{
     read_exr, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR, CHANNEL_X, CHANNEL_Y,
     CHANNEL_Y_STDERR, CHANNEL_Z, ILLUMINANCE_SENTINEL,
@@ -115,6 +116,16 @@ pub fn probe(
             .collect::<Vec<_>>()
             .join(", ")
     };
+    if let Some((name, c)) = layers
+        .channels
+        .iter()
+        .find(|(_, c)| Some(c.len()) != w.checked_mul(h))
+    {
+        return Err(format!(
+            "channel '{name}' has {} samples, expected {w}×{h}",
+            c.len()
+        ));
+    }
     let lum = layers.channel(CHANNEL_Y).ok_or_else(|| {
         format!(
             "no '{CHANNEL_Y}' (luminance) channel; the image has: {}",
@@ -137,14 +148,22 @@ pub fn probe(
         }
     }
 
-    // The probed pixels.
+    // The probed pixels: a radius beyond the image covers the image (and no more), and their
+    // indices must fit in memory.
     let mut idx = Vec::new();
     match radius {
         None => idx.push(y * w + x),
         Some(r) => {
-            let k = r.floor() as usize;
-            for j in y.saturating_sub(k)..=(y + k).min(h - 1) {
-                for i in x.saturating_sub(k)..=(x + k).min(w - 1) {
+            let k = (r.floor() as usize).min(w.max(h));
+            let (i0, i1) = (x.saturating_sub(k), (x.saturating_add(k)).min(w - 1));
+            let (j0, j1) = (y.saturating_sub(k), (y.saturating_add(k)).min(h - 1));
+            let most = (i1 - i0 + 1) as u64 * (j1 - j0 + 1) as u64;
+            check_memory(
+                most * 16,
+                &format!("a probe of radius {r} pixels in the {w}×{h} image"),
+            )?;
+            for j in j0..=j1 {
+                for i in i0..=i1 {
                     let (dx, dy) = (i as f64 - x as f64, j as f64 - y as f64);
                     if dx * dx + dy * dy <= r * r {
                         idx.push(j * w + i);

@@ -40,12 +40,14 @@ pub struct RunMode {
 
 const PIXEL_SUMS: u64 = std::mem::size_of::<crate::film::PixelSums>() as u64;
 
-/// Peak memory of a plain render per pixel: the tiles' pixel sums and the film (both alive while
-/// the film is assembled), a pass's light-path sums (48 B for each of up to two buffers), plus
-/// the image, EXR and PNG buffers (48 B). Measured peak RSS at 2048²: 1.58 GB (this: 1.61 GB).
+/// Peak memory of a plain render's own buffers per pixel: the tiles' pixel sums and the film
+/// (both alive while the film is assembled), a pass's light-path sums (48 B for each of up to
+/// two buffers), plus the image, EXR and PNG buffers (48 B). Measured peak RSS at 2048² of a
+/// render that writes no state: 1.58 GB (this: 1.61 GB).
 const BYTES_PER_PIXEL: u64 = 2 * PIXEL_SUMS + 2 * 48 + 48;
 
-/// Peak memory of a render per pixel in `mode`. Adaptive sampling adds the decision buffer (one
+/// Peak memory of a render's own buffers per pixel in `mode`, without the render state
+/// (see [`peak_bytes_per_pixel`] for the whole job). Adaptive sampling adds the decision buffer (one
 /// [`crate::film::PixelSums`] per pixel) and its per-pass statistics (16 B); its peak is then
 /// while the outputs are written, so the illuminance channels and false-colour maps add 32 B.
 /// Measured peak RSS at 2048² (GB): adaptive 2.20 (this: 2.18), adaptive with --illuminance
@@ -63,33 +65,85 @@ pub fn bytes_per_pixel(mode: &RunMode, illuminance: bool) -> u64 {
     }
 }
 
-/// Refuse a film of `w`×`h` pixels beyond [`MAX_PIXELS`] or the memory available to a render
-/// in `mode` (see [`bytes_per_pixel`]).
-fn check_film(
-    ctx: &Context,
-    w: u32,
-    h: u32,
-    mode: &RunMode,
-    illuminance: bool,
-) -> Result<(), SceneError> {
+/// Memory of a render besides its per-pixel buffers: the program, the scene, the threads and
+/// light tracing's batches of splats (measured: 50 to 130 MB).
+pub const RENDER_BASE_BYTES: u64 = 150 << 20;
+
+/// Bytes of a pixel in a pass's results (pixel index, its sums and those of its decision
+/// buffer), the largest per-pixel buffer of a pass.
+const PASS_PIXEL_BYTES: u64 =
+    8 + PIXEL_SUMS + std::mem::size_of::<Option<crate::film::PixelSums>>() as u64;
+
+/// A film buffer's pixel in a render state file (postcard: 9 f64 and 3 variable-length
+/// counts), with the slack of the growing encoding buffer.
+const STATE_PIXEL_BYTES: u64 = 90;
+
+/// Peak memory per pixel of a render as `candela render` runs it in `mode` (add
+/// [`RENDER_BASE_BYTES`] once). The larger of
+/// * the render's own buffers, [`bytes_per_pixel`], and
+/// * writing the render state, which the job does at every checkpoint (every 60 s by default)
+///   and at the end once a state exists: the film, the finished render's copy of it, the
+///   state's copy and its encoding, per film buffer (two with adaptive sampling);
+///
+/// and, with light-traced caustics, a pass's results (256 B): the allocator keeps their memory
+/// once they are freed, because light tracing's splat batches are allocated after them.
+/// Measured peak RSS with a checkpoint after every pass, minus [`RENDER_BASE_BYTES`] (B/pixel
+/// at 1024² / 2048², Cornell box without and Cornell boxes with glass; this estimate in
+/// brackets): plain 411 / 428 (450), plain with caustics 490–545 / 622–643 (706), adaptive
+/// 806 / 887 (900), adaptive with caustics 938–940 / 1082–1104 (1156). A render that writes
+/// no state peaks lower: 1.26 to 1.8 times below this at 2048².
+pub fn peak_bytes_per_pixel(mode: &RunMode, illuminance: bool, caustics: bool) -> u64 {
+    let buffers = if mode.adaptive { 2 } else { 1 };
+    let mut state = buffers * (3 * PIXEL_SUMS + STATE_PIXEL_BYTES);
+    if mode.adaptive && (illuminance || mode.falsecolour) {
+        state += 32;
+    }
+    let peak = bytes_per_pixel(mode, illuminance).max(state);
+    if caustics {
+        peak + PASS_PIXEL_BYTES
+    } else {
+        peak
+    }
+}
+
+/// Refuse a film of `w`×`h` pixels beyond [`MAX_PIXELS`].
+fn check_film_size(ctx: &Context, w: u32, h: u32) -> Result<(), SceneError> {
     if w as u64 * h as u64 > MAX_PIXELS {
         return Err(ctx.err(
             "camera.resolution",
             format!(
                 "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {:.0} GiB)",
-                w as f64 * h as f64 * BYTES_PER_PIXEL as f64 / (1u64 << 30) as f64
+                w as f64 * h as f64 * BYTES_PER_PIXEL as f64 / crate::limits::GIB
             ),
         ));
     }
-    let need = w as u64 * h as u64 * bytes_per_pixel(mode, illuminance);
+    Ok(())
+}
+
+/// Refuse a film of `w`×`h` pixels that a render in `mode` could not hold in the memory
+/// available (see [`peak_bytes_per_pixel`]).
+fn check_film_memory(
+    ctx: &Context,
+    (w, h): (u32, u32),
+    mode: &RunMode,
+    illuminance: bool,
+    caustics: bool,
+) -> Result<(), SceneError> {
+    let need =
+        w as u64 * h as u64 * peak_bytes_per_pixel(mode, illuminance, caustics) + RENDER_BASE_BYTES;
     if let Some(avail) = crate::limits::available_memory_bytes() {
         if need > avail {
+            let traced = if caustics {
+                ", with light-traced caustics"
+            } else {
+                ""
+            };
             return Err(ctx.err(
                 "camera.resolution",
                 format!(
-                    "{w}×{h} pixels need about {:.1} GiB of memory but only {:.1} GiB is available",
-                    need as f64 / (1u64 << 30) as f64,
-                    avail as f64 / (1u64 << 30) as f64
+                    "{w}×{h} pixels need about {:.1} GiB of memory{traced} but only {:.1} GiB is available",
+                    need as f64 / crate::limits::GIB,
+                    avail as f64 / crate::limits::GIB
                 ),
             ));
         }
@@ -139,9 +193,7 @@ pub fn build_for(
 
     // Camera, and the film its resolution asks for.
     let illuminance = scene.render.illuminance || overrides.illuminance;
-    let camera = Camera::build(&ctx, &scene.camera, |w, h| {
-        check_film(&ctx, w, h, mode, illuminance)
-    })?;
+    let camera = Camera::build(&ctx, &scene.camera, |w, h| check_film_size(&ctx, w, h))?;
 
     // Render settings.
     let r = &scene.render;
@@ -242,6 +294,24 @@ pub fn build_for(
         })
         .filter_map(|(shape, _)| crate::world::caustic_lights::bounding_sphere(shape))
         .collect();
+    // The film's memory, before the BVH is built: light tracing (when anything can start and
+    // aim its paths) keeps more per pixel.
+    let caustics = settings.caustics == crate::world::Caustics::LightTracing
+        && crate::world::caustic_lights::may_trace(
+            &caustic_targets,
+            !pending_area.is_empty(),
+            scene
+                .lights
+                .iter()
+                .any(|l| !matches!(l, LightDesc::Environment { .. })),
+        );
+    check_film_memory(
+        &ctx,
+        (camera.width as u32, camera.height as u32),
+        mode,
+        illuminance,
+        caustics,
+    )?;
     let geometry = SceneGeometry::build(&shapes).map_err(|e| {
         let field = match &e {
             geometry::GeometryError::InvalidShape { object, .. } => scene

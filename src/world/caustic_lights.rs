@@ -68,6 +68,18 @@ fn sphere_of_box(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
     (c, 0.5 * (hi - lo).length() * (1.0 + 1e-4) + 1e-6)
 }
 
+/// Whether light tracing may have work in a scene, judged before its lights are built (for the
+/// memory guard, which then counts light tracing's buffers): some object can scatter
+/// specularly (`targets`, the bounding spheres [`CausticLights::new`] gets) and some light
+/// other than an environment exists (an emitting object, `area_lights`, or another light).
+/// [`CausticLights::new`] then returns `Some` unless every such light has no power.
+pub fn may_trace(targets: &[(Vec3, f32)], area_lights: bool, other_lights: bool) -> bool {
+    targets
+        .iter()
+        .any(|(c, r)| c.is_finite() && r.is_finite() && *r > 0.0)
+        && (area_lights || other_lights)
+}
+
 impl CausticLights {
     /// `targets`: bounding spheres of the objects whose material has a delta lobe. None when
     /// light tracing has nothing to do: no such object, or no light other than an environment with

@@ -56,6 +56,18 @@ impl Grid {
     }
 }
 
+/// Most points of one grid.
+pub const MAX_GRID_POINTS: u64 = 1_000_000;
+
+/// Most points along one edge of a grid: its heat map draws each point as a cell of at least
+/// one pixel, in a square of at most [`MAX_GRID_EDGE_POINTS`] pixels a side, so the image
+/// stays under about 80 MB whatever the grid.
+pub const MAX_GRID_EDGE_POINTS: u32 = 4096;
+
+/// Longest grid name, in characters: it becomes part of two file names (file systems take
+/// 255 bytes) and the heat map's title.
+pub const MAX_GRID_NAME_CHARS: usize = 100;
+
 /// Sample budget of meters.
 #[derive(Clone, Debug)]
 pub struct MeasureSettings {
@@ -163,10 +175,33 @@ impl Grid {
         grid_files: &mut HashMap<PathBuf, (usize, String)>,
     ) -> Result<Grid, SceneError> {
         let field = format!("grids[{i}]");
-        if g.nx == 0 || g.ny == 0 || g.nx as u64 * g.ny as u64 > 1_000_000 {
+        let shown = crate::limits::printable(&g.name, 40);
+        if g.nx == 0 || g.ny == 0 || g.nx as u64 * g.ny as u64 > MAX_GRID_POINTS {
             return Err(ctx.err(
                 format!("{field}.nx"),
-                format!("a grid needs 1 to 1 000 000 points, got {}×{}", g.nx, g.ny),
+                format!(
+                    "grid {shown:?}: a grid needs 1 to {MAX_GRID_POINTS} points, got {}×{}",
+                    g.nx, g.ny
+                ),
+            ));
+        }
+        for (axis, n) in [("nx", g.nx), ("ny", g.ny)] {
+            if n > MAX_GRID_EDGE_POINTS {
+                return Err(ctx.err(
+                    format!("{field}.{axis}"),
+                    format!(
+                        "grid {shown:?} has {n} points along one edge, more than the limit of {MAX_GRID_EDGE_POINTS} (its heat map draws every point as a cell of at least one pixel)"
+                    ),
+                ));
+            }
+        }
+        if g.name.chars().count() > MAX_GRID_NAME_CHARS {
+            return Err(ctx.err(
+                format!("{field}.name"),
+                format!(
+                    "the grid name {shown:?} has {} characters, more than the limit of {MAX_GRID_NAME_CHARS} (it names the grid's CSV and heat map files)",
+                    g.name.chars().count()
+                ),
             ));
         }
         let eu = ctx.vec3(&format!("{field}.edge_u"), g.edge_u)?;

@@ -23,6 +23,10 @@ const RAY_MAGIC: &[u8; 8] = b"CNDLRAY1";
 const HIT_MAGIC: &[u8; 8] = b"CNDLHIT1";
 const NAME_LEN: usize = 16;
 
+/// Largest ray or hit file read: the largest export (50 M triangles, three batches of 8192²
+/// rays) is about 7.5 GB.
+pub const MAX_RAY_FILE_BYTES: u64 = 16 << 30;
+
 /// Which query a batch is traced with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RayKind {
@@ -209,13 +213,19 @@ impl RayFile {
     }
 
     pub fn read(path: &Path) -> Result<RayFile> {
-        let bytes = std::fs::read(path).with_context(|| {
+        let bytes = candela::limits::read_file(path, MAX_RAY_FILE_BYTES).with_context(|| {
             format!(
                 "cannot read the ray file '{}' (create it with `candela bench traversal --export {}`)",
                 path.display(),
                 path.display()
             )
         })?;
+        // The mesh and rays take about as much memory as their bytes.
+        candela::limits::check_memory(
+            bytes.len() as u64,
+            &format!("the mesh and rays of '{}'", path.display()),
+        )
+        .map_err(anyhow::Error::msg)?;
         Self::from_bytes(&bytes).with_context(|| {
             format!(
                 "the ray file '{}' is corrupt or truncated; export it again with `candela bench traversal --export`",
@@ -227,7 +237,7 @@ impl RayFile {
 
 /// Reads a hit file: one `t` array per batch.
 pub fn read_hits(path: &Path) -> Result<Vec<Vec<f32>>> {
-    let bytes = std::fs::read(path)
+    let bytes = candela::limits::read_file(path, MAX_RAY_FILE_BYTES)
         .with_context(|| format!("cannot read the hit file '{}'", path.display()))?;
     hits_from_bytes(&bytes)
         .with_context(|| format!("the hit file '{}' is corrupt or truncated", path.display()))

@@ -131,6 +131,23 @@ pub fn run(args: &ScalingArgs) -> Result<()> {
     super::check_positive("--spp", args.spp.into())?;
     super::check_resolution(args.resolution)?;
     super::check_positive("--reps", args.reps as u64)?;
+    // The sizes run one at a time: the largest decides, with the traversal rays at 512² and
+    // the render's film (the linearity check renders up to 512² too).
+    let largest = args.triangles.iter().copied().max().unwrap_or(0);
+    let images = super::render_bytes(args.resolution.max(512)) + 512 * 512 * super::BYTES_PER_RAY;
+    for (flag, n) in [
+        ("--triangles", largest),
+        ("--linearity-triangles", args.linearity_triangles),
+    ] {
+        super::check_memory_for(
+            &format!(
+                "{} with --resolution {} (its renders and 512² traversal rays)",
+                super::mesh_what(flag, n),
+                args.resolution
+            ),
+            super::mesh_bytes(n) + images,
+        )?;
+    }
     let overrides = Overrides {
         spp: Some(args.spp),
         ..Default::default()

@@ -470,10 +470,31 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
     super::check_positive("--reps", args.reps as u64)?;
     super::check_positive("--build-reps", args.build_reps as u64)?;
     let reps = args.reps;
+    if args.rays.is_none() {
+        let rays = (args.resolution as u64).pow(2) * super::BYTES_PER_RAY;
+        super::check_memory_for(
+            &format!(
+                "{} with --resolution {} ({}² primary rays and their diffuse and shadow rays, about {} bytes each)",
+                super::mesh_what("--triangles", args.triangles),
+                args.resolution,
+                args.resolution,
+                super::BYTES_PER_RAY
+            ),
+            super::mesh_bytes(args.triangles) + rays,
+        )?;
+    }
     let (file, source) = match &args.rays {
         Some(path) => {
             let t0 = Instant::now();
             let f = RayFile::read(path)?;
+            super::check_memory_for(
+                &format!(
+                    "the BVH of the {} triangles of '{}'",
+                    f.mesh.indices.len(),
+                    path.display()
+                ),
+                super::mesh_bytes(f.mesh.indices.len()),
+            )?;
             eprintln!(
                 "read {} in {:.1} s",
                 path.display(),

@@ -9,6 +9,7 @@ use super::{
     describe_scale, ColourScale, FalsecolourSettings, Legend, LegendInfo, HATCH_PERIOD, LABEL_PX,
     UNDEFINED_HATCH,
 };
+use crate::limits::{check_memory, printable};
 use crate::output::draw::{self, BLACK, DARK_GREY, WHITE};
 use crate::output::{
     Layers, OutputError, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_Y, ILLUMINANCE_SENTINEL,
@@ -71,13 +72,29 @@ pub fn render_falsecolour(
     if w == 0 || h == 0 {
         return Err("image is empty".into());
     }
-    let (values, defined) = extract(layers, settings)?;
-    if values.len() != w * h {
+    // Pixel coordinates of the PNG are drawn as i32 and u32.
+    const MAX_SIDE: usize = 1 << 28;
+    if w.max(h) > MAX_SIDE {
         return Err(format!(
-            "channel has {} samples, expected {w}×{h}",
-            values.len()
+            "the {w}×{h} image is too large for a false-colour map (at most {MAX_SIDE} pixels a side)"
         ));
     }
+    let pixels = w.checked_mul(h).ok_or("the image size overflows")?;
+    if let Some((name, c)) = layers.channels.iter().find(|(_, c)| c.len() != pixels) {
+        return Err(format!(
+            "channel '{name}' has {} samples, expected {w}×{h}",
+            c.len()
+        ));
+    }
+    // Per pixel: its value, whether it is defined, the defined values, the range's sorted
+    // copy of them, and their positive part (log scale) or contour classes.
+    let log_or_contours = settings.scale == super::Scale::Log || settings.contours;
+    let per_pixel = 8 + 1 + 8 + 8 + if log_or_contours { 8 } else { 0 };
+    check_memory(
+        pixels as u64 * per_pixel,
+        &format!("the false-colour map of the {w}×{h} image"),
+    )?;
+    let (values, defined) = extract(layers, settings)?;
     let data: Vec<f64> = values
         .iter()
         .zip(&defined)
@@ -99,13 +116,17 @@ pub fn render_falsecolour(
     let zoom = 420_usize.div_ceil(h).clamp(1, 16).min((2400 / w).max(1)) as u32;
     let (mw, mh) = (w as u32 * zoom, h as u32 * zoom);
 
-    let title = settings.title.clone().unwrap_or_else(|| {
-        let name = settings.quantity.name();
-        let mut c = name.chars();
-        c.next()
-            .map(|f| f.to_uppercase().collect::<String>() + c.as_str())
-            .unwrap_or_default()
-    });
+    let title = settings
+        .title
+        .as_deref()
+        .map(|t| printable(t, 200))
+        .unwrap_or_else(|| {
+            let name = settings.quantity.name();
+            let mut c = name.chars();
+            c.next()
+                .map(|f| f.to_uppercase().collect::<String>() + c.as_str())
+                .unwrap_or_default()
+        });
     let subtitle = describe_scale(&cs, unit);
     let footer = match stats {
         Some((lo, mean, hi)) => {
@@ -150,6 +171,12 @@ pub fn render_falsecolour(
         .max(PAD * 2 + draw::text_width(LABEL_PX, &subtitle))
         .max(PAD * 2 + draw::text_width(LABEL_PX, &footer));
     let height = header_h + body_h + footer_h;
+    // The PNG's pixels, beside the values, flags, defined values and contour classes.
+    let kept = 8 + 1 + 8 + if settings.contours { 8 } else { 0 };
+    check_memory(
+        width as u64 * height as u64 * 3 + pixels as u64 * kept,
+        &format!("the false-colour PNG ({width}×{height} pixels) of the {w}×{h} image"),
+    )?;
     let mut img = RgbImage::from_pixel(width, height, WHITE);
 
     draw::draw_text(&mut img, PAD as i32, PAD as i32, TITLE_PX, &title, BLACK);
@@ -165,7 +192,11 @@ pub fn render_falsecolour(
 
     // The map.
     let (ox, oy) = (PAD, header_h);
-    let classes: Vec<usize> = values.iter().map(|&v| cs.contour_class(v)).collect();
+    let classes: Vec<usize> = if settings.contours {
+        values.iter().map(|&v| cs.contour_class(v)).collect()
+    } else {
+        Vec::new()
+    };
     for j in 0..h {
         for i in 0..w {
             let k = j * w + i;
