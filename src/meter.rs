@@ -24,6 +24,9 @@ pub struct Estimate {
     pub stderr: f64,
     /// Samples taken.
     pub samples: u64,
+    /// Samples whose value was not finite (NaN or infinite), counted as 0 in `mean`: a meter
+    /// with any is not a measurement to trust, and the report and the summary say so.
+    pub non_finite: u64,
 }
 
 impl Estimate {
@@ -44,8 +47,14 @@ impl Estimate {
 
 const BATCH: u64 = 1024;
 
-/// One sample of a meter (lx or cd/m²).
-fn sample_meter(world: &World, kind: &MeterKind, stream: u64, s: u64, stats: &mut RayStats) -> f64 {
+/// One sample of a meter (lx or cd/m²); `None` if it was not finite.
+fn sample_meter(
+    world: &World,
+    kind: &MeterKind,
+    stream: u64,
+    s: u64,
+    stats: &mut RayStats,
+) -> Option<f64> {
     let mut sampler = Sampler::new(world.settings.seed, stream, s);
     let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
     let v = match kind {
@@ -83,10 +92,10 @@ fn sample_meter(world: &World, kind: &MeterKind, stream: u64, s: u64, stats: &mu
         }
     };
     if v.is_finite() {
-        v
+        Some(v)
     } else {
         stats.non_finite += 1;
-        0.0
+        None
     }
 }
 
@@ -118,7 +127,20 @@ fn measure_until(
     stats: &mut RayStats,
     stop: &AtomicBool,
 ) -> Option<Estimate> {
-    let (mut sum, mut sum2, mut n) = (0.0f64, 0.0f64, 0u64);
+    accumulate(settings, stop, |s| {
+        sample_meter(world, kind, stream, s, stats)
+    })
+}
+
+/// The estimate from `sample(0)`, `sample(1)`, … within `settings`' budget, giving up (`None`)
+/// once `stop` is set (polled every `BATCH` samples). A sample that is `None` (not finite)
+/// counts as 0 and in [`Estimate::non_finite`].
+fn accumulate(
+    settings: &MeasureSettings,
+    stop: &AtomicBool,
+    mut sample: impl FnMut(u64) -> Option<f64>,
+) -> Option<Estimate> {
+    let (mut sum, mut sum2, mut n, mut non_finite) = (0.0f64, 0.0f64, 0u64, 0u64);
     let min = settings.samples.max(2);
     let max = settings.max_samples.max(min);
     loop {
@@ -131,7 +153,10 @@ fn measure_until(
             if n % BATCH == 0 && stop.load(Ordering::Relaxed) {
                 return None;
             }
-            let v = sample_meter(world, kind, stream, n, stats);
+            let v = sample(n).unwrap_or_else(|| {
+                non_finite += 1;
+                0.0
+            });
             sum += v;
             sum2 += v * v;
             n += 1;
@@ -140,6 +165,7 @@ fn measure_until(
             mean: sum / n as f64,
             stderr: standard_error(sum, sum2, n),
             samples: n,
+            non_finite,
         };
         match settings.target_relative_error {
             Some(t) if n < max && est.relative_error() > t => continue,
@@ -208,6 +234,11 @@ pub fn measure_all_until(world: &World, stop: &AtomicBool) -> Option<Measurement
     Some(out)
 }
 
+/// Samples of a grid's points that were not finite (see [`Estimate::non_finite`]).
+pub fn grid_non_finite(values: &[Estimate]) -> u64 {
+    values.iter().map(|e| e.non_finite).sum()
+}
+
 /// Statistics of a grid, in the units of the values they were computed from.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct GridStats {
@@ -259,4 +290,27 @@ pub fn grid_stats(values: &[Estimate]) -> GridStats {
         min_over_max: None,
         max_stderr: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_that_are_not_finite_are_counted_per_meter() {
+        let settings = MeasureSettings {
+            samples: 1000,
+            target_relative_error: None,
+            max_samples: 1000,
+        };
+        let stop = AtomicBool::new(false);
+        // Every third sample is lost: the mean counts it as 0, and the estimate says how many.
+        let e = accumulate(&settings, &stop, |s| (s % 3 != 0).then_some(3.0)).unwrap();
+        assert_eq!((e.samples, e.non_finite), (1000, 334));
+        assert!((e.mean - 3.0 * 666.0 / 1000.0).abs() < 1e-12);
+        let clean = accumulate(&settings, &stop, |_| Some(1.0)).unwrap();
+        assert_eq!(clean.non_finite, 0);
+        let est = [e, clean, e];
+        assert_eq!(grid_non_finite(&est), 668);
+    }
 }

@@ -12,9 +12,14 @@
 //! The diffuse albedo is then (1 − E(θo)) ρ (1 − F̄ᵢ)/(1 − ρ F̄ᵢ) ≤ 1 − E(θo): a white base
 //! (ρ = 1) loses nothing (exactly when smooth; to the accuracy of the E table when rough), which
 //! the furnace tests check. f is symmetric in ωo, ωi (reciprocal). Two-sided.
+//!
+//! The diffuse lobe is evaluated as T(θi) T(θo) ρ / (π (η² (1 − ρ) + ρ T̄)) with T = 1 − E
+//! computed directly (never as 1 minus a reflectance) and T̄ = 1 − Ē, in f64: the same value,
+//! but finite and exact for any index, where 1 − ρ F̄ᵢ rounds to 0 for a white base under a
+//! coat of index 10⁴ and η² leaves single precision past 10¹⁹.
 
 use super::conductor::{flip_up, sample_microfacet_reflection};
-use super::fresnel::{fr_dielectric, reflect};
+use super::fresnel::{fr_dielectric, reflect, tr_dielectric};
 use super::microfacet::Microfacet;
 use super::{same_hemisphere, BsdfSample, MaterialFlags};
 use crate::description::context::{Context, Role, SceneError};
@@ -23,7 +28,8 @@ use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
-/// Entries of the specular-albedo table, uniform in cos θ on [0, 1].
+/// Entries of the specular-albedo table, uniform in √(cos θ) on [0, 1]: a nearly smooth coat's
+/// albedo changes within cos θ ≲ α of grazing, which a grid uniform in cos θ steps over.
 const E_N: usize = 64;
 
 #[derive(Clone, Debug)]
@@ -32,15 +38,22 @@ pub struct Coated {
     pub eta: f32,
     /// Roughness of the coat (effectively smooth: a delta specular lobe).
     pub mf: Microfacet,
-    /// Internal diffuse reflectance F̄ᵢ of the coat.
-    pub fdr_internal: f32,
-    /// E(μ) at μ = k/(E_N − 1).
-    e_table: Vec<f32>,
+    /// η².
+    eta2: f64,
+    /// T̄ = 1 − Ē, the cosine-weighted average of the coat's transmittance T(μ) = 1 − E(μ).
+    t_avg: f64,
+    /// T(μ) = 1 − E(μ) at μ = (k/(E_N − 1))² (rough coats only).
+    t_table: Vec<f32>,
 }
 
 /// Cosine-weighted hemispherical average 2∫g(μ) μ dμ by 8-point Gauss–Legendre on 256
 /// sub-intervals of [0, 1].
 fn hemispherical_average(g: impl Fn(f64) -> f64) -> f64 {
+    cosine_integral(&g, 0.0, 1.0)
+}
+
+/// 2∫ₐᵇ g(μ) μ dμ by 8-point Gauss–Legendre on 256 sub-intervals of [a, b].
+fn cosine_integral(g: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     const X: [f64; 4] = [
         0.183_434_642_495_649_8,
         0.525_532_409_916_329,
@@ -55,8 +68,12 @@ fn hemispherical_average(g: impl Fn(f64) -> f64) -> f64 {
     ];
     let n = 256;
     let mut s = 0.0;
+    let w = b - a;
     for k in 0..n {
-        let (a, b) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
+        let (a, b) = (
+            a + w * k as f64 / n as f64,
+            a + w * (k + 1) as f64 / n as f64,
+        );
         let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
         for j in 0..4 {
             for sgn in [-1.0, 1.0] {
@@ -115,31 +132,43 @@ impl Coated {
     }
 
     pub fn new(base: DenseSpectrum, eta: f32, mf: Microfacet) -> Self {
+        let eta64 = eta as f64;
         let mut c = Self {
             base,
             eta,
             mf,
-            fdr_internal: 0.0,
-            e_table: Vec::new(),
+            eta2: eta64 * eta64,
+            t_avg: 0.0,
+            t_table: Vec::new(),
         };
-        if !mf.effectively_smooth() {
-            c.e_table = (0..E_N)
+        c.t_avg = if mf.effectively_smooth() {
+            // Below 1 the coat transmits only inside the critical cone μ > √(1 − η²): the
+            // quadrature is split there, or it would miss a narrow cone altogether.
+            let t = |mu: f64| tr_dielectric(mu, eta64);
+            let mu_c = if eta < 1.0 {
+                ((1.0 - eta64) * (1.0 + eta64)).sqrt()
+            } else {
+                0.0
+            };
+            cosine_integral(&t, 0.0, mu_c) + cosine_integral(&t, mu_c, 1.0)
+        } else {
+            c.t_table = (0..E_N)
                 .map(|k| {
-                    let mu = (k as f32 / (E_N - 1) as f32).max(1e-3);
-                    c.specular_albedo(mu)
+                    let mu = (k as f32 / (E_N - 1) as f32).powi(2).max(1e-6);
+                    c.rough_transmittance(mu)
                 })
                 .collect();
-        }
-        let e_avg = hemispherical_average(|mu| c.e(mu as f32) as f64);
-        let eta2 = (eta as f64) * (eta as f64);
-        c.fdr_internal = (1.0 - (1.0 - e_avg) / eta2) as f32;
+            hemispherical_average(|mu| c.t(mu as f32) as f64)
+        };
         c
     }
 
-    /// Directional albedo of the rough specular lobe at cos θo = `mu`: the visible-normal
-    /// estimator F(ωo·ωm) G₂/G₁(ωo) on a stratified 64 × 64 grid (the lobe is isotropic in the
-    /// tangent plane only for isotropic α; the azimuth φo = 45° is used otherwise).
-    fn specular_albedo(&self, mu: f32) -> f32 {
+    /// 1 − E of the rough specular lobe at cos θo = `mu`, E its directional albedo: the
+    /// visible-normal estimator of E is F(ωo·ωm) G₂/G₁(ωo), so 1 − E is the mean of
+    /// (1 − F) G₂/G₁ + (1 − G₂/G₁), with 1 − F and 1 − G₂/G₁ = Λ(ωi)/(1 + Λ(ωo) + Λ(ωi))
+    /// formed directly, on a stratified 64 × 64 grid (the lobe is isotropic in the tangent
+    /// plane only for isotropic α; the azimuth φo = 45° is used otherwise).
+    fn rough_transmittance(&self, mu: f32) -> f32 {
         let s = (1.0 - mu * mu).max(0.0).sqrt();
         let wo = Vec3::new(
             s * std::f32::consts::FRAC_1_SQRT_2,
@@ -154,11 +183,18 @@ impl Coated {
                 let wm = self.mf.sample_wm(wo, u);
                 let wi = reflect(wo, wm);
                 if wi.z <= 0.0 {
+                    sum += 1.0;
                     continue;
                 }
-                let g1 = self.mf.g1(wo);
-                let g2 = self.mf.g(wo, wi, wm);
-                sum += (fr_dielectric(wo.dot(wm), self.eta) * g2 / g1) as f64;
+                let (lo, li) = (self.mf.lambda(wo) as f64, self.mf.lambda(wi) as f64);
+                let (kept, masked) = if li.is_infinite() {
+                    (0.0, 1.0)
+                } else if lo.is_infinite() {
+                    (1.0, 0.0)
+                } else {
+                    ((1.0 + lo) / (1.0 + lo + li), li / (1.0 + lo + li))
+                };
+                sum += tr_dielectric(wo.dot(wm) as f64, self.eta as f64) * kept + masked;
             }
         }
         (sum / (n * n) as f64) as f32
@@ -167,14 +203,23 @@ impl Coated {
     /// Specular albedo E(μ).
     #[inline]
     fn e(&self, mu: f32) -> f32 {
-        let mu = mu.abs().min(1.0);
-        if self.e_table.is_empty() {
-            return fr_dielectric(mu, self.eta);
+        if self.t_table.is_empty() {
+            return fr_dielectric(mu.abs().min(1.0), self.eta);
         }
-        let x = mu * (E_N - 1) as f32;
+        1.0 - self.t(mu)
+    }
+
+    /// The coat's transmittance T(μ) = 1 − E(μ), formed without the subtraction.
+    #[inline]
+    fn t(&self, mu: f32) -> f32 {
+        let mu = mu.abs().min(1.0);
+        if self.t_table.is_empty() {
+            return tr_dielectric(mu as f64, self.eta as f64) as f32;
+        }
+        let x = mu.sqrt() * (E_N - 1) as f32;
         let i = (x as usize).min(E_N - 2);
         let t = x - i as f32;
-        self.e_table[i] * (1.0 - t) + self.e_table[i + 1] * t
+        self.t_table[i] * (1.0 - t) + self.t_table[i + 1] * t
     }
 
     /// Probability of choosing the specular lobe.
@@ -184,11 +229,16 @@ impl Coated {
     }
 
     fn diffuse(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
-        let k = (1.0 - self.e(wo.z)) * (1.0 - self.e(wi.z)) * FRAC_1_PI / (self.eta * self.eta);
+        let k = self.t(wo.z) as f64 * self.t(wi.z) as f64 * std::f64::consts::FRAC_1_PI;
         let rho = self.base.sample(wl);
         let mut f = SampledSpectrum::ZERO;
         for i in 0..crate::spectrum::N_LAMBDA {
-            f[i] = k * rho[i] / (1.0 - rho[i] * self.fdr_internal);
+            let r = rho[i] as f64;
+            // η² (1 − ρ F̄ᵢ); 0 only for a white base under a coat that transmits nothing.
+            let d = self.eta2 * (1.0 - r) + r * self.t_avg;
+            if d > 0.0 {
+                f[i] = (k * r / d) as f32;
+            }
         }
         f
     }
@@ -198,6 +248,11 @@ impl Coated {
         let (wo, wi) = (flip_up(wo), flip_up(wi));
         let wm = (wo + wi).normalize_or_zero();
         if wm == Vec3::ZERO || wo.z == 0.0 || wi.z == 0.0 {
+            return 0.0;
+        }
+        // A back-facing microfacet reflects nothing (and `specular_pdf` is 0 there). Rounding
+        // makes the half vector tilt so far only for grazing pairs of nearly opposite azimuth.
+        if wo.dot(wm) <= 0.0 || wi.dot(wm) <= 0.0 {
             return 0.0;
         }
         self.mf.d(wm) * self.mf.g(wo, wi, wm) * fr_dielectric(wo.dot(wm), self.eta)

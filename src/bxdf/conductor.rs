@@ -63,14 +63,20 @@ impl Conductor {
             return SampledSpectrum::ZERO;
         }
         let (co, ci) = (wo.z.abs(), wi.z.abs());
-        let wm = (wo + wi).normalize_or_zero();
+        // On the +z side, as `pdf` and the sampling work.
+        let (wo_u, wi_u) = (flip_up(wo), flip_up(wi));
+        let wm = (wo_u + wi_u).normalize_or_zero();
         if wm == Vec3::ZERO || co == 0.0 || ci == 0.0 {
             return SampledSpectrum::ZERO;
         }
-        let wm = if wm.z < 0.0 { -wm } else { wm };
-        let (wo_u, wi_u) = (flip_up(wo), flip_up(wi));
+        // A back-facing microfacet reflects nothing (and `pdf` is 0 there). Rounding makes
+        // the half vector tilt so far only for grazing pairs of nearly opposite azimuth.
+        let cos_o = wo_u.dot(wm);
+        if cos_o <= 0.0 || wi_u.dot(wm) <= 0.0 {
+            return SampledSpectrum::ZERO;
+        }
         let v = self.mf.d(wm) * self.mf.g(wo_u, wi_u, wm) / (4.0 * co * ci);
-        self.fresnel(wo.dot(wm), wl) * v
+        self.fresnel(cos_o, wl) * v
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<BsdfSample> {

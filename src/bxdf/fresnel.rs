@@ -36,6 +36,30 @@ pub fn fr_dielectric(cos_i: f32, eta: f32) -> f32 {
     0.5 * (s + p)
 }
 
+/// Unpolarised transmittance 1 − R of a dielectric interface (arguments as
+/// [`fr_dielectric_sp`]), in f64 and without forming 1 − R: each polarisation's 1 − r² is
+/// 4ab with a = x/(x + y), b = y/(x + y) for its two terms x, y, so an index of 10⁻³⁰ or 10³⁰
+/// still gives its tiny transmittance instead of 0 or NaN.
+pub fn tr_dielectric(cos_i: f64, eta: f64) -> f64 {
+    let mut cos_i = cos_i.clamp(-1.0, 1.0);
+    let mut eta = eta;
+    if cos_i < 0.0 {
+        eta = 1.0 / eta;
+        cos_i = -cos_i;
+    }
+    // sin²θt = sin²θi / η², with sin²θi = (1 − cos)(1 + cos) exact near normal incidence.
+    let sin2_t = ((1.0 - cos_i) * (1.0 + cos_i)) / eta / eta;
+    if sin2_t >= 1.0 || sin2_t.is_nan() || cos_i == 0.0 {
+        return 0.0;
+    }
+    let cos_t = ((1.0 - sin2_t).max(0.0)).sqrt();
+    let t = |x: f64, y: f64| {
+        let s = x + y;
+        4.0 * (x / s) * (y / s)
+    };
+    0.5 * (t(cos_i, eta * cos_t) + t(eta * cos_i, cos_t))
+}
+
 /// Unpolarised reflectance of a conductor with complex index n + ik (relative to the outside
 /// medium) at incidence cosine `cos_i` ∈ [0, 1]. Evaluated in f64 complex arithmetic.
 pub fn fr_conductor(cos_i: f32, n: f32, k: f32) -> f32 {

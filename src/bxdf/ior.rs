@@ -10,6 +10,13 @@ use crate::description::schema::{IorDesc, SpectrumDesc};
 use crate::spectrum::{DenseSpectrum, SampledWavelengths, N_LAMBDA};
 use std::sync::OnceLock;
 
+/// Smallest and largest relative index a dielectric may have (anywhere in 360–830 nm): far
+/// beyond any material, and η² stays within single precision (10¹²), which the refracted
+/// radiance and Russian roulette's η′² products need.
+pub const MIN_IOR: f32 = 1e-6;
+/// See [`MIN_IOR`].
+pub const MAX_IOR: f32 = 1e6;
+
 /// The real index of a dielectric as a function of wavelength.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Ior {
@@ -68,6 +75,14 @@ impl Ior {
                 field,
                 format!(
                     "the refractive index must be finite and greater than 0 over 360–830 nm (range {lo} to {hi})"
+                ),
+            ));
+        }
+        if lo < MIN_IOR || hi > MAX_IOR {
+            return Err(ctx.err(
+                field,
+                format!(
+                    "the refractive index must lie between {MIN_IOR:e} and {MAX_IOR:e} over 360–830 nm (range {lo} to {hi}); beyond, single precision cannot carry η² through refraction"
                 ),
             ));
         }

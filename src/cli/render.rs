@@ -273,6 +273,12 @@ pub fn render(a: &RenderOpts) -> Result<()> {
             e.ci95() * k,
             e.samples
         );
+        if e.non_finite > 0 {
+            eprintln!(
+                "warning: meter {:?}: {} of {} samples were not finite and were counted as 0; its value is not reliable",
+                m.name, e.non_finite, e.samples
+            );
+        }
     }
     for g in &out.grids {
         let s = &g.stats;
@@ -290,6 +296,12 @@ pub fn render(a: &RenderOpts) -> Result<()> {
             s.max * k,
             s.u0.unwrap_or(0.0)
         );
+        if g.non_finite > 0 {
+            eprintln!(
+                "warning: grid {:?}: {} samples were not finite and were counted as 0; its values are not reliable",
+                g.name, g.non_finite
+            );
+        }
     }
     let r = &out.render;
     say!(

@@ -40,6 +40,10 @@ pub enum SceneError {
 /// single-precision light spectra and the f32 image channels cannot overflow to infinity.
 pub const MAX_SPECTRAL_VALUE: f64 = 1e25;
 
+/// Smallest spectral value of a light that is not off (same units): below it the light's
+/// contributions fall into single precision's subnormal range and round to 0.
+pub const MIN_SPECTRAL_VALUE: f64 = 1e-25;
+
 /// What building a scene value needs: the scene file (for messages), its directory (for
 /// relative paths) and the files it refers to.
 pub struct Context<'a> {
@@ -155,6 +159,15 @@ impl Context<'_> {
     ) -> Result<DenseSpectrum, SceneError> {
         let k = photometric_scale(s, amount).map_err(|m| self.err(sfield, m))?;
         self.representable(afield, s, k)?;
+        let peak = s.max_value() as f64 * k as f64;
+        if amount > 0.0 && peak < MIN_SPECTRAL_VALUE {
+            return Err(self.err(
+                afield,
+                format!(
+                    "the amount is too small: the light's spectral value would be {peak:e} (less than {MIN_SPECTRAL_VALUE:e} in W, m, sr, nm), which single precision rounds to 0; use 0 for a light that is off"
+                ),
+            ));
+        }
         Ok(s.scaled(k))
     }
 

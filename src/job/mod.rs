@@ -133,6 +133,8 @@ pub struct GridResult {
     pub nx: u32,
     pub ny: u32,
     pub stats: GridStats,
+    /// Samples of its points that were not finite (counted as 0).
+    pub non_finite: u64,
 }
 
 /// How a job ended.
@@ -561,6 +563,7 @@ pub fn run(
             nx: g.nx,
             ny: g.ny,
             stats: crate::meter::grid_stats(est),
+            non_finite: crate::meter::grid_non_finite(est),
         })
         .collect();
     Ok(outputs)

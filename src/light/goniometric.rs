@@ -14,7 +14,9 @@
 //! lights by their integrated lumens.
 
 use super::LightFlags;
-use crate::description::context::{Context, Role, SceneError};
+use crate::description::context::{
+    Context, Role, SceneError, MAX_SPECTRAL_VALUE, MIN_SPECTRAL_VALUE,
+};
 use crate::description::schema::{SpectrumDesc, V3};
 use crate::luminaire::Distribution;
 use crate::photometry::luminous_integral;
@@ -85,6 +87,35 @@ impl GoniometricLight {
         }
         let scale = crate::photometry::photometric_scale(&spectrum, k)
             .map_err(|m| ctx.err(format!("{field}.spectrum"), m))?;
+        // The brightest direction's spectral intensity, in f64 (the f32 scale may already be
+        // infinite), against the limits every light is held to.
+        let peak_cd = distribution.values.iter().copied().fold(0.0, f64::max);
+        let peak = peak_cd * k / luminous_integral(&spectrum) * spectrum.max_value() as f64;
+        let culprit = match (d.multiplier, d.lumens) {
+            (Some(_), _) => "multiplier",
+            (None, Some(_)) => "lumens",
+            (None, None) => "file",
+        };
+        let scaled = if k == 1.0 {
+            String::new()
+        } else {
+            format!(" × {k:e} (`lumens`, `multiplier`)")
+        };
+        let amount = format!(
+            "the file's peak intensity of {peak_cd:e} cd{scaled} makes a spectral intensity of {peak:.3e} W/(sr·nm)"
+        );
+        if peak.is_nan() || peak > MAX_SPECTRAL_VALUE {
+            return Err(ctx.err(
+                format!("{field}.{culprit}"),
+                format!("the light is too bright: {amount}, more than {MAX_SPECTRAL_VALUE:e}, beyond any physical source"),
+            ));
+        }
+        if peak_cd * k > 0.0 && peak < MIN_SPECTRAL_VALUE {
+            return Err(ctx.err(
+                format!("{field}.{culprit}"),
+                format!("the light is too dim: {amount}, less than {MIN_SPECTRAL_VALUE:e}, which single precision rounds to 0; use a multiplier of 0 for a light that is off"),
+            ));
+        }
         Ok(Self {
             position,
             rotation: Mat3::from_quat(crate::geometry::euler_rotation_deg(rotate_deg)),

@@ -1,7 +1,7 @@
 //! `NAME.report.json` and one CSV per calculation grid. The schema is documented in
 //! docs/reports.md; every value carries its unit in the `units` object.
 
-use crate::meter::{grid_stats, Estimate, Measurements};
+use crate::meter::{grid_non_finite, grid_stats, Estimate, Measurements};
 use crate::output::{write_atomic, OutputError};
 use crate::render::RenderResult;
 use crate::world::MeterKind;
@@ -23,7 +23,40 @@ fn estimate(e: &Estimate, k: f64) -> Value {
         "ci95_low": (e.mean - e.ci95()) * k,
         "ci95_high": (e.mean + e.ci95()) * k,
         "samples": e.samples,
+        "non_finite_samples": e.non_finite,
     })
+}
+
+/// What the report must not let pass silently: every meter and grid, and the image, with
+/// samples that were not finite (counted as 0, so their values are too low or meaningless).
+pub fn warnings(world: &World, render: &RenderResult, m: &Measurements) -> Vec<String> {
+    let mut out = Vec::new();
+    for (meter, e) in world.meters.iter().zip(&m.meters) {
+        if e.non_finite > 0 {
+            out.push(format!(
+                "meter {:?}: {} of {} samples were not finite and were counted as 0; its value is not reliable",
+                meter.name, e.non_finite, e.samples
+            ));
+        }
+    }
+    for (grid, est) in world.grids.iter().zip(&m.grids) {
+        let n = grid_non_finite(est);
+        if n > 0 {
+            let points = est.iter().filter(|e| e.non_finite > 0).count();
+            out.push(format!(
+                "grid {:?}: {n} samples at {points} of {} points were not finite and were counted as 0; those points are not reliable",
+                grid.name,
+                est.len()
+            ));
+        }
+    }
+    if render.stats.non_finite > 0 {
+        out.push(format!(
+            "image: {} samples were not finite and were counted as 0",
+            render.stats.non_finite
+        ));
+    }
+    out
 }
 
 /// Everything a report says about one run.
@@ -126,6 +159,7 @@ pub fn report_json(r: &ReportInput) -> Value {
                 "values": rows(&|e| json!(e.mean * ke)),
                 "stderr": rows(&|e| json!(e.stderr * ke)),
                 "samples": rows(&|e| json!(e.samples)),
+                "non_finite_samples": grid_non_finite(est),
                 "E_min": s.min * ke, "E_avg": s.avg * ke, "E_max": s.max * ke,
                 "U0": s.u0, "E_min_over_E_max": s.min_over_max,
             })
@@ -160,11 +194,16 @@ pub fn report_json(r: &ReportInput) -> Value {
             "light_paths": stats_all.light_paths,
             "non_finite_samples": stats_all.non_finite,
         },
-        "image": { "luminance": luminance, "illuminance": illuminance },
+        "image": {
+            "luminance": luminance,
+            "illuminance": illuminance,
+            "non_finite_samples": r.render.stats.non_finite,
+        },
         "meters": meters,
         "grids": grids,
         "outputs": r.outputs,
         "progressive": r.progressive,
+        "warnings": warnings(w, r.render, r.measurements),
     })
 }
 
