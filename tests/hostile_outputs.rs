@@ -256,29 +256,44 @@ fn an_earlier_state_is_kept_unless_resumed_or_overwritten() {
 fn a_grid_name_too_long_for_a_file_name_is_refused_before_rendering() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let long = "a".repeat(250);
+    // A grid name past the scene format's limit is refused when the scene is read.
+    std::fs::write(
+        d.join("s.ron"),
+        scene("Constant(0.5)", "", "", &grid(&"a".repeat(250))),
+    )
+    .unwrap();
+    let before = snapshot(d);
+    assert_refused_untouched(
+        d,
+        &["render", "--quiet", "s.ron"],
+        &["grids[0].name", "more than the limit of 100"],
+        &before,
+    );
+    // Within it, but with an output stem that makes `NAME.grid-<name>.csv` too long for a
+    // file name: a million samples per pixel are refused at once, not after the render.
+    let long = "a".repeat(100);
     std::fs::write(
         d.join("s.ron"),
         scene("Constant(0.5)", "", "", &grid(&long)),
     )
     .unwrap();
-    // A million samples per pixel: refused at once, not after the render.
+    let stem = "c".repeat(150);
     let t = std::time::Instant::now();
     let before = snapshot(d);
     let stderr = assert_refused_untouched(
         d,
-        &["render", "--quiet", "--spp", "1000000", "s.ron"],
-        &["grid \"aaaa", "bytes", "s.grid-aaaa"],
+        &[
+            "render", "--quiet", "--spp", "1000000", "--out", &stem, "s.ron",
+        ],
+        &["grid \"aaaa", "bytes", ".grid-aaaa"],
         &before,
     );
     assert!(t.elapsed().as_secs_f64() < 10.0, "{:?}", t.elapsed());
     assert!(stderr.contains("the CSV of grid") || stderr.contains("the heat map of grid"));
-    // 200 characters fit (255 bytes less the temporary name's additions).
-    let ok = "b".repeat(200);
-    std::fs::write(d.join("s.ron"), scene("Constant(0.5)", "", "", &grid(&ok))).unwrap();
+    // The same grid with a short stem fits.
     let (code, _, stderr) = common::cli(&["render", "--quiet", "s.ron"], d);
     assert_eq!(code, 0, "{stderr}");
-    assert!(d.join(format!("s.grid-{ok}.csv")).is_file());
+    assert!(d.join(format!("s.grid-{long}.csv")).is_file());
 }
 
 #[test]
@@ -396,4 +411,26 @@ fn a_job_stopped_before_its_first_pass_leaves_a_resumed_state_as_it_was() {
     let out = job::run(&job, &mut job::Silent, &AtomicBool::new(true)).unwrap();
     assert_eq!(out.outcome, Outcome::InterruptedBeforeFirstPass);
     assert_eq!(snapshot(d), before);
+}
+
+#[test]
+fn merge_never_replaces_an_input_state_by_any_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.ron"), plain()).unwrap();
+    common::render_states(d, "s.ron", &[("s", "1"), ("t", "2")]);
+    // The input state under the output's name: a hard link, a symbolic link, a path through
+    // `..`. Each is refused before anything is read or written.
+    std::fs::hard_link(d.join("s.state"), d.join("h.state")).unwrap();
+    std::os::unix::fs::symlink(d.join("s.state"), d.join("l.state")).unwrap();
+    std::fs::create_dir(d.join("sub")).unwrap();
+    let before = snapshot(d);
+    for out in ["h", "l", "sub/../s"] {
+        assert_refused_untouched(
+            d,
+            &["merge", "s.state", "t.state", "-o", out],
+            &["refusing to overwrite the input state file", "s.state"],
+            &before,
+        );
+    }
 }

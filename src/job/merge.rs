@@ -34,7 +34,7 @@ pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result
     let state_path = with_suffix(&stem, ".state");
     check_output_dir(&stem).with_context(|| format!("-o {}", out.display()))?;
     for output in [&exr_path, &png_path, &state_path] {
-        if let Some(input) = states.iter().find(|s| output::same_file(output, s)) {
+        if let Some(input) = states.iter().find(|s| super::would_replace(output, s)) {
             bail!(
                 "-o {}: refusing to overwrite the input state file {} with the merged {}; choose another output name",
                 out.display(),

@@ -156,15 +156,6 @@ pub fn remove_temporary_files() {
     std::mem::forget(files);
 }
 
-/// Whether `a` and `b` name the same existing file (after resolving links and `..`); paths
-/// that do not both exist are compared as given.
-pub fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => a == b,
-    }
-}
-
 /// Removes the temporary file when dropped, unless disarmed after the rename. This also
 /// cleans up if the writer closure panics.
 struct TempGuard {
