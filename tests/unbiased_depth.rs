@@ -32,7 +32,7 @@ const CUBE: &str = r#"
 
 /// A uniform random number in [0, 1) from a counter.
 fn uniform(k: u64) -> f64 {
-    (mix64(k ^ 0x5eed_0f_c0be) >> 11) as f64 / (1u64 << 53) as f64
+    (mix64(k ^ 0x005e_ed0f_c0be) >> 11) as f64 / (1u64 << 53) as f64
 }
 
 /// CIE 171:2006 test case 5.8: an isotropic point source of flux Φ at the centre of a closed
@@ -177,4 +177,55 @@ fn white_box_paths_end_with_unlimited_depth() {
         "{rays} bounce rays per sample, expected 102"
     );
     assert_eq!(m.stats.truncated_paths, 0);
+}
+
+/// The report and the closing summary say when a finite `max_depth` cut paths short, and
+/// count them; with the default (no limit) there are none.
+#[test]
+fn report_counts_paths_cut_at_a_finite_max_depth() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("s.ron"),
+        format!(
+            r#"(
+            camera: (position: (0, 1, -0.9), look_at: (0, 1, 1), vfov_deg: 90, resolution: (4, 4)),
+            render: (spp: 4),
+            materials: {{ "wall": Diffuse(reflectance: Constant(0.5)) }},
+            objects: [{CUBE}],
+            lights: [Point(position: (0, 1, 0), spectrum: Named("D65"), amount: Flux(1000))],
+            meters: [Illuminance(name: "floor", position: (0, 0.001, 0), normal: (0, 1, 0))],
+            measure: (samples: 64),
+        )"#
+        ),
+    )
+    .unwrap();
+    let report = || -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.report.json")).unwrap())
+            .unwrap()
+    };
+    let (code, _, stderr) = cli(&["render", "--quiet", "s.ron"], dir.path());
+    assert_eq!(code, 0, "{stderr}");
+    let r = report();
+    assert!(r["settings"]["max_depth"].is_null());
+    assert_eq!(r["timing"]["truncated_paths"], 0);
+    assert!(!stderr.contains("max_depth"), "{stderr}");
+    let (code, _, stderr) = cli(
+        &[
+            "render",
+            "--quiet",
+            "--overwrite",
+            "--max-depth",
+            "2",
+            "s.ron",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, 0, "{stderr}");
+    let r = report();
+    assert_eq!(r["settings"]["max_depth"], 2);
+    // In a closed room with ρ = 0.5 every path that scatters twice is cut: far more than 0.
+    assert!(r["timing"]["truncated_paths"].as_u64().unwrap() > 16, "{r}");
+    let warnings = r["warnings"].to_string();
+    assert!(warnings.contains("max_depth 2"), "{warnings}");
+    assert!(stderr.contains("reached max_depth 2"), "{stderr}");
 }
