@@ -46,12 +46,22 @@ pub struct RenderState {
     pub scene_hash: u64,
     pub scene: String,
     pub seed: u64,
+    /// Most scattering events per path, [`UNLIMITED_DEPTH`] for none.
     pub max_depth: u32,
     pub illuminance: bool,
     pub film: Film,
     /// The other seeds a merged state contains (`candela merge`; empty for one render), so a
     /// later merge can refuse a seed that is already in it.
     pub merged_seeds: Vec<u64>,
+}
+
+/// [`RenderState::max_depth`] of a render without a depth limit (finite limits are at most
+/// 10 000).
+pub const UNLIMITED_DEPTH: u32 = u32::MAX;
+
+/// The state file's code of a depth limit: the limit, or [`UNLIMITED_DEPTH`].
+pub fn depth_code(max_depth: Option<u32>) -> u32 {
+    max_depth.unwrap_or(UNLIMITED_DEPTH)
 }
 
 /// The leading fields of every version, read first so an old file gets a clear message.
@@ -168,7 +178,7 @@ pub fn scene_hash(scene_text: &[u8], world: &World) -> u64 {
             Err(_) => h = mix64(h ^ 0xdead),
         }
     }
-    h = mix64(h ^ world.settings.max_depth as u64);
+    h = mix64(h ^ depth_code(world.settings.max_depth) as u64);
     h = mix64(h ^ world.settings.rr_depth as u64);
     h = mix64(h ^ world.settings.illuminance as u64);
     h = mix64(h ^ world.caustics.is_some() as u64);
@@ -184,7 +194,7 @@ impl RenderState {
             scene_hash,
             scene: scene.display().to_string(),
             seed: world.settings.seed,
-            max_depth: world.settings.max_depth,
+            max_depth: depth_code(world.settings.max_depth),
             illuminance: world.settings.illuminance,
             film,
             merged_seeds: Vec::new(),

@@ -364,7 +364,8 @@ fn nan_inf_and_extremes_in_every_numeric_field() {
                     );
                     // Sample budgets are the user's (see huge_sample_counts_…): keep them small.
                     world.settings.spp = 1;
-                    world.settings.max_depth = world.settings.max_depth.min(4);
+                    world.settings.max_depth =
+                        Some(world.settings.max_depth.map_or(4, |d| d.min(4)));
                     world.measure.samples = world.measure.samples.min(8);
                     world.measure.max_samples = world.measure.max_samples.min(16);
                     if world.camera.width * world.camera.height <= 64 {
@@ -380,7 +381,8 @@ fn nan_inf_and_extremes_in_every_numeric_field() {
 #[test]
 fn huge_sample_counts_are_accepted_as_asked_and_depth_is_bounded() {
     // spp and meter samples are the user's budget: up to u32::MAX (u64 for meters) is accepted
-    // (a long render with a progress bar); max_depth above 10 000 is refused.
+    // (a long render with a progress bar); max_depth and rr_depth above 10 000 are refused
+    // (without max_depth, rr_depth bounds the paths that Russian roulette cannot yet end).
     let base = r#"(camera: (position: (0, 0, 0), look_at: (0, 0, 1), vfov_deg: 30, resolution: (1, 1)), render: (RENDER), measure: (MEASURE))"#;
     let build = |r: &str, m: &str| {
         let text = base.replace("RENDER", r).replace("MEASURE", m);
@@ -388,7 +390,7 @@ fn huge_sample_counts_are_accepted_as_asked_and_depth_is_bounded() {
         scene::build(&scene::parse(&text, p).unwrap(), p, &Overrides::default())
     };
     let w = build(
-        "spp: 4294967295, rr_depth: 4294967295, seed: 18446744073709551615",
+        "spp: 4294967295, rr_depth: 10000, seed: 18446744073709551615",
         "samples: 18446744073709551615",
     )
     .unwrap();
@@ -396,6 +398,8 @@ fn huge_sample_counts_are_accepted_as_asked_and_depth_is_bounded() {
     let e = build("max_depth: 10001", "").err().unwrap().to_string();
     assert!(e.contains("render.max_depth"), "{e}");
     assert!(build("max_depth: 10000", "").is_ok());
+    let e = build("rr_depth: 4294967295", "").err().unwrap().to_string();
+    assert!(e.contains("render.rr_depth"), "{e}");
     // Overrides from the command line are checked the same way.
     let text = base.replace("RENDER", "").replace("MEASURE", "");
     let p = Path::new("scene.ron");

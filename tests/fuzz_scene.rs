@@ -121,7 +121,7 @@ fn check(bytes: &[u8], path: &Path) {
     let mut world = world;
     // Keep the work of one case tiny: at most 1 spp, a few bounces, a few meter samples.
     world.settings.spp = 1;
-    world.settings.max_depth = world.settings.max_depth.min(6);
+    world.settings.max_depth = Some(world.settings.max_depth.map_or(6, |d| d.min(6)));
     world.measure.samples = 8;
     world.measure.max_samples = 16;
     if world.camera.width * world.camera.height <= RENDER_PIXELS {

@@ -29,7 +29,7 @@ pub struct RenderOpts {
     /// Random seed (overrides render.seed).
     #[arg(long)]
     seed: Option<u64>,
-    /// Maximum path depth (overrides render.max_depth).
+    /// Most scattering events per path, at most 10000 (overrides render.max_depth; default: unlimited, paths end by Russian roulette).
     #[arg(long)]
     max_depth: Option<u32>,
     /// Exposure of the PNG in EV (ISO 100), between -100 and 100; default: automatic. Does not affect the EXR.
@@ -322,6 +322,9 @@ pub fn render(a: &RenderOpts) -> Result<()> {
             "warning: {} samples gave a non-finite value and were counted as 0",
             r.stats.non_finite
         );
+    }
+    if let Some(w) = &out.truncation {
+        eprintln!("warning: {w}");
     }
     Ok(())
 }

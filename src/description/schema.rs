@@ -177,8 +177,11 @@ pub struct LensDesc {
 pub struct RenderDesc {
     #[serde(default = "default_spp")]
     pub spp: u32,
-    #[serde(default = "default_max_depth")]
-    pub max_depth: u32,
+    /// Most scattering events per path; None (absent) = unlimited, paths end by Russian
+    /// roulette only.
+    #[serde(default)]
+    pub max_depth: Option<u32>,
+    /// Scattering events before Russian roulette may end a path.
     #[serde(default = "default_rr_depth")]
     pub rr_depth: u32,
     #[serde(default)]
@@ -219,7 +222,7 @@ impl Default for RenderDesc {
     fn default() -> Self {
         Self {
             spp: default_spp(),
-            max_depth: default_max_depth(),
+            max_depth: None,
             rr_depth: default_rr_depth(),
             seed: 0,
             filter: FilterDesc::Box,
@@ -231,9 +234,6 @@ impl Default for RenderDesc {
 }
 fn default_spp() -> u32 {
     64
-}
-fn default_max_depth() -> u32 {
-    16
 }
 fn default_rr_depth() -> u32 {
     3

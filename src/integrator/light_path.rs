@@ -310,10 +310,11 @@ pub fn trace_light_path(
         // Continue while a further surface is within the depth limit; the first scattering
         // must be specular (the paths whose light-side end is non-specular are the camera
         // paths' part).
-        if black
-            || depth >= settings.max_depth
-            || (depth == 1 && !material.flags().contains(crate::bxdf::MaterialFlags::DELTA))
-        {
+        if black || (depth == 1 && !material.flags().contains(crate::bxdf::MaterialFlags::DELTA)) {
+            return;
+        }
+        if settings.max_depth.is_some_and(|max| depth >= max) {
+            stats.truncated_paths += 1;
             return;
         }
         let [ux, uy, uc, u_rr] = sampler.get4();
@@ -335,13 +336,13 @@ pub fn trace_light_path(
         if beta.is_black() || !k.is_finite() {
             return;
         }
-        if depth > settings.rr_depth && throughput < 1.0 {
-            let q = (1.0 - throughput).max(0.0);
-            if u_rr < q {
+        if depth > settings.rr_depth {
+            let p = super::survival_probability(throughput);
+            if u_rr < 1.0 - p {
                 return;
             }
-            beta = beta / (1.0 - q);
-            throughput /= 1.0 - q;
+            beta = beta / p;
+            throughput /= p;
         }
         straight_through = 0;
         ray_o = hit.spawn_origin(wi_world);

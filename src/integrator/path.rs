@@ -1,6 +1,7 @@
 //! Camera paths: unidirectional spectral path tracing with next-event estimation and multiple
-//! importance sampling (Veach 1997, power heuristic β = 2), Russian roulette and a maximum
-//! depth; and the irradiance at a point, from the same paths.
+//! importance sampling (Veach 1997, power heuristic β = 2), Russian roulette (see
+//! [`super::survival_probability`]) and an optional maximum depth; and the irradiance at a
+//! point, from the same paths.
 //!
 //! The integrator only talks to materials through [`crate::bxdf::Material`]'s interface and to
 //! lights through [`crate::light::Light`]'s, so new families slot in without touching it.
@@ -178,7 +179,8 @@ pub fn trace(
             }
         }
 
-        if depth >= settings.max_depth {
+        if settings.max_depth.is_some_and(|max| depth >= max) {
+            stats.truncated_paths += 1;
             break;
         }
         material.prepare(wl);
@@ -243,20 +245,17 @@ pub fn trace(
         let wi_world = frame.to_world(bs.wi);
         ray_o = hit.spawn_origin(wi_world);
         ray_d = wi_world.normalize();
-        stats.bounce_rays += 1;
         depth += 1;
 
         // Russian roulette.
         if depth > settings.rr_depth {
-            let m = beta.max_component() * eta_scale;
-            if m < 1.0 {
-                let q = (1.0 - m).max(0.0);
-                if u_rr < q {
-                    break;
-                }
-                beta = beta / (1.0 - q);
+            let p = super::survival_probability(beta.max_component() * eta_scale);
+            if u_rr < 1.0 - p {
+                break;
             }
+            beta = beta / p;
         }
+        stats.bounce_rays += 1;
     }
     l
 }
@@ -335,9 +334,10 @@ pub fn irradiance(
 ) -> SampledSpectrum {
     use std::f32::consts::PI;
     let mut e = SampledSpectrum::ZERO;
-    if world.settings.max_depth == 0 {
+    if world.settings.max_depth == Some(0) {
         // (Light sampling alone would also be wrong here: its MIS weight assumes the cosine
         // strategy below, which a depth of 0 rules out.)
+        stats.truncated_paths += 1;
         return e;
     }
     let u_light = sampler.get1d();

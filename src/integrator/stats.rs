@@ -12,6 +12,9 @@ pub struct RayStats {
     /// connections count as shadow rays).
     pub light_paths: u64,
     pub light_rays: u64,
+    /// Camera, meter and light paths cut short at a finite `max_depth` (0 without one): while
+    /// it is above 0 the estimates lack the light of longer paths and are biased low.
+    pub truncated_paths: u64,
 }
 
 impl RayStats {
@@ -25,5 +28,6 @@ impl RayStats {
         self.non_finite += o.non_finite;
         self.light_paths += o.light_paths;
         self.light_rays += o.light_rays;
+        self.truncated_paths += o.truncated_paths;
     }
 }

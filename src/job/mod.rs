@@ -166,6 +166,8 @@ pub struct RenderOutputs {
     pub render: RenderResult,
     pub meters: Vec<MeterResult>,
     pub grids: Vec<GridResult>,
+    /// Paths of the image, meters and grids cut short at a finite `max_depth`, as a warning.
+    pub truncation: Option<String>,
 }
 
 impl RenderOutputs {
@@ -475,6 +477,7 @@ pub fn run(
         render: result,
         meters: Vec::new(),
         grids: Vec::new(),
+        truncation: None,
     };
     let result = &outputs.render;
     let mut writes = Writes::default();
@@ -544,6 +547,10 @@ pub fn run(
     }
     writes.finish()?;
     outputs.outputs = written;
+    outputs.truncation = crate::report::json::truncation_warning(
+        &world,
+        outputs.render.stats.truncated_paths + measurements.stats.truncated_paths,
+    );
     outputs.meters = world
         .meters
         .iter()

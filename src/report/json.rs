@@ -56,7 +56,23 @@ pub fn warnings(world: &World, render: &RenderResult, m: &Measurements) -> Vec<S
             render.stats.non_finite
         ));
     }
+    if let Some(w) = truncation_warning(
+        world,
+        render.stats.truncated_paths + m.stats.truncated_paths,
+    ) {
+        out.push(w);
+    }
     out
+}
+
+/// The warning for `truncated` paths cut short at the scene's finite `max_depth`, if any were.
+pub fn truncation_warning(world: &World, truncated: u64) -> Option<String> {
+    let max = world.settings.max_depth?;
+    (truncated > 0).then(|| {
+        format!(
+            "{truncated} paths reached max_depth {max} and were cut short: the image, meters and grids lack the light of longer paths and read low; leave max_depth out for unbiased results"
+        )
+    })
 }
 
 /// Everything a report says about one run.
@@ -193,6 +209,7 @@ pub fn report_json(r: &ReportInput) -> Value {
             "rays": stats_all.total_rays(),
             "light_paths": stats_all.light_paths,
             "non_finite_samples": stats_all.non_finite,
+            "truncated_paths": stats_all.truncated_paths,
         },
         "image": {
             "luminance": luminance,

@@ -201,11 +201,19 @@ pub fn build_for(
     if spp == 0 {
         return Err(ctx.err("render.spp", "samples per pixel must be at least 1"));
     }
-    let max_depth = overrides.max_depth.unwrap_or(r.max_depth);
-    if max_depth > 10_000 {
+    let max_depth = overrides.max_depth.or(r.max_depth);
+    if let Some(max_depth) = max_depth.filter(|&d| d > 10_000) {
         return Err(ctx.err(
             "render.max_depth",
             format!("{max_depth} is unreasonably deep (limit 10000)"),
+        ));
+    }
+    // Without a depth limit, a path that loses no light (a closed box of reflectance 1) only
+    // ends once Russian roulette begins, after rr_depth scatterings.
+    if r.rr_depth > 10_000 {
+        return Err(ctx.err(
+            "render.rr_depth",
+            format!("{} is unreasonably deep (limit 10000)", r.rr_depth),
         ));
     }
     let filter = PixelFilter::build(&ctx, &r.filter)?;

@@ -27,8 +27,9 @@ pub struct Object {
 pub struct RenderSettings {
     /// Camera samples per pixel.
     pub spp: u32,
-    /// Maximum number of scattering events along a path (0 = only directly visible emission).
-    pub max_depth: u32,
+    /// Maximum number of scattering events along a path (0 = only directly visible emission);
+    /// None = unlimited (paths end by Russian roulette only, and the estimate is unbiased).
+    pub max_depth: Option<u32>,
     /// Number of scattering events before Russian roulette may end a path.
     pub rr_depth: u32,
     pub seed: u64,
@@ -56,7 +57,7 @@ impl Default for RenderSettings {
     fn default() -> Self {
         Self {
             spp: 64,
-            max_depth: 16,
+            max_depth: None,
             rr_depth: 3,
             seed: 0,
             filter: PixelFilter::Box,
