@@ -426,6 +426,7 @@ fn meters_and_grids_with_non_finite_samples_are_flagged_in_the_report() {
         stderr: 0.1,
         samples: 2048,
         non_finite,
+        batches: 16,
     };
     let m = Measurements {
         meters: vec![e(0.0, 900), e(5.0, 0)],

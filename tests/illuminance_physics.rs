@@ -261,12 +261,18 @@ fn target_error_stops_when_reached() {
         objects: [(shape: Disk(center: (0, 2, 0), normal: (0, -1, 0), radius: 0.5), material: "black",
                    emission: (spectrum: Named("D65"), amount: Luminance(1000.0)))],
         meters: [Illuminance(name: "m", position: (0, 0, 0), normal: (0, 1, 0))],
-        measure: (samples: 256, target_relative_error: 0.002, max_samples: 1000000),
+        measure: (samples: 256, target_relative_error: 0.0002, max_samples: 1000000),
     )"#,
     );
     let e = measure_all(&w).meters[0];
-    assert!(e.relative_error() <= 0.002, "{e:?}");
+    assert!(e.relative_error() <= 0.0002, "{e:?}");
     assert!(e.samples > 256 && e.samples < 1_000_000, "{e:?}");
+    // It stopped at the first doubling that met the target: half as many did not.
+    let mut half = w;
+    half.measure.samples = e.samples / 2;
+    half.measure.target_relative_error = None;
+    let h = measure_all(&half).meters[0];
+    assert!(h.relative_error() > 0.0002, "{h:?}");
     assert!((e.mean - 184.7996).abs() <= 5.0 * e.stderr, "{e:?}");
 }
 

@@ -23,6 +23,7 @@ fn estimate(e: &Estimate, k: f64) -> Value {
         "ci95_low": (e.mean - e.ci95()) * k,
         "ci95_high": (e.mean + e.ci95()) * k,
         "samples": e.samples,
+        "batches": e.batches,
         "non_finite_samples": e.non_finite,
     })
 }
@@ -175,6 +176,7 @@ pub fn report_json(r: &ReportInput) -> Value {
                 "values": rows(&|e| json!(e.mean * ke)),
                 "stderr": rows(&|e| json!(e.stderr * ke)),
                 "samples": rows(&|e| json!(e.samples)),
+                "batches": crate::meter::BATCHES,
                 "non_finite_samples": grid_non_finite(est),
                 "E_min": s.min * ke, "E_avg": s.avg * ke, "E_max": s.max * ke,
                 "U0": s.u0, "E_min_over_E_max": s.min_over_max,

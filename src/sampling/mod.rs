@@ -7,5 +7,5 @@ pub mod sobol;
 pub mod warp;
 
 pub use discrete::{cdf_from_weights, choose_by_weight, pick_from_cdf};
-pub use sobol::{mix64, Sampler, ONE_MINUS_EPSILON};
+pub use sobol::{batch_stream, mix64, Sampler, ONE_MINUS_EPSILON};
 pub use warp::*;

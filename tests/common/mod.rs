@@ -171,10 +171,15 @@ pub fn conductor_reflectance(c: f64, n_re: f64, k: f64) -> f64 {
 }
 
 /// An estimate (mean ± standard error) within 5 standard errors of `expected`, with a standard
-/// error below `max_rel_se` of it (so that the check has power).
+/// error below `max_rel_se` of it (so that the check has power). Below 10⁻⁵ of `expected` the
+/// renderer is not a Monte Carlo estimate of the closed form alone: emission is scaled by a
+/// 1 nm sum of the spectrum against V(λ) while paths integrate its interpolant, in single
+/// precision (a D65 sky reads 1.6·10⁻⁶ low), so that much is allowed beside the 5 standard
+/// errors (stratified meters reach standard errors of 10⁻⁸).
 pub fn assert_estimate_near(mean: f64, stderr: f64, expected: f64, max_rel_se: f64, label: &str) {
     assert!(
-        (mean - expected).abs() <= 5.0 * stderr && stderr < max_rel_se * expected,
+        (mean - expected).abs() <= 5.0 * stderr + 1e-5 * expected.abs()
+            && stderr < max_rel_se * expected,
         "{label}: {mean} ± {stderr}, expected {expected}"
     );
 }
