@@ -9,10 +9,12 @@ target/bench/radiance/results.json. Progress goes to stderr.
 """
 
 import argparse
+import glob
 import hashlib
 import json
 import math
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -50,6 +52,11 @@ def sh(cmd, **kw):
     return subprocess.run(cmd, check=True, **kw)
 
 
+def children_cpu():
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
 class Bench:
     def __init__(self, a):
         self.a = a
@@ -66,8 +73,6 @@ class Bench:
         sh([sys.executable, os.path.join(HERE, "gen_scene.py"), "--n", str(n), "--ies", IES, "--out-dir", d])
         with open(os.path.join(d, f"office-{n}.oct"), "wb") as f:
             sh(["oconv", f"office-{n}.rad"], cwd=d, stdout=f)
-        with open(os.path.join(d, f"office-{n}.ron")) as f:
-            self.ron_template = f.read()
         return d
 
     def scene_hash(self, n):
@@ -93,15 +98,15 @@ class Bench:
         os.makedirs(outdir, exist_ok=True)
         cmd = [self.candela, "render", ron, "--threads", str(self.a.threads), "--seed", str(seed),
                "--out", outdir + "/", "--quiet", "--overwrite", "--checkpoint-interval", "0s"]
-        t0 = time.perf_counter()
+        c0, t0 = children_cpu(), time.perf_counter()
         sh(cmd, stdout=subprocess.DEVNULL)
-        wall = time.perf_counter() - t0
+        wall, cpu = time.perf_counter() - t0, children_cpu() - c0
         with open(os.path.join(outdir, f"{tag}.report.json")) as f:
             rep = json.load(f)
         g = rep["grids"][0]
         vals = [v for row in g["values"] for v in row]
         ses = [v for row in g["stderr"] for v in row]
-        return {"wall_s": wall, "measure_s": rep["timing"]["measure_seconds"], "values": vals, "stderr": ses,
+        return {"wall_s": wall, "cpu_s": cpu, "measure_s": rep["timing"]["measure_seconds"], "values": vals, "stderr": ses,
                 "samples": samples, "seed": seed}
 
     def run_radiance(self, n, args, nproc, seed):
@@ -112,39 +117,54 @@ class Bench:
             pts = f.read()
         dummy = "4 3 1.5 0 0 1\n" * seed
         cmd = ["rtrace", "-h", "-I", "-ov", "-n", str(nproc)] + args.split() + [f"office-{n}.oct"]
-        t0 = time.perf_counter()
+        c0, t0 = children_cpu(), time.perf_counter()
         p = subprocess.run(cmd, cwd=d, input=dummy + pts, capture_output=True, text=True, check=True)
-        wall = time.perf_counter() - t0
+        wall, cpu = time.perf_counter() - t0, children_cpu() - c0
         rows = [line.split() for line in p.stdout.strip().splitlines()][seed:]
         lux = [EFFICACY * sum(w * float(c) for w, c in zip(RGB_Y, r[:3])) for r in rows]
-        return {"wall_s": wall, "values": lux, "args": args, "nproc": nproc, "seed": seed}
+        return {"wall_s": wall, "cpu_s": cpu, "values": lux, "args": args, "nproc": nproc, "seed": seed}
 
     # ---------- references ----------
     def references(self, n):
+        """Both converged grids, each cached under a key of the scene files and its settings."""
         a = self.a
-        key = f"{self.scene_hash(n)}-c{a.ref_samples}x{a.ref_seeds}-r{a.ref_ad}x{a.ref_runs}ab{a.ref_ab}"
-        path = os.path.join(self.out, f"refs-{n}-{key}.json")
-        if os.path.exists(path) and not a.fresh_refs:
-            log(f"N={n}: cached references {os.path.basename(path)}")
-            with open(path) as f:
-                return json.load(f)
+        h = self.scene_hash(n)
+        return {
+            "candela": self.cached(f"refs-candela-{n}-{h}-{a.ref_samples}", a.ref_seeds, lambda: self.ref_candela(n)),
+            "radiance": self.cached(f"refs-radiance-{n}-{h}-{a.ref_ad}ab{a.ref_ab}", a.ref_runs,
+                                    lambda: self.ref_radiance(n)),
+        }
+
+    def cached(self, name, runs, make):
+        """A cached reference of these settings with at least `runs` runs (all of them used)."""
+        path = os.path.join(self.out, f"{name}x{runs}.json")
+        if not self.a.fresh_refs:
+            for p in sorted(glob.glob(os.path.join(self.out, name + "x*.json"))):
+                with open(p) as f:
+                    got = json.load(f)
+                if len(got) >= runs:
+                    log(f"cached: {os.path.basename(p)}")
+                    return got
+        got = make()
+        with open(path, "w") as f:
+            json.dump(got, f)
+        return got
+
+    def ref_candela(self, n):
+        a = self.a
         log(f"N={n}: candela reference, {a.ref_seeds} x {a.ref_samples} samples per point")
-        cruns = [self.run_candela(n, a.ref_samples, 1000 + k, f"ref-c{k}") for k in range(a.ref_seeds)]
+        return [self.run_candela(n, a.ref_samples, 1000 + k, f"ref-c{k}") for k in range(a.ref_seeds)]
+
+    def ref_radiance(self, n):
+        a = self.a
         log(f"N={n}: Radiance reference, {a.ref_runs} runs of {mc_args(a.ref_ad, a.ref_ab)}, 2 at a time")
-        rruns = []
+        runs = []
         t0 = time.perf_counter()
         for k in range(0, a.ref_runs, 2):
-            # Two single-process runs side by side (each its own random stream).
-            procs = []
-            for s in (k, k + 1):
-                if s < a.ref_runs:
-                    procs.append(s)
-            rruns += self.parallel_radiance(n, mc_args(a.ref_ad, a.ref_ab), procs)
-            log(f"  {len(rruns)}/{a.ref_runs} ({time.perf_counter() - t0:.0f} s)")
-        ref = {"key": key, "candela": cruns, "radiance": rruns}
-        with open(path, "w") as f:
-            json.dump(ref, f)
-        return ref
+            # Two single-process runs side by side, each with its own random stream.
+            runs += self.parallel_radiance(n, mc_args(a.ref_ad, a.ref_ab), [s for s in (k, k + 1) if s < a.ref_runs])
+            log(f"  {len(runs)}/{a.ref_runs} ({time.perf_counter() - t0:.0f} s)")
+        return runs
 
     def parallel_radiance(self, n, args, seeds):
         import concurrent.futures as cf
@@ -210,16 +230,18 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--ns", default="6,48", help="luminaire counts (6, 48, 500)")
     ap.add_argument("--reps", type=int, default=3, help="timed runs of each configuration")
+    ap.add_argument("--reps-high", type=int, default=3, help="timed runs of Radiance \"high\" (minutes each)")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--settings", default="medium,high,mc", help="Radiance settings to time")
     ap.add_argument("--mc-ad", type=int, default=256, help="-ad of the timed Monte Carlo mode")
-    ap.add_argument("--ref-samples", type=int, default=65536, help="candela reference samples per point")
+    ap.add_argument("--ref-samples", type=int, default=16384, help="candela reference samples per point")
     ap.add_argument("--ref-seeds", type=int, default=2)
     ap.add_argument("--ref-ad", type=int, default=512, help="-ad of each Radiance reference run")
-    ap.add_argument("--ref-runs", type=int, default=8, help="Radiance reference runs (averaged)")
+    ap.add_argument("--ref-runs", type=int, default=4, help="Radiance reference runs (averaged)")
     ap.add_argument("--ref-ab", type=int, default=16)
     ap.add_argument("--calib-samples", type=int, default=1024, help="candela run that sets its sample counts")
     ap.add_argument("--fresh-refs", action="store_true")
+    ap.add_argument("--radiance-refs-only", action="store_true", help="only make (and cache) Radiance's references")
     ap.add_argument("--quick", action="store_true", help="smoke run: N=6, small references, 1 rep, medium+mc")
     ap.add_argument("--check", action="store_true", help="exit 1 when the references disagree")
     a = ap.parse_args()
@@ -231,6 +253,9 @@ def main():
     disagree = False
     for n in [int(x) for x in a.ns.split(",")]:
         b.generate(n)
+        if a.radiance_refs_only:
+            b.cached(f"refs-radiance-{n}-{b.scene_hash(n)}-{a.ref_ad}ab{a.ref_ab}", a.ref_runs, lambda: b.ref_radiance(n))
+            continue
         ref = b.references(n)
         c, sc_rep, sc_spread = combine_candela(ref["candela"])
         r, sr = mean_se([x["values"] for x in ref["radiance"]])
@@ -258,7 +283,7 @@ def main():
             log(f"N={n}: {setting}: {args}")
             rad_runs, can_runs = [], []
             samples = None
-            for rep in range(a.reps):
+            for rep in range(a.reps_high if setting == "high" else a.reps):
                 rr = b.run_radiance(n, args, a.threads, 0 if rep == 0 else 5 * rep)
                 rr["rel_rms"], rr["rel_rms_raw"] = rel_rms(rr["values"], ref_v, ref_se)
                 rr["bias"] = bias(rr["values"], ref_v)
@@ -273,9 +298,11 @@ def main():
                 del cr["values"], cr["stderr"]
                 can_runs.append(cr)
                 log(f"  rep {rep}: Radiance {rr['wall_s']:.2f} s rel. RMS {rr['rel_rms']:.3%} (bias {rr['bias']:+.3%}); "
-                    f"candela {samples} samples {cr['wall_s']:.3f} s rel. RMS {cr['rel_rms']:.3%}")
+                    f"candela {samples} samples {cr['wall_s']:.3f} s (CPU {cr['cpu_s']:.2f} s; Radiance CPU {rr['cpu_s']:.1f} s) rel. RMS {cr['rel_rms']:.3%}")
             tr = [x["wall_s"] for x in rad_runs]
             tc = [x["wall_s"] for x in can_runs]
+            cr_ = [x["cpu_s"] for x in rad_runs]
+            cc_ = [x["cpu_s"] for x in can_runs]
             entry["timed"][setting] = {
                 "args": args,
                 "radiance": rad_runs,
@@ -286,13 +313,16 @@ def main():
                 "radiance_bias_median": statistics.median(x["bias"] for x in rad_runs),
                 "candela_time_median": statistics.median(tc), "candela_time_min": min(tc), "candela_time_max": max(tc),
                 "candela_rms_median": statistics.median(x["rel_rms"] for x in can_runs),
+                "radiance_cpu_median": statistics.median(cr_), "candela_cpu_median": statistics.median(cc_),
+                "cpu_ratio_median": statistics.median(cr_) / statistics.median(cc_),
                 "ratio_median": statistics.median(tr) / statistics.median(tc),
                 "ratio_min": min(tr) / max(tc), "ratio_max": max(tr) / min(tc),
             }
         results["ns"][str(n)] = entry
         with open(os.path.join(b.out, "results.json"), "w") as f:
             json.dump(results, f, indent=1)
-    print_table(results)
+    if not a.radiance_refs_only:
+        print_table(results)
     if a.check and disagree:
         sys.exit(1)
 
