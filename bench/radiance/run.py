@@ -240,11 +240,17 @@ def main():
     ap.add_argument("--ref-runs", type=int, default=4, help="Radiance reference runs (averaged)")
     ap.add_argument("--ref-ab", type=int, default=16)
     ap.add_argument("--calib-samples", type=int, default=1024, help="candela run that sets its sample counts")
+    ap.add_argument("--results", default="results.json", help="file name in target/bench/radiance/")
     ap.add_argument("--fresh-refs", action="store_true")
     ap.add_argument("--radiance-refs-only", action="store_true", help="only make (and cache) Radiance's references")
     ap.add_argument("--quick", action="store_true", help="smoke run: N=6, small references, 1 rep, medium+mc")
     ap.add_argument("--check", action="store_true", help="exit 1 when the references disagree")
+    ap.add_argument("--table", metavar="JSON", help="only print the table of a results file")
     a = ap.parse_args()
+    if a.table:
+        with open(a.table) as f:
+            print_table(json.load(f))
+        return
     if a.quick:
         a.ns, a.reps, a.settings = "6", 1, "medium,mc"
         a.ref_samples, a.ref_seeds, a.ref_ad, a.ref_runs, a.mc_ad = 8192, 2, 128, 4, 64
@@ -273,6 +279,7 @@ def main():
             ref_v.append((wc * ci + wr * ri) / (wc + wr))
             ref_se.append(math.sqrt(1 / (wc + wr)))
         entry = {"agreement": agree, "reference_E_avg": sum(ref_v) / len(ref_v), "timed": {}}
+        results["ns"][str(n)] = entry
         # candela's calibration run: error at calib-samples, then RMS^2 ~ 1/samples.
         cal = b.run_candela(n, a.calib_samples, 7, "calib")
         cal_rms = rel_rms(cal["values"], ref_v, ref_se)[0]
@@ -284,7 +291,8 @@ def main():
             rad_runs, can_runs = [], []
             samples = None
             for rep in range(a.reps_high if setting == "high" else a.reps):
-                rr = b.run_radiance(n, args, a.threads, 0 if rep == 0 else 5 * rep)
+                # rtrace seeds its random numbers itself (repeated runs differ): no dummy points here.
+                rr = b.run_radiance(n, args, a.threads, 0)
                 rr["rel_rms"], rr["rel_rms_raw"] = rel_rms(rr["values"], ref_v, ref_se)
                 rr["bias"] = bias(rr["values"], ref_v)
                 del rr["values"]
@@ -318,9 +326,10 @@ def main():
                 "ratio_median": statistics.median(tr) / statistics.median(tc),
                 "ratio_min": min(tr) / max(tc), "ratio_max": max(tr) / min(tc),
             }
-        results["ns"][str(n)] = entry
-        with open(os.path.join(b.out, "results.json"), "w") as f:
-            json.dump(results, f, indent=1)
+            # Saved after every setting, so an interrupted run keeps what it measured.
+            results["ns"][str(n)] = entry
+            with open(os.path.join(b.out, a.results), "w") as f:
+                json.dump(results, f, indent=1)
     if not a.radiance_refs_only:
         print_table(results)
     if a.check and disagree:
@@ -328,19 +337,23 @@ def main():
 
 
 def print_table(results):
-    print("| N | agreement: mean rel. diff candela − Radiance (points > 3σ) | Radiance setting | Radiance time s | Radiance rel. RMS (bias) | candela samples/point | candela time s | candela rel. RMS | ratio |")
-    print("|---:|---|---|---:|---:|---:|---:|---:|---:|")
+    print("| N | candela − Radiance, converged (points > 3σ) | Radiance setting | Radiance wall s | Radiance rel. RMS (bias) "
+          "| candela samples/point | candela wall s | candela rel. RMS | wall-time ratio | CPU-time ratio |")
+    print("|---:|---|---|---:|---:|---:|---:|---:|---:|---:|")
     for n, e in results["ns"].items():
         ag = e["agreement"]
         first = True
         for setting, t in e["timed"].items():
             agree = (f"{ag['mean_rel_diff']:+.2%} ± {ag['se_mean_rel_diff']:.2%} ({ag['beyond_3sigma']}/{ag['points']})"
                      if first else "")
-            first = False
-            print(f"| {n if agree else ''} | {agree} | {setting} | {t['radiance_time_median']:.2f} ({t['radiance_time_min']:.2f}–{t['radiance_time_max']:.2f}) | "
+            reps = len(t["radiance"])
+            print(f"| {n if first else ''} | {agree} | {setting} ({reps} run{'s' if reps > 1 else ''}) | "
+                  f"{t['radiance_time_median']:.1f} ({t['radiance_time_min']:.1f}–{t['radiance_time_max']:.1f}) | "
                   f"{t['radiance_rms_median']:.2%} ({t['radiance_bias_median']:+.2%}) | {t['candela_samples']} | "
-                  f"{t['candela_time_median']:.3f} ({t['candela_time_min']:.3f}–{t['candela_time_max']:.3f}) | {t['candela_rms_median']:.2%} | "
-                  f"**{t['ratio_median']:.0f}×** ({t['ratio_min']:.0f}–{t['ratio_max']:.0f}) |")
+                  f"{t['candela_time_median']:.2f} ({t['candela_time_min']:.2f}–{t['candela_time_max']:.2f}) | "
+                  f"{t['candela_rms_median']:.2%} | **{t['ratio_median']:.0f}×** ({t['ratio_min']:.0f}–{t['ratio_max']:.0f}) | "
+                  f"{t['cpu_ratio_median']:.0f}× |")
+            first = False
 
 
 if __name__ == "__main__":
