@@ -336,9 +336,13 @@ def main():
         sys.exit(1)
 
 
+def ratio(x):
+    return f"{x:.1f}" if x < 10 else f"{x:.0f}"
+
+
 def print_table(results):
     print("| N | candela − Radiance, converged (points > 3σ) | Radiance setting | Radiance wall s | Radiance rel. RMS (bias) "
-          "| candela samples/point | candela wall s | candela rel. RMS | wall-time ratio | CPU-time ratio |")
+          "| candela samples/point | candela wall s | candela rel. RMS | wall-time ratio | CPU-time ratio (medians) |")
     print("|---:|---|---|---:|---:|---:|---:|---:|---:|---:|")
     for n, e in results["ns"].items():
         ag = e["agreement"]
@@ -348,11 +352,11 @@ def print_table(results):
                      if first else "")
             reps = len(t["radiance"])
             print(f"| {n if first else ''} | {agree} | {setting} ({reps} run{'s' if reps > 1 else ''}) | "
-                  f"{t['radiance_time_median']:.1f} ({t['radiance_time_min']:.1f}–{t['radiance_time_max']:.1f}) | "
+                  f"{t['radiance_time_median']:.1f} ({t['radiance_time_min']:.1f}–{t['radiance_time_max']:.1f}); CPU {t['radiance_cpu_median']:.2f} | "
                   f"{t['radiance_rms_median']:.2%} ({t['radiance_bias_median']:+.2%}) | {t['candela_samples']} | "
-                  f"{t['candela_time_median']:.2f} ({t['candela_time_min']:.2f}–{t['candela_time_max']:.2f}) | "
-                  f"{t['candela_rms_median']:.2%} | **{t['ratio_median']:.0f}×** ({t['ratio_min']:.0f}–{t['ratio_max']:.0f}) | "
-                  f"{t['cpu_ratio_median']:.0f}× |")
+                  f"{t['candela_time_median']:.2f} ({t['candela_time_min']:.2f}–{t['candela_time_max']:.2f}); CPU {t['candela_cpu_median']:.2f} | "
+                  f"{t['candela_rms_median']:.2%} | {ratio(t['ratio_median'])}× ({ratio(t['ratio_min'])}–{ratio(t['ratio_max'])}) | "
+                  f"**{ratio(t['cpu_ratio_median'])}×** |")
             first = False
 
 
