@@ -232,7 +232,7 @@ def main():
     ap.add_argument("--reps", type=int, default=3, help="timed runs of each configuration")
     ap.add_argument("--reps-high", type=int, default=3, help="timed runs of Radiance \"high\" (minutes each)")
     ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--settings", default="medium,high,mc", help="Radiance settings to time")
+    ap.add_argument("--settings", default="mc,medium", help="Radiance settings to time: mc, medium, high")
     ap.add_argument("--mc-ad", type=int, default=256, help="-ad of the timed Monte Carlo mode")
     ap.add_argument("--ref-samples", type=int, default=16384, help="candela reference samples per point")
     ap.add_argument("--ref-seeds", type=int, default=2)
@@ -252,7 +252,7 @@ def main():
             print_table(json.load(f))
         return
     if a.quick:
-        a.ns, a.reps, a.settings = "6", 1, "medium,mc"
+        a.ns, a.reps, a.settings = "6", 1, "mc,medium"
         a.ref_samples, a.ref_seeds, a.ref_ad, a.ref_runs, a.mc_ad = 8192, 2, 128, 4, 64
     b = Bench(a)
     results = {"settings": vars(a), "presets": PRESETS, "machine": os.uname().nodename, "ns": {}}
