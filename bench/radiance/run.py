@@ -91,6 +91,7 @@ class Bench:
         ron = os.path.join(d, f"{tag}.ron")
         with open(os.path.join(d, f"office-{n}.ron")) as f:
             text = f.read()
+        assert "measure: (samples: 4096)" in text, "gen_scene.py's default measure.samples changed"
         text = text.replace("measure: (samples: 4096)", f"measure: (samples: {samples})")
         with open(ron, "w") as f:
             f.write(text)
