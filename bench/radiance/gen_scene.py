@@ -1,0 +1,171 @@
+#!/usr/bin/env python3
+"""Writes the office of the Radiance benchmark for candela and for Radiance.
+
+The room is 8 m x 6 m x 3 m, grey and Lambertian (ceiling 0.8, walls 0.7, floor 0.2), lit by N
+copies of one IES luminaire on a regular ceiling layout, with a 16 x 12 work-plane grid at
+0.8 m. Radiance is z-up; candela is y-up. A Radiance point (X, Y, Z) is candela's
+(X, Z, 6 - Y): a proper rotation (no mirror), so an asymmetric luminaire keeps its handedness.
+Both tools put C0 along +X and C90 along Radiance's +Y (= candela's -Z), nadir down.
+
+Outputs in --out-dir:
+  office-N.ron         candela scene (grid "work plane", measure.samples = --samples)
+  office-N.rad         Radiance scene: materials, room polygons, one illum sphere per luminaire
+  lum.dat              ies2rad's candela table (-dm: metres; -i: small sphere), read by office-N.rad
+  points.txt           the grid's points in Radiance coordinates with +z normals (rtrace -I),
+                       in the order of candela's grid CSV (j outer, i inner)
+"""
+
+import argparse
+import os
+import subprocess
+import sys
+
+ROOM = (8.0, 6.0, 3.0)  # X (length), Y (depth), Z (height), metres
+RHO = {"ceiling": 0.8, "wall": 0.7, "floor": 0.2}
+GRID_NX, GRID_NY, GRID_H = 16, 12, 0.8
+LUM_Z = 2.95  # luminaire centre height, m (5 cm below the ceiling)
+LUM_RADIUS = 0.01  # radius of Radiance's illum sphere, m: a near point source, like candela's
+
+# Layouts: columns x rows of luminaires at the centres of equal cells of the ceiling.
+LAYOUTS = {6: (3, 2), 48: (8, 6), 500: (25, 20)}
+
+
+def layout(n):
+    if n not in LAYOUTS:
+        sys.exit(f"no layout for N={n}; known: {sorted(LAYOUTS)}")
+    cols, rows = LAYOUTS[n]
+    lx, ly, _ = ROOM
+    return [((c + 0.5) * lx / cols, (r + 0.5) * ly / rows, LUM_Z) for r in range(rows) for c in range(cols)]
+
+
+def grid_points():
+    """Radiance coordinates of the grid points, in candela's order (j outer, i inner)."""
+    lx, ly, _ = ROOM
+    pts = []
+    # candela grid: origin (0, 0.8, 0), edge_u (8, 0, 0), edge_v (0, 0, 6); point (i, j) at
+    # x = (i + 1/2) * 8/16, z = (j + 1/2) * 6/12, i.e. Radiance Y = 6 - z.
+    for j in range(GRID_NY):
+        for i in range(GRID_NX):
+            x = (i + 0.5) * lx / GRID_NX
+            z = (j + 0.5) * ly / GRID_NY
+            pts.append((x, ly - z, GRID_H))
+    return pts
+
+
+def to_candela(p):
+    x, y, z = p
+    return (x, z, ROOM[1] - y)
+
+
+def fmt(v):
+    return "(" + ", ".join(f"{c:.6g}" for c in v) + ")"
+
+
+def candela_scene(n, ies_rel, samples, max_depth):
+    lx, ly, lz = ROOM
+    lights = "\n".join(
+        f"        Goniometric(file: \"{ies_rel}\", position: {fmt(to_candela(p))}, spectrum: Named(\"E\")),"
+        for p in layout(n)
+    )
+    # Quads in candela coordinates: x in [0, 8], y in [0, 3] (up), z in [0, 6].
+    return f"""// Radiance benchmark office (bench/radiance/gen_scene.py): {lx:g} x {ly:g} x {lz:g} m, N = {n}
+// luminaires, grey Lambertian surfaces, 16 x 12 work-plane grid at 0.8 m. Generated; do not edit.
+Scene(
+    camera: (position: (4.0, 1.6, 0.5), look_at: (4.0, 1.2, 6.0), vfov_deg: 60.0, resolution: (1, 1)),
+    render: (spp: 1, max_depth: {max_depth}),
+    materials: {{
+        "ceiling": Diffuse(reflectance: Constant({RHO['ceiling']})),
+        "wall": Diffuse(reflectance: Constant({RHO['wall']})),
+        "floor": Diffuse(reflectance: Constant({RHO['floor']})),
+    }},
+    objects: [
+        (name: "floor", material: "floor",
+         shape: Quad(origin: (0.0, 0.0, 0.0), edge_u: (0.0, 0.0, {ly}), edge_v: ({lx}, 0.0, 0.0))),
+        (name: "ceiling", material: "ceiling",
+         shape: Quad(origin: (0.0, {lz}, 0.0), edge_u: ({lx}, 0.0, 0.0), edge_v: (0.0, 0.0, {ly}))),
+        (name: "wall x=0", material: "wall",
+         shape: Quad(origin: (0.0, 0.0, 0.0), edge_u: (0.0, {lz}, 0.0), edge_v: (0.0, 0.0, {ly}))),
+        (name: "wall x=8", material: "wall",
+         shape: Quad(origin: ({lx}, 0.0, 0.0), edge_u: (0.0, 0.0, {ly}), edge_v: (0.0, {lz}, 0.0))),
+        (name: "wall z=0", material: "wall",
+         shape: Quad(origin: (0.0, 0.0, 0.0), edge_u: ({lx}, 0.0, 0.0), edge_v: (0.0, {lz}, 0.0))),
+        (name: "wall z=6", material: "wall",
+         shape: Quad(origin: (0.0, 0.0, {ly}), edge_u: (0.0, {lz}, 0.0), edge_v: ({lx}, 0.0, 0.0))),
+    ],
+    grids: [
+        (name: "work plane", origin: (0.0, {GRID_H}, 0.0), edge_u: ({lx}, 0.0, 0.0), edge_v: (0.0, 0.0, {ly}), nx: {GRID_NX}, ny: {GRID_NY}),
+    ],
+    measure: (samples: {samples}),
+    lights: [
+{lights}
+    ],
+)
+"""
+
+
+def radiance_scene(n, lum_modifiers):
+    lx, ly, lz = ROOM
+    out = [
+        f"# Radiance benchmark office (bench/radiance/gen_scene.py), N = {n}. Generated; do not edit.",
+        "# Grey Lambertian: plastic with zero specularity and roughness.",
+    ]
+    for name, rho in RHO.items():
+        out.append(f"void plastic {name}\n0\n0\n5 {rho} {rho} {rho} 0 0")
+
+    def poly(mat, name, pts):
+        coords = "\n".join(f"  {x:g} {y:g} {z:g}" for x, y, z in pts)
+        out.append(f"{mat} polygon {name}\n0\n0\n{3 * len(pts)}\n{coords}")
+
+    poly("floor", "floor", [(0, 0, 0), (0, ly, 0), (lx, ly, 0), (lx, 0, 0)])
+    poly("ceiling", "ceiling", [(0, 0, lz), (lx, 0, lz), (lx, ly, lz), (0, ly, lz)])
+    poly("wall", "wall_x0", [(0, 0, 0), (0, 0, lz), (0, ly, lz), (0, ly, 0)])
+    poly("wall", "wall_x8", [(lx, 0, 0), (lx, ly, 0), (lx, ly, lz), (lx, 0, lz)])
+    poly("wall", "wall_y0", [(0, 0, 0), (lx, 0, 0), (lx, 0, lz), (0, 0, lz)])
+    poly("wall", "wall_y6", [(0, ly, 0), (0, ly, lz), (lx, ly, lz), (lx, ly, 0)])
+    # ies2rad's modifier chain (brightdata -> illum 'lum_light') is direction-only, so every
+    # luminaire is a sphere of that modifier at its own centre, none rotated.
+    out.append(lum_modifiers)
+    for k, (x, y, z) in enumerate(layout(n)):
+        out.append(f"lum_light sphere lum_{k}\n0\n0\n4 {x:.6g} {y:.6g} {z:.6g} {LUM_RADIUS}")
+    return "\n".join(out) + "\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--n", type=int, required=True, help="number of luminaires (6, 48 or 500)")
+    ap.add_argument("--ies", required=True, help="IES file")
+    ap.add_argument("--out-dir", required=True)
+    ap.add_argument("--samples", type=int, default=4096, help="candela measure.samples per grid point")
+    ap.add_argument("--max-depth", type=int, default=1000, help="candela render.max_depth")
+    ap.add_argument("--ies2rad", default="ies2rad")
+    ap.add_argument("--name", help="file stem (default office-N)")
+    a = ap.parse_args()
+
+    os.makedirs(a.out_dir, exist_ok=True)
+    stem = a.name or f"office-{a.n}"
+    ies_abs = os.path.abspath(a.ies)
+    ies_rel = os.path.relpath(ies_abs, os.path.abspath(a.out_dir))
+    with open(os.path.join(a.out_dir, stem + ".ron"), "w") as f:
+        f.write(candela_scene(a.n, ies_rel, a.samples, a.max_depth))
+    # -dm: the file's dimensions and Radiance's output in metres; -i: ignore the file's luminous
+    # opening (0.3 x 1.2 m) and emit from a sphere of LUM_RADIUS, as candela's point source;
+    # -t default: white lamp (RGB 1 1 1), so 179 lm/W turns its radiance back into the candela.
+    conv = subprocess.run(
+        [a.ies2rad, "-dm", "-i", str(LUM_RADIUS), "-t", "default", "-o", "lum", "-s", ies_abs],
+        cwd=a.out_dir,
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    # Keep the modifiers (brightdata, illum); drop ies2rad's own sphere at the origin.
+    cut = conv.index("'lum_light' sphere")
+    mods = conv[:cut].rstrip() + "\n"
+    with open(os.path.join(a.out_dir, stem + ".rad"), "w") as f:
+        f.write(radiance_scene(a.n, mods))
+    with open(os.path.join(a.out_dir, "points.txt"), "w") as f:
+        for x, y, z in grid_points():
+            f.write(f"{x:.6g} {y:.6g} {z:.6g} 0 0 1\n")
+
+
+if __name__ == "__main__":
+    main()
