@@ -321,7 +321,9 @@ def scene_xml(scene, files):
     assert render.get("filter", {"$type": "Box"})["$type"] == "Box"
     assert "aperture_radius" not in cam and "lens" not in cam
     width, height = cam["resolution"]
-    max_depth = int(render["max_depth"]) + MITSUBA_DEPTH_OFFSET
+    # No max_depth in the scene: candela's default, unlimited (Mitsuba's -1).
+    depth = render.get("max_depth")
+    max_depth = -1 if depth is None else int(depth) + MITSUBA_DEPTH_OFFSET
     mats = "\n".join(bsdf_xml(mid, m, files) for mid, m in scene["materials"].items())
     shapes = "\n".join(shape_xml(o, files) for o in scene["objects"])
     return f"""<?xml version="1.0" encoding="utf-8"?>
@@ -334,7 +336,7 @@ def scene_xml(scene, files):
     <default name="rr_depth" value="5"/>
     <default name="max_depth" value="{max_depth}"/>
 
-    <!-- candela max_depth {int(render['max_depth'])} (scattering events) = Mitsuba max_depth {max_depth} (segments) -->
+    <!-- candela max_depth {"unlimited" if depth is None else int(depth)} (scattering events) = Mitsuba max_depth {max_depth} (segments) -->
     <integrator type="path">
         <integer name="max_depth" value="$max_depth"/>
         <integer name="rr_depth" value="$rr_depth"/>
