@@ -3,6 +3,7 @@
 //! usage errors do (docs/guarantees.md).
 
 mod common;
+use common::listing;
 use std::path::Path;
 use std::process::Command;
 
@@ -192,16 +193,6 @@ fn out_file_name_is_respected() {
 fn candela_in(dir: &Path, args: &[&str]) -> (i32, String) {
     let (code, _, stderr) = common::cli(args, dir);
     (code, stderr)
-}
-
-/// The sorted names of the files in `dir`.
-fn listing(dir: &Path) -> Vec<String> {
-    let mut files: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    files.sort();
-    files
 }
 
 /// Exit code 1, no panic, and every needle in the message.

@@ -3,6 +3,7 @@
 
 mod common;
 use candela::job::{self, Outcome, Progress, RenderJob};
+use common::listing;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
@@ -34,16 +35,6 @@ fn grid(name: &str) -> String {
     format!(
         "(name: {name:?}, origin: (-0.5, -0.5, 1.9), edge_u: (1, 0, 0), edge_v: (0, 1, 0), nx: 2, ny: 2, normal: (0, 0, -1))"
     )
-}
-
-/// The sorted names of the files in `dir`.
-fn listing(dir: &Path) -> Vec<String> {
-    let mut files: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    files.sort();
-    files
 }
 
 /// Exit code 1, one line naming every needle, and the directory exactly as before.

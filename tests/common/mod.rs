@@ -217,3 +217,13 @@ pub fn render_states(dir: &Path, scene: &str, runs: &[(&str, &str)]) {
         assert_eq!(code, 0, "{stderr}");
     }
 }
+
+/// The sorted names of the files in `dir`.
+pub fn listing(dir: &Path) -> Vec<String> {
+    let mut files: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    files
+}
