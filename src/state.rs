@@ -183,6 +183,7 @@ pub fn scene_hash(scene_text: &[u8], world: &World) -> u64 {
     h = mix64(h ^ world.settings.illuminance as u64);
     h = mix64(h ^ world.caustics.is_some() as u64);
     h = mix64(h ^ world.settings.light_paths_per_sample.to_bits() as u64);
+    h = mix64(h ^ world.settings.light_sampler as u64);
     mix64(h ^ ((world.camera.width as u64) << 32 | world.camera.height as u64))
 }
 

@@ -198,6 +198,18 @@ pub struct RenderDesc {
     /// With light-traced caustics: light paths per camera sample.
     #[serde(default = "default_light_paths_per_sample")]
     pub light_paths_per_sample: f32,
+    /// How next-event estimation chooses a light (see `light::sampler`).
+    #[serde(default)]
+    pub light_sampler: LightSamplerDesc,
+}
+
+/// See `light::LightSamplerKind`.
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum LightSamplerDesc {
+    #[default]
+    Bvh,
+    Power,
 }
 
 /// Light paths per camera sample unless the scene says otherwise: aimed at the specular
@@ -229,6 +241,7 @@ impl Default for RenderDesc {
             illuminance: false,
             caustics: CausticsDesc::LightTracing,
             light_paths_per_sample: default_light_paths_per_sample(),
+            light_sampler: LightSamplerDesc::Bvh,
         }
     }
 }

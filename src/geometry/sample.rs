@@ -12,6 +12,14 @@ impl SceneGeometry {
         self.prim(prim).area()
     }
 
+    /// Bounding box (m) of a primitive and, for a flat one, its unit front-face normal (the
+    /// normal [`SceneGeometry::sample_prim`] gives everywhere on it); None for a sphere.
+    pub fn prim_bounds_normal(&self, prim: u32) -> ((Vec3, Vec3), Option<Vec3>) {
+        let pr = self.prim(prim);
+        let n = (!matches!(pr, Prim::Sphere { .. })).then(|| pr.sample_area(Vec2::splat(0.5)).1);
+        (pr.bounds(), n)
+    }
+
     /// Uniform by area on the primitive: point, unit front-face geometric normal; the pdf
     /// w.r.t. area is `1 / prim_area(prim)`. `u` ∈ [0,1)². The point's error bound is
     /// [`super::point_error_bound`] (it is computed in f64).

@@ -37,6 +37,8 @@ pub struct PathStart {
     pub pdf: f32,
     /// The point the ray leaves (for the light-sampling density of what it hits).
     pub p: Vec3,
+    /// The normal light selection used at `p` (None for a camera).
+    pub n: Option<Vec3>,
     /// Scattering events already on the path (0 for a camera ray).
     pub depth: u32,
     /// A camera ray whose caustic paths (first surface scattered non-specularly, last
@@ -52,6 +54,7 @@ impl PathStart {
             specular: true,
             pdf: 0.0,
             p,
+            n: None,
             depth: 0,
             caustics_by_light_tracing: false,
         }
@@ -87,6 +90,7 @@ pub fn trace(
     let mut prev_specular = start.specular;
     let mut prev_pdf = start.pdf;
     let mut prev_p = start.p;
+    let mut prev_n = start.n;
     let mut depth = start.depth;
     // Product of η′² over the refractions so far (see `Material::eta_scale`), for Russian
     // roulette only.
@@ -111,8 +115,8 @@ pub fn trace(
                 if prev_specular {
                     l += beta * le;
                 } else {
-                    let p_light =
-                        world.light_sampler.pmf(li as usize) * light.pdf_li_escape(prev_p, ray_d);
+                    let p_light = world.light_sampler.pmf(prev_p, prev_n, li as usize, 0)
+                        * light.pdf_li_escape(prev_p, ray_d);
                     l += beta * le * power_heuristic(prev_pdf, p_light);
                 }
             }
@@ -136,8 +140,10 @@ pub fn trace(
                 if prev_specular {
                     l += beta * le;
                 } else {
-                    let p_light = world.light_sampler.pmf(li as usize)
-                        * light.pdf_li_hit(&world.geometry, prev_p, &hit);
+                    let p_light = world
+                        .light_sampler
+                        .pmf(prev_p, prev_n, li as usize, hit.prim)
+                        * light.pdf_li_hit_prim(&world.geometry, prev_p, &hit);
                     l += beta * le * power_heuristic(prev_pdf, p_light);
                 }
             }
@@ -195,11 +201,11 @@ pub fn trace(
         {
             None
         } else {
-            world.light_sampler.sample(u_light)
+            world.light_sampler.sample(hit.p, Some(hit.ns), u_light)
         };
-        if let Some((k, p_select)) = light_sample {
+        if let Some((k, prim, p_select)) = light_sample {
             let light = &world.lights[k];
-            if let Some(ls) = light.sample_li(&world.geometry, hit.p, u_prim, u_pt, wl) {
+            if let Some(ls) = light.sample_li_prim(&world.geometry, hit.p, prim, u_prim, u_pt, wl) {
                 if ls.pdf > 0.0 && !ls.li.is_black() {
                     let wi = frame.to_local(ls.wi);
                     let f = material.eval(wo, wi, wl) * wi.z.abs();
@@ -242,6 +248,7 @@ pub fn trace(
         straight_through = 0;
         prev_pdf = bs.pdf;
         prev_p = hit.p;
+        prev_n = Some(hit.ns);
         let wi_world = frame.to_world(bs.wi);
         ray_o = hit.spawn_origin(wi_world);
         ray_d = wi_world.normalize();
@@ -343,9 +350,9 @@ pub fn irradiance(
     let u_light = sampler.get1d();
     let u_prim = sampler.get1d();
     let u_pt = sampler.get2d();
-    if let Some((k, p_select)) = world.light_sampler.sample(u_light) {
+    if let Some((k, prim, p_select)) = world.light_sampler.sample(at.p, Some(n), u_light) {
         let light = &world.lights[k];
-        if let Some(ls) = light.sample_li(&world.geometry, at.p, u_prim, u_pt, wl) {
+        if let Some(ls) = light.sample_li_prim(&world.geometry, at.p, prim, u_prim, u_pt, wl) {
             let cos = ls.wi.dot(n);
             if cos > 0.0 && ls.pdf > 0.0 && !ls.li.is_black() {
                 stats.shadow_rays += 1;
@@ -371,6 +378,7 @@ pub fn irradiance(
                 specular: false,
                 pdf: crate::sampling::cosine_hemisphere_pdf(local.z),
                 p: at.p,
+                n: Some(n),
                 depth: 1,
                 caustics_by_light_tracing,
             };

@@ -142,7 +142,21 @@ impl AreaLight {
         wl: &SampledWavelengths,
     ) -> Option<LightSample> {
         let (k, p_prim) = pick_from_cdf(&self.cdf, uc);
-        let prim = self.prims[k];
+        let mut ls = self.sample_li_prim(geom, p, self.prims[k], u, wl)?;
+        ls.pdf *= p_prim;
+        Some(ls)
+    }
+
+    /// A point on primitive `prim` (one of `prims`) seen from `p`, by solid angle; `pdf` is
+    /// the density within that primitive (its choice is the caller's).
+    pub fn sample_li_prim(
+        &self,
+        geom: &SceneGeometry,
+        p: Vec3,
+        prim: u32,
+        u: Vec2,
+        wl: &SampledWavelengths,
+    ) -> Option<LightSample> {
         let (sp, pdf_sa) = geom.sample_prim_solid_angle(prim, p, u)?;
         let d = sp.p - p;
         let dist = d.length();
@@ -157,7 +171,7 @@ impl AreaLight {
         Some(LightSample {
             wi,
             li: self.radiance.sample(wl),
-            pdf: pdf_sa * p_prim,
+            pdf: pdf_sa,
             dist,
             point: Some((sp.p, sp.n)),
             delta: false,

@@ -150,6 +150,71 @@ impl GoniometricLight {
         self.distribution.lumens() * luminous_integral(&self.spectrum)
     }
 
+    /// Peak table candela times the spectrum's luminous content: the largest luminous
+    /// intensity (cd) toward any direction (interpolation never exceeds the table's values).
+    pub fn peak_candela(&self) -> f64 {
+        let peak = self.distribution.values.iter().copied().fold(0.0, f64::max);
+        peak * luminous_integral(&self.spectrum)
+    }
+
+    /// A cone (unit world axis, cosine of its half-angle) containing every direction of
+    /// non-zero intensity, for the light BVH's bounds. Interpolation spreads a table value over
+    /// the cells around it, so the support is the cells touching a non-zero value, widened by
+    /// 0.01° for rounding. Type C: around the nadir (γ = 0) or the zenith, whichever is narrower (a
+    /// downlight lighting only the lower hemisphere gets the nadir with cos = 0). Types A and
+    /// B: around their polar axis if the support lies within 90° of it, else the sphere.
+    pub fn emission_cone(&self) -> (Vec3, f32) {
+        use crate::luminaire::Kind;
+        const MARGIN_DEG: f64 = 0.01;
+        let d = &*self.distribution;
+        let (np, na) = (d.planes.len(), d.angles.len());
+        let sphere = (self.rotation * -Vec3::Y, -1.0);
+        if np == 0 || na == 0 || d.values.len() != np * na {
+            return sphere;
+        }
+        let lit = |i: usize, j: usize| d.values[i * na + j] > 0.0;
+        // Index ranges of non-zero vertices, widened by one cell each way.
+        let lit_angles: Vec<usize> = (0..na).filter(|&j| (0..np).any(|i| lit(i, j))).collect();
+        let lit_planes: Vec<usize> = (0..np).filter(|&i| (0..na).any(|j| lit(i, j))).collect();
+        let (Some(&j0), Some(&j1)) = (lit_angles.first(), lit_angles.last()) else {
+            return sphere;
+        };
+        let a_lo = d.angles[j0.saturating_sub(1)] - MARGIN_DEG;
+        let a_hi = d.angles[(j1 + 1).min(na - 1)] + MARGIN_DEG;
+        let cone = match d.kind {
+            Kind::C => {
+                let down = a_hi.clamp(0.0, 180.0);
+                let up = (180.0 - a_lo).clamp(0.0, 180.0);
+                if down <= up {
+                    (-Vec3::Y, down)
+                } else {
+                    (Vec3::Y, up)
+                }
+            }
+            Kind::A | Kind::B => {
+                // cos(angle to the polar axis −y) = cos(plane) · cos(angle).
+                let i0 = lit_planes[0];
+                let i1 = lit_planes[lit_planes.len() - 1];
+                let p_lo = d.planes[i0.saturating_sub(1)] - MARGIN_DEG;
+                let p_hi = d.planes[(i1 + 1).min(np - 1)] + MARGIN_DEG;
+                let pmax = p_lo.abs().max(p_hi.abs());
+                let amax = a_lo.abs().max(a_hi.abs());
+                if pmax >= 90.0 || amax >= 90.0 {
+                    return sphere;
+                }
+                let c = pmax.to_radians().cos() * amax.to_radians().cos();
+                (-Vec3::Y, c.clamp(-1.0, 1.0).acos().to_degrees())
+            }
+        };
+        let (axis, half_deg) = cone;
+        let cos = if half_deg >= 180.0 {
+            -1.0
+        } else {
+            half_deg.to_radians().cos() as f32
+        };
+        ((self.rotation * axis).normalize(), cos)
+    }
+
     /// Emission direction (world) sampled by the intensity distribution, its density per
     /// steradian, and the table candela in that direction.
     pub fn sample_emission(&self, u0: f32, u: Vec2) -> Option<(Vec3, f32, f64)> {

@@ -9,6 +9,8 @@
 //! | environment, area | radiance L_e(λ) | W·m⁻²·sr⁻¹·nm⁻¹ |
 
 pub mod area;
+pub mod bounds;
+pub mod bvh;
 pub mod distant;
 pub mod environment;
 pub mod goniometric;
@@ -29,7 +31,7 @@ pub use environment::EnvironmentLight;
 pub use goniometric::GoniometricLight;
 pub use point::PointLight;
 pub use portal::{Portal, Portals};
-pub use sampler::LightSampler;
+pub use sampler::{LightSampler, LightSamplerKind};
 pub use spot::SpotLight;
 
 #[derive(Clone, Debug)]
@@ -196,6 +198,24 @@ impl Light {
         }
     }
 
+    /// [`Light::sample_li`] with the primitive of an area light already chosen (`prim`, a
+    /// primitive id of the light, as [`LightSampler`] returns it): `pdf` is then the density
+    /// within that primitive. Other lights ignore `prim`.
+    pub fn sample_li_prim(
+        &self,
+        geom: &SceneGeometry,
+        p: Vec3,
+        prim: u32,
+        uc: f32,
+        u: Vec2,
+        wl: &SampledWavelengths,
+    ) -> Option<LightSample> {
+        match self {
+            Light::Area(a) => a.sample_li_prim(geom, p, prim, u, wl),
+            _ => self.sample_li(geom, p, uc, u, wl),
+        }
+    }
+
     /// The single direction from `p` toward a point-like source at `position`, with
     /// li = I_e(ω)/d² (None if the source sends nothing toward `p`).
     fn sample_li_from(
@@ -229,6 +249,15 @@ impl Light {
     pub fn pdf_li_hit(&self, geom: &SceneGeometry, p: Vec3, hit: &Hit) -> f32 {
         match self {
             Light::Area(a) => a.pdf_li_hit(geom, p, hit),
+            _ => 0.0,
+        }
+    }
+
+    /// Density (solid angle) with which [`Light::sample_li_prim`] from `p`, given the primitive
+    /// hit, would have produced the ray that hit this area light at `hit`.
+    pub fn pdf_li_hit_prim(&self, geom: &SceneGeometry, p: Vec3, hit: &Hit) -> f32 {
+        match self {
+            Light::Area(_) => geom.pdf_prim_solid_angle(hit.prim, p, hit),
             _ => 0.0,
         }
     }

@@ -6,7 +6,7 @@ use crate::camera::{Camera, PixelFilter};
 use crate::description::context::{Context, SceneError};
 use crate::description::schema::*;
 use crate::geometry::{self, SceneGeometry, Shape, Transform};
-use crate::light::{AreaLight, Light, LightFlags, LightSampler};
+use crate::light::{AreaLight, Light, LightFlags, LightSampler, LightSamplerKind};
 use crate::spectrum::DenseSpectrum;
 use crate::world::{Object, RenderSettings, World};
 use glam::Vec3;
@@ -234,6 +234,10 @@ pub fn build_for(
             }
             v as f32
         },
+        light_sampler: match r.light_sampler {
+            crate::description::schema::LightSamplerDesc::Bvh => LightSamplerKind::Bvh,
+            crate::description::schema::LightSamplerDesc::Power => LightSamplerKind::Power,
+        },
         caustics: overrides.caustics.unwrap_or(match r.caustics {
             CausticsDesc::LightTracing => crate::world::Caustics::LightTracing,
             CausticsDesc::PathTracing => crate::world::Caustics::PathTracing,
@@ -353,7 +357,7 @@ pub fn build_for(
         }
         lights.push(light);
     }
-    let light_sampler = LightSampler::new(&lights, &geometry, scene_radius);
+    let light_sampler = LightSampler::new(settings.light_sampler, &lights, &geometry, scene_radius);
     let (meters, grids, measure) =
         crate::world::measure::build_meters(&ctx, &scene.meters, &scene.grids, &scene.measure)?;
     let caustics = match settings.caustics {

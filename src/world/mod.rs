@@ -12,7 +12,7 @@ pub use measure::{Grid, MeasureSettings, Meter, MeterKind};
 use crate::bxdf::Material;
 use crate::camera::{Camera, PixelFilter};
 use crate::geometry::SceneGeometry;
-use crate::light::{Light, LightSampler};
+use crate::light::{Light, LightSampler, LightSamplerKind};
 
 /// What a primitive's `object` id refers to.
 #[derive(Clone, Copy, Debug)]
@@ -40,6 +40,8 @@ pub struct RenderSettings {
     pub caustics: Caustics,
     /// Light paths traced per camera sample when caustics are light-traced.
     pub light_paths_per_sample: f32,
+    /// How next-event estimation chooses a light ([`crate::light::sampler`]).
+    pub light_sampler: LightSamplerKind,
 }
 
 /// Estimator of the caustic paths light → specular surfaces → non-specular surface → camera.
@@ -64,6 +66,7 @@ impl Default for RenderSettings {
             illuminance: false,
             caustics: Caustics::LightTracing,
             light_paths_per_sample: crate::description::schema::DEFAULT_LIGHT_PATHS_PER_SAMPLE,
+            light_sampler: LightSamplerKind::Bvh,
         }
     }
 }
@@ -77,6 +80,7 @@ pub struct World {
     pub objects: Vec<Object>,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
+    /// Chooses the light for next-event estimation at a shading point.
     pub light_sampler: LightSampler,
     /// Indices of lights at infinity (environment), evaluated on escaped rays.
     pub infinite_lights: Vec<u32>,

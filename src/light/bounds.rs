@@ -1,0 +1,289 @@
+//! Bounds of a set of lights for the light BVH ([`super::bvh`]): where they are (a box, m),
+//! how much they emit (a power φ, lm) and toward which directions (two cones), and the
+//! importance a node of lights has for a shading point: an upper bound, up to a constant, of
+//! the illuminance the lights can send there (Conty Estevez & Kulla 2018).
+//!
+//! Directions: every emitter in the set has its emission axis within `cos_o` (θ_o) of `w`, and
+//! emits only within θ_e (`cos_e`) of its own axis. So no light in the set sends anything
+//! along a direction more than θ_o + θ_e from `w`:
+//! - a one-sided flat primitive: its front normal, θ_o = 0, θ_e = π/2;
+//! - a two-sided flat primitive: `two_sided` (directions are folded onto the axis' side);
+//! - a sphere primitive, an isotropic point light: the whole sphere, θ_o = π;
+//! - a spot: its axis, θ_o = the outer half-angle; a goniometric luminaire: the cone of its
+//!   table's non-zero directions ([`super::goniometric::GoniometricLight::emission_cone`]).
+//!   Point-like sources have no cosine falloff, so they get a tiny θ_e ([`POINT_SPREAD`]):
+//!   zero importance outside their support, ≈ 1 inside.
+
+use glam::Vec3;
+use std::f32::consts::{FRAC_PI_2, PI};
+
+/// θ_e (rad) of point-like sources: a margin that absorbs rounding in the angle tests, so a
+/// direction on the edge of a cone never gets zero importance.
+pub const POINT_SPREAD: f32 = 0.01;
+
+/// Smallest clamped squared distance, m², so a shading point on a point light stays finite.
+const MIN_DIST2: f32 = 1e-12;
+
+/// Floor of the bound on the receiver's |cos θ_i|: a light exactly in the tangent plane sends
+/// nothing, but the caller's own cosine may round to a tiny positive value there, which must
+/// not meet a zero probability.
+const MIN_COS_I: f32 = 1e-4;
+
+/// A cone of unit directions: axis `w` and cosine of the half-angle (`cos_theta` = −1: the
+/// whole sphere).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cone {
+    pub w: Vec3,
+    pub cos_theta: f32,
+}
+
+impl Cone {
+    pub const SPHERE: Cone = Cone {
+        w: Vec3::Z,
+        cos_theta: -1.0,
+    };
+
+    /// The smallest cone (up to a safety margin) containing `a` and `b`.
+    pub fn union(a: Cone, b: Cone) -> Cone {
+        let ta = a.cos_theta.clamp(-1.0, 1.0).acos();
+        let tb = b.cos_theta.clamp(-1.0, 1.0).acos();
+        let td = angle_between(a.w, b.w);
+        if (td + tb).min(PI) <= ta {
+            return a;
+        }
+        if (td + ta).min(PI) <= tb {
+            return b;
+        }
+        // The new cone spans from a's far edge to b's far edge along the great circle through
+        // both axes; a small margin covers the rounding of the rotation below.
+        let t = 0.5 * (ta + td + tb) + 1e-4;
+        if t >= PI {
+            return Cone::SPHERE;
+        }
+        let axis = a.w.cross(b.w);
+        let len = axis.length();
+        if len < 1e-6 {
+            return Cone::SPHERE;
+        }
+        // Rotate a.w toward b.w by t − ta about their common normal (Rodrigues, axis ⟂ a.w).
+        let k = axis / len;
+        let r = t - ta;
+        let w = (a.w * r.cos() + k.cross(a.w) * r.sin()).normalize();
+        Cone {
+            w,
+            cos_theta: t.cos(),
+        }
+    }
+}
+
+/// Angle (rad) between unit vectors, accurate near 0 and π.
+fn angle_between(a: Vec3, b: Vec3) -> f32 {
+    if a.dot(b) < 0.0 {
+        PI - 2.0 * ((a + b).length() * 0.5).clamp(-1.0, 1.0).asin()
+    } else {
+        2.0 * ((b - a).length() * 0.5).clamp(-1.0, 1.0).asin()
+    }
+}
+
+/// cos(max(0, a − b)) from the sines and cosines of angles a, b ∈ [0, π].
+#[inline]
+fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+    if cos_a > cos_b {
+        1.0
+    } else {
+        cos_a * cos_b + sin_a * sin_b
+    }
+}
+
+/// sin(max(0, a − b)) from the sines and cosines of angles a, b ∈ [0, π].
+#[inline]
+fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+    if cos_a > cos_b {
+        0.0
+    } else {
+        sin_a * cos_b - cos_a * sin_b
+    }
+}
+
+#[inline]
+fn sin_of(cos: f32) -> f32 {
+    (1.0 - cos * cos).max(0.0).sqrt()
+}
+
+/// Bounds of one light (a leaf) or of a node's lights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightBounds {
+    /// Box containing every emitting point, m.
+    pub lo: Vec3,
+    pub hi: Vec3,
+    /// Power, lm: π L A × sides for area primitives, 4π × peak intensity for point-like
+    /// sources (the flux an isotropic source of that intensity would emit).
+    pub phi: f32,
+    /// Cone containing every emitter's axis (θ_o).
+    pub axes: Cone,
+    /// Cosine of the spread θ_e ≤ π/2 of emission around each emitter's axis.
+    pub cos_e: f32,
+    /// Some emitter emits on both sides of its axis: directions are compared to ±w.
+    pub two_sided: bool,
+}
+
+impl LightBounds {
+    pub fn centroid(&self) -> Vec3 {
+        0.5 * (self.lo + self.hi)
+    }
+
+    /// The bounds of the lights of `a` and of `b` together.
+    pub fn union(a: &LightBounds, b: &LightBounds) -> LightBounds {
+        if a.phi <= 0.0 {
+            return *b;
+        }
+        if b.phi <= 0.0 {
+            return *a;
+        }
+        LightBounds {
+            lo: a.lo.min(b.lo),
+            hi: a.hi.max(b.hi),
+            phi: a.phi + b.phi,
+            axes: Cone::union(a.axes, b.axes),
+            cos_e: a.cos_e.min(b.cos_e),
+            two_sided: a.two_sided || b.two_sided,
+        }
+    }
+
+    /// Solid-angle measure of the emitted directions (M_Ω of Conty Estevez & Kulla), sr.
+    fn orientation_measure(&self) -> f32 {
+        let theta_o = self.axes.cos_theta.clamp(-1.0, 1.0).acos();
+        let theta_e = self.cos_e.clamp(-1.0, 1.0).acos();
+        let theta_w = (theta_o + theta_e).min(PI);
+        let (sin_o, cos_o) = theta_o.sin_cos();
+        2.0 * PI * (1.0 - cos_o)
+            + FRAC_PI_2
+                * (2.0 * theta_w * sin_o - (theta_o - 2.0 * theta_w).cos() - 2.0 * theta_o * sin_o
+                    + cos_o)
+    }
+
+    /// Cost of a node with these bounds for the build (surface area–orientation heuristic):
+    /// φ × M_Ω × box area, with `kr` the regularisation for thin boxes.
+    pub fn cost(&self, kr: f32) -> f32 {
+        let d = (self.hi - self.lo).max(Vec3::ZERO);
+        let area = 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
+        self.phi * self.orientation_measure() * area.max(1e-12) * kr
+    }
+
+    /// Importance for a receiver at `p` (m) with unit normal `n` (None: a point without a
+    /// surface, e.g. inside a medium): φ × bounded cos at the emitter × bounded |cos| at the
+    /// receiver / clamped squared distance, lm·m⁻². It is zero only where no light of the
+    /// bounds can send anything to `p` (or every light lies exactly in the tangent plane).
+    pub fn importance(&self, p: Vec3, n: Option<Vec3>) -> f32 {
+        if self.phi <= 0.0 {
+            return 0.0;
+        }
+        let c = self.centroid();
+        let r2 = 0.25 * (self.hi - self.lo).length_squared();
+        let v = p - c;
+        let dist2 = v.length_squared();
+        if dist2 <= r2 || dist2 == 0.0 || !dist2.is_finite() {
+            // Inside the bounding sphere: every direction is possible.
+            if dist2.is_nan() {
+                return 0.0;
+            }
+            return self.phi / r2.max(MIN_DIST2);
+        }
+        let wi = v / dist2.sqrt();
+        // Half-angle θ_b of the cone from p that contains the bounding sphere.
+        let sin2_b = r2 / dist2;
+        let (sin_b, cos_b) = (sin2_b.sqrt(), (1.0 - sin2_b).max(0.0).sqrt());
+
+        let mut cos_w = self.axes.w.dot(wi);
+        if self.two_sided {
+            cos_w = cos_w.abs();
+        }
+        let sin_w = sin_of(cos_w);
+        let cos_o = self.axes.cos_theta;
+        let sin_o = sin_of(cos_o);
+        // θ' = max(0, θ_w − θ_o − θ_b): the smallest angle between an emitter's axis and the
+        // direction from one of its points to p.
+        let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, cos_o);
+        let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, cos_o);
+        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
+        if cos_p <= self.cos_e {
+            return 0.0;
+        }
+        let mut importance = self.phi * cos_p / dist2.max(r2).max(MIN_DIST2);
+        if let Some(n) = n {
+            let cos_i = n.dot(wi).abs().min(1.0);
+            let sin_i = sin_of(cos_i);
+            importance *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b).max(MIN_COS_I);
+        }
+        importance.max(0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rand_dir(s: &mut u64) -> Vec3 {
+        let mut next = || {
+            *s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((*s >> 40) as f32) / (1u64 << 24) as f32
+        };
+        let z = 1.0 - 2.0 * next();
+        let phi = 2.0 * PI * next();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+
+    #[test]
+    fn cone_union_contains_both_cones() {
+        let mut s = 7u64;
+        for _ in 0..2000 {
+            let a = Cone {
+                w: rand_dir(&mut s),
+                cos_theta: rand_dir(&mut s).z,
+            };
+            let b = Cone {
+                w: rand_dir(&mut s),
+                cos_theta: rand_dir(&mut s).z,
+            };
+            let u = Cone::union(a, b);
+            let tu = u.cos_theta.clamp(-1.0, 1.0).acos();
+            for c in [a, b] {
+                let tc = c.cos_theta.clamp(-1.0, 1.0).acos();
+                let d = angle_between(u.w, c.w);
+                assert!(
+                    d + tc <= tu + 1e-4 || tu >= PI - 1e-6,
+                    "{a:?} ∪ {b:?} = {u:?} misses {c:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn one_sided_primitive_is_dark_behind_and_bright_in_front() {
+        let b = LightBounds {
+            lo: Vec3::new(-0.5, 2.0, -0.5),
+            hi: Vec3::new(0.5, 2.0, 0.5),
+            phi: 100.0,
+            axes: Cone {
+                w: -Vec3::Y,
+                cos_theta: 1.0,
+            },
+            cos_e: 0.0,
+            two_sided: false,
+        };
+        assert!(b.importance(Vec3::new(0.0, 0.0, 0.0), Some(Vec3::Y)) > 0.0);
+        assert_eq!(b.importance(Vec3::new(0.0, 3.0, 0.0), None), 0.0);
+        // A grazing point just below the plane, off to the side, still sees the emitter.
+        assert!(b.importance(Vec3::new(3.0, 1.99, 0.0), None) > 0.0);
+        assert_eq!(b.importance(Vec3::new(3.0, 3.0, 0.0), None), 0.0);
+        // Two-sided: bright on both sides.
+        let t = LightBounds {
+            two_sided: true,
+            ..b
+        };
+        assert!(t.importance(Vec3::new(0.0, 3.0, 0.0), None) > 0.0);
+    }
+}
