@@ -140,3 +140,20 @@ fn many_lights_meters_match_closed_form_with_both_samplers() {
         assert!((b.mean - p.mean).abs() <= 5.0 * se);
     }
 }
+
+#[test]
+fn render_state_hash_covers_the_light_sampler() {
+    // The same scene text hashed with worlds that differ only in their sampler: a state
+    // written with one must not resume with the other.
+    let (bvh, power) = (scene("Bvh"), scene("Power"));
+    let (wb, wp) = (world(&bvh.text), world(&power.text));
+    let text = bvh.text.as_bytes();
+    assert_eq!(
+        candela::state::scene_hash(text, &wb),
+        candela::state::scene_hash(text, &world(&bvh.text))
+    );
+    assert_ne!(
+        candela::state::scene_hash(text, &wb),
+        candela::state::scene_hash(text, &wp)
+    );
+}
