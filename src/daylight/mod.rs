@@ -8,10 +8,12 @@
 pub mod cie;
 pub mod epw;
 pub mod perez;
+pub mod sky_map;
 pub mod sun;
 
 pub use cie::CieSky;
 pub use perez::{PerezSky, SkyCondition};
+pub use sky_map::SkyMap;
 pub use sun::{sun_position, CivilTime, SunPosition};
 
 /// Angle γ (radians) between a sky direction at zenith angle Z (cos Z = `cos_z`) and the sun
