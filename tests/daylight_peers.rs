@@ -242,3 +242,77 @@ fn perez_bin(e: f64) -> usize {
         .rposition(|&lo| e >= lo)
         .unwrap()
 }
+
+/// The EPW reader against ladybug-core: a year written by ladybug, read by both. Hourly sums
+/// (irradiance, illuminance) are labelled by ladybug with the start of their hour, which
+/// [`Weather::at`] takes; point-in-time values (the dew point) with their instant, the end of
+/// the record's hour.
+#[test]
+fn epw_reader_against_ladybug() {
+    use candela::daylight::epw::Weather;
+    let dir = tempfile::tempdir().unwrap();
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/daylight/epw_ladybug.py");
+    let out = Command::new(python())
+        .arg(script)
+        .arg(dir.path())
+        .output()
+        .expect("run python");
+    assert!(
+        out.status.success(),
+        "epw_ladybug.py: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lb: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let w = Weather::read(std::path::Path::new(lb["path"].as_str().unwrap())).unwrap();
+    assert_eq!(w.records.len(), 8760);
+    assert_eq!(w.site.latitude_deg, lb["latitude"].as_f64().unwrap());
+    assert_eq!(w.site.longitude_deg, lb["longitude"].as_f64().unwrap());
+    assert_eq!(w.site.time_zone_h, lb["time_zone"].as_f64().unwrap());
+    assert_eq!(w.site.elevation_m, lb["elevation"].as_f64().unwrap());
+    type Get = fn(&candela::daylight::epw::Record) -> Option<f64>;
+    let summed: [(&str, Get); 4] = [
+        ("direct_normal_radiation", |r| r.direct_normal_w_m2),
+        ("diffuse_horizontal_radiation", |r| {
+            r.diffuse_horizontal_w_m2
+        }),
+        ("direct_normal_illuminance", |r| r.direct_normal_lx),
+        ("diffuse_horizontal_illuminance", |r| {
+            r.diffuse_horizontal_lx
+        }),
+    ];
+    let mut compared = 0;
+    for (name, get) in summed {
+        for row in lb["fields"][name].as_array().unwrap() {
+            let v: Vec<f64> = row
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect();
+            let r = w
+                .at(v[0] as u32, v[1] as u32, v[2] as u32, 0)
+                .expect("record");
+            assert_eq!(get(r), Some(v[3]), "{name} at {v:?}");
+            compared += 1;
+        }
+    }
+    for row in lb["fields"]["dew_point_temperature"].as_array().unwrap() {
+        let v: Vec<f64> = row
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        if v[2] == 0.0 {
+            continue; // the previous day's hour 24
+        }
+        let r = w
+            .records
+            .iter()
+            .find(|r| r.month == v[0] as u32 && r.day == v[1] as u32 && r.hour == v[2] as u32)
+            .unwrap();
+        assert_eq!(r.dew_point_c, Some(v[3]), "dew point at {v:?}");
+        compared += 1;
+    }
+    println!("EPW: {compared} values agree with ladybug-core");
+}

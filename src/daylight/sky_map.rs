@@ -87,7 +87,12 @@ mod tests {
         let (mut s, mut s2) = (0.0, 0.0);
         for _ in 0..n {
             let (d, p) = map.sample(rnd(), rnd());
-            assert!((map.pdf(d) / p - 1.0).abs() < 1e-9, "pdf {} vs {}", map.pdf(d), p);
+            assert!(
+                (map.pdf(d) / p - 1.0).abs() < 1e-9,
+                "pdf {} vs {}",
+                map.pdf(d),
+                p
+            );
             assert!(d.z > 0.0, "the sky has no light below the horizon");
             let f = lum(d) * d.z / p;
             s += f;
@@ -95,7 +100,8 @@ mod tests {
         }
         let mean = s / n as f64;
         let sd = (s2 / n as f64 - mean * mean).sqrt();
-        let exact = crate::daylight::horizontal_integral(zs, |cz, g| sky.relative_luminance(cz, g, zs));
+        let exact =
+            crate::daylight::horizontal_integral(zs, |cz, g| sky.relative_luminance(cz, g, zs));
         let se = sd / (n as f64).sqrt();
         assert!((mean - exact).abs() < 4.0 * se, "{mean} ± {se} vs {exact}");
         // The spread per sample is that of cos Z over the sky, about its mean: far below the
@@ -106,7 +112,10 @@ mod tests {
         let (nu, nv) = (600, 900);
         for i in 0..nu {
             for j in 0..nv {
-                total += map.pdf(direction((i as f64 + 0.5) / nu as f64, (j as f64 + 0.5) / nv as f64));
+                total += map.pdf(direction(
+                    (i as f64 + 0.5) / nu as f64,
+                    (j as f64 + 0.5) / nv as f64,
+                ));
             }
         }
         total *= 4.0 * PI / (nu * nv) as f64;

@@ -60,7 +60,11 @@ impl Piecewise1D {
     pub fn sample(&self, u: f64) -> (f64, f64, usize) {
         let n = self.len();
         // The last cdf entry ≤ u among those with a following cell of positive weight.
-        let mut k = self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(n - 1);
+        let mut k = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .saturating_sub(1)
+            .min(n - 1);
         while self.density[k] == 0.0 && k > 0 {
             k -= 1;
         }
@@ -164,7 +168,13 @@ mod tests {
         // χ² of 200 000 samples against the cell probabilities of a 6 × 5 table with zeros.
         let (nu, nv) = (6, 5);
         let w: Vec<f64> = (0..nu * nv)
-            .map(|k| if k % 7 == 3 { 0.0 } else { 1.0 + ((k * 37) % 11) as f64 })
+            .map(|k| {
+                if k % 7 == 3 {
+                    0.0
+                } else {
+                    1.0 + ((k * 37) % 11) as f64
+                }
+            })
             .collect();
         let d = Piecewise2D::new(&w, nu, nv).unwrap();
         let total: f64 = w.iter().sum();
@@ -190,8 +200,10 @@ mod tests {
                 continue;
             }
             // The density integrates to the cell's probability: p · cell area.
-            let p_cell = d.pdf((k / nv) as f64 / nu as f64 + 1e-9, (k % nv) as f64 / nv as f64 + 1e-9)
-                / (nu * nv) as f64;
+            let p_cell = d.pdf(
+                (k / nv) as f64 / nu as f64 + 1e-9,
+                (k % nv) as f64 / nv as f64 + 1e-9,
+            ) / (nu * nv) as f64;
             assert!((p_cell - w[k] / total).abs() < 1e-12);
             chi2 += (counts[k] as f64 - expected).powi(2) / expected;
             dof += 1;
