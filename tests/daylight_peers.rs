@@ -185,7 +185,13 @@ fn perez_sky_against_gendaylit() {
         let sun = sun_dir(alt, az);
         let zs = sun[2].acos();
         // gendaylit -ang leaves the day number at 0.
-        let cond = SkyCondition::from_irradiance(dhi, dni, zs, 0.0).unwrap();
+        let cond = SkyCondition::from_irradiance(
+            dhi,
+            dni,
+            zs,
+            candela::daylight::perez::eccentricity(0.0),
+        )
+        .unwrap();
         let header: Vec<&str> = res["header"]
             .as_array()
             .unwrap()

@@ -178,14 +178,15 @@ fn bin(clearness: f64) -> usize {
 }
 
 impl SkyCondition {
-    /// From the diffuse-horizontal and direct-normal irradiance (W/m²) on day `day` of the
-    /// year, the sun at zenith angle `sun_zenith` (radians); ε and Δ clamped to the models'
-    /// range.
+    /// From the diffuse-horizontal and direct-normal irradiance (W/m²), the sun at zenith
+    /// angle `sun_zenith` (radians), the Earth–Sun distance correction `eccentricity`
+    /// ((R₀/R)², [`eccentricity`] of the day, 1 at the mean distance); ε and Δ clamped to the
+    /// models' range.
     pub fn from_irradiance(
         diffuse_horizontal_w_m2: f64,
         direct_normal_w_m2: f64,
         sun_zenith: f64,
-        day: f64,
+        eccentricity: f64,
     ) -> Result<Self, PerezError> {
         let (ed, en) = (diffuse_horizontal_w_m2, direct_normal_w_m2);
         if !(ed.is_finite() && ed >= 0.0) {
@@ -209,7 +210,7 @@ impl SkyCondition {
         } else {
             CLEARNESS_MAX
         };
-        let brightness = ed * air_mass(sun_zenith) / (SOLAR_CONSTANT_W_M2 * eccentricity(day));
+        let brightness = ed * air_mass(sun_zenith) / (SOLAR_CONSTANT_W_M2 * eccentricity);
         Ok(Self {
             clearness,
             brightness,
@@ -225,7 +226,7 @@ impl SkyCondition {
         diffuse_horizontal_lx: f64,
         direct_normal_lx: f64,
         sun_zenith: f64,
-        day: f64,
+        eccentricity: f64,
         dew_point_c: f64,
     ) -> Result<(Self, [f64; 2]), PerezError> {
         let (vd, vn) = (diffuse_horizontal_lx, direct_normal_lx);
@@ -242,7 +243,7 @@ impl SkyCondition {
         // Start from the solar constant's own efficacy, 127 500 lx / 1367 W/m² (93.3 lm/W).
         let k0 = 127_500.0 / SOLAR_CONSTANT_W_M2;
         let (mut ed, mut en) = (vd / k0, vn / k0);
-        let mut cond = Self::from_irradiance(ed, en, sun_zenith, day)?;
+        let mut cond = Self::from_irradiance(ed, en, sun_zenith, eccentricity)?;
         for _ in 0..100 {
             let (kd, kn) = (cond.diffuse_efficacy(w), cond.direct_efficacy(w));
             let ed2 = if kd > 0.0 { vd / kd } else { 0.0 };
@@ -250,7 +251,7 @@ impl SkyCondition {
             let done =
                 (ed2 - ed).abs() <= 1e-9 * ed.max(1.0) && (en2 - en).abs() <= 1e-9 * en.max(1.0);
             (ed, en) = (ed2, en2);
-            cond = Self::from_irradiance(ed, en, sun_zenith, day)?;
+            cond = Self::from_irradiance(ed, en, sun_zenith, eccentricity)?;
             if done {
                 break;
             }
@@ -343,15 +344,16 @@ mod tests {
     #[test]
     fn clearness_and_brightness_round_trip() {
         // An overcast sky (no direct light) has ε = 1; a clear one a large ε.
-        let c = SkyCondition::from_irradiance(100.0, 0.0, 0.6, 172.0).unwrap();
+        let c = SkyCondition::from_irradiance(100.0, 0.0, 0.6, eccentricity(172.0)).unwrap();
         assert_eq!(c.clearness, 1.0);
-        let c = SkyCondition::from_irradiance(80.0, 800.0, 0.6, 172.0).unwrap();
+        let c = SkyCondition::from_irradiance(80.0, 800.0, 0.6, eccentricity(172.0)).unwrap();
         let z3 = 1.041 * 0.6f64.powi(3);
         assert!((c.clearness - (880.0 / 80.0 + z3) / (1.0 + z3)).abs() < 1e-12);
         assert!(c.clearness > 6.2 && bin(c.clearness) == 7);
         // Illuminance input reproduces itself through the efficacies.
         let (c, [ed, en]) =
-            SkyCondition::from_illuminance(20_000.0, 70_000.0, 0.6, 172.0, 11.0).unwrap();
+            SkyCondition::from_illuminance(20_000.0, 70_000.0, 0.6, eccentricity(172.0), 11.0)
+                .unwrap();
         let w = precipitable_water(11.0);
         assert!((ed * c.diffuse_efficacy(w) / 20_000.0 - 1.0).abs() < 1e-6);
         assert!((en * c.direct_efficacy(w) / 70_000.0 - 1.0).abs() < 1e-6);
