@@ -322,3 +322,85 @@ fn site_frame_turns_the_sky() {
     assert!(w2 > 2.0 * e2, "east {e2}, west {w2}");
     assert!((e / w2 - 1.0).abs() < 0.02 && (w / e2 - 1.0).abs() < 0.05);
 }
+
+#[test]
+fn daylight_factor_in_the_report() {
+    use candela::light::sky::daylight_reference;
+    let w = world(&format!(
+        "({CAMERA}, lights: [Sky(model: CieOvercast, amount: HorizontalIlluminance(12000.0))])"
+    ));
+    let d = daylight_reference(&w.lights).expect("an overcast sky alone has a DF reference");
+    assert_eq!(d.sky, "CieOvercast");
+    assert!((d.horizontal_illuminance_lx / 12_000.0 - 1.0).abs() < 1e-12);
+    // Not with a sun, a sun-dependent sky, or another light.
+    for lights in [
+        "Sky(model: CieOvercast, amount: HorizontalIlluminance(1.0)), Sun(sun: (altitude_deg: 30.0, azimuth_deg: 0.0), amount: NormalIlluminance(1.0))",
+        "Sky(model: CieGeneral(2), sun: (altitude_deg: 30.0, azimuth_deg: 0.0), amount: HorizontalIlluminance(1.0))",
+        "Sky(model: Uniform, amount: HorizontalIlluminance(1.0)), Point(position: (0, 1, 0), spectrum: Named(\"D65\"), amount: Flux(1.0))",
+    ] {
+        let w = world(&format!("({CAMERA}, lights: [{lights}])"));
+        assert!(daylight_reference(&w.lights).is_none(), "{lights}");
+    }
+}
+
+/// The report JSON and grid CSV of a render under an overcast sky carry the daylight factor:
+/// DF = 100 E / E_h for every meter and grid point, with the same relative interval.
+#[test]
+fn daylight_factor_in_report_files() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("df.ron"),
+        format!(
+            r#"({CAMERA}, render: (spp: 1),
+            lights: [Sky(model: CieOvercast, amount: HorizontalIlluminance(8000.0))],
+            meters: [{UP_METER}],
+            grids: [(name: "g", origin: (0, 0, 0), edge_u: (1, 0, 0), edge_v: (0, 0, 1), nx: 2, ny: 1)],
+            measure: (samples: 256))"#
+        ),
+    )
+    .unwrap();
+    let (code, _, err) = common::cli(&["render", "df.ron"], dir.path());
+    assert_eq!(code, 0, "{err}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("df.report.json")).unwrap())
+            .unwrap();
+    assert_eq!(r["daylight"]["sky"], "CieOvercast");
+    assert_eq!(
+        r["daylight"]["horizontal_illuminance"].as_f64().unwrap(),
+        8000.0
+    );
+    let m = &r["meters"][0];
+    let df = &m["daylight_factor_percent"];
+    let rel = |a: &serde_json::Value, b: f64| (a.as_f64().unwrap() / b - 1.0).abs() < 1e-12;
+    assert!(
+        rel(&df["value"], m["value"].as_f64().unwrap() / 80.0),
+        "{df}"
+    );
+    assert!(
+        rel(&df["ci95_high"], m["ci95_high"].as_f64().unwrap() / 80.0),
+        "{df}"
+    );
+    // An unobstructed horizontal meter under the sky alone: DF = 100 %.
+    assert!(
+        (df["value"].as_f64().unwrap() - 100.0).abs() <= 5.0 * df["stderr"].as_f64().unwrap(),
+        "{df}"
+    );
+    let g = &r["grids"][0]["daylight_factor_percent"];
+    assert!((g["DF_avg"].as_f64().unwrap() - 100.0).abs() < 5.0, "{g}");
+    let csv = std::fs::read_to_string(dir.path().join("df.grid-g.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .nth(1)
+            .unwrap()
+            .ends_with("DF_percent,DF_ci95_low_percent,DF_ci95_high_percent"),
+        "{csv}"
+    );
+    let row: Vec<f64> = csv
+        .lines()
+        .nth(2)
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!((row[10] / (row[5] / 80.0) - 1.0).abs() < 1e-9, "{csv}");
+}

@@ -111,6 +111,36 @@ pub struct SkyLight {
     /// None when the sky and ground are black.
     map: Option<SkyMap>,
     pub portals: Portals,
+    /// The model as the scene names it (e.g. `CieOvercast`), for reports.
+    pub model: String,
+}
+
+/// What daylight factors are relative to: the horizontal illuminance of an unobstructed
+/// overcast sky.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DaylightReference {
+    /// The sky's model as the scene names it.
+    pub sky: String,
+    /// Its unobstructed horizontal illuminance, lx.
+    pub horizontal_illuminance_lx: f64,
+}
+
+/// The daylight-factor reference of a scene lit by an overcast sky alone: its sky is
+/// `CieOvercast`, `Uniform` or a general sky that does not depend on the sun (1, 3, 5), and it
+/// has no sun and no other light. None otherwise (a daylight factor is defined
+/// only under such a sky).
+pub fn daylight_reference(lights: &[super::Light]) -> Option<DaylightReference> {
+    let [super::Light::Sky(sky)] = lights else {
+        return None;
+    };
+    let overcast = match sky.distribution {
+        SkyDistribution::Cie(c) => !c.needs_sun(),
+        SkyDistribution::Perez(_) => false,
+    };
+    (overcast && sky.horizontal_illuminance_lx > 0.0).then(|| DaylightReference {
+        sky: sky.model.clone(),
+        horizontal_illuminance_lx: sky.horizontal_illuminance_lx,
+    })
 }
 
 impl SkyLight {
@@ -149,6 +179,7 @@ impl SkyLight {
             ground_reflectance,
             map,
             portals,
+            model: String::new(),
         }
     }
 
@@ -385,7 +416,7 @@ impl SkyLight {
         }
         let ground = e_h.scaled((rho / std::f64::consts::PI) as f32);
         let portals = super::environment::build_portals(ctx, field, d.portals)?;
-        let sky = Self::new(
+        let mut sky = Self::new(
             *frame,
             distribution,
             sun,
@@ -395,6 +426,13 @@ impl SkyLight {
             rho,
             portals,
         );
+        sky.model = match d.model {
+            SkyModelDesc::CieGeneral(k) => format!("CieGeneral({k})"),
+            SkyModelDesc::CieOvercast => "CieOvercast".into(),
+            SkyModelDesc::Uniform => "Uniform".into(),
+            SkyModelDesc::CieClear => "CieClear".into(),
+            SkyModelDesc::Perez { .. } => "Perez".into(),
+        };
         Ok((sky, perez_sun))
     }
 }
