@@ -404,3 +404,79 @@ fn daylight_factor_in_report_files() {
         .collect();
     assert!((row[10] / (row[5] / 80.0) - 1.0).abs() < 1e-9, "{csv}");
 }
+
+/// `Weather(file, time)`: the Perez sky and sun of one hour of tests/data/lyon-excerpt.epw (a
+/// synthetic excerpt in EPW format). An unobstructed horizontal meter reads the record's
+/// diffuse-horizontal illuminance plus its direct-normal illuminance times the sine of the
+/// sun's altitude at that time (local standard time UTC+1, the file's site).
+#[test]
+fn weather_file_hour() {
+    use candela::daylight::sun::{sun_position, Atmosphere, CivilTime};
+    let file = "tests/data/lyon-excerpt.epw";
+    let alt = |iso: &str| {
+        let t = CivilTime::parse(iso).unwrap();
+        sun_position(45.73, 4.94, 201.0, &t, Atmosphere::default(), None)
+            .unwrap()
+            .altitude_deg
+            .to_radians()
+    };
+    // 10:30 is in the record of hour 11: 77 000 lx direct normal, 11 160 lx diffuse.
+    let r = measure(
+        &format!(r#"Weather(file: "{file}", time: "06-21 10:30")"#),
+        "",
+        UP_METER,
+        4096,
+    );
+    let expected = 11_160.0 + 77_000.0 * alt("2003-06-21T10:30:00+01:00").sin();
+    assert_estimate_near(r[0].0, r[0].1, expected, 0.01, "weather 06-21 10:30");
+    // Without its sun's disk: the diffuse part alone.
+    let r = measure(
+        &format!(r#"Weather(file: "{file}", time: "06-21 10:30", sun_disk: false)"#),
+        "",
+        UP_METER,
+        4096,
+    );
+    assert_estimate_near(r[0].0, r[0].1, 11_160.0, 0.01, "weather, no disk");
+    // 22 June has irradiances only: the efficacy model turns them into illuminances, so the
+    // sky's diffuse part lies between 100 and 140 lm/W times its 260 sin(…) W/m².
+    let w = common::world(&format!(
+        "({CAMERA}, lights: [Weather(file: \"{file}\", time: \"06-22 13:15\", sun_disk: false)])"
+    ));
+    let candela::light::Light::Sky(sky) = &w.lights[0] else {
+        panic!("a sky")
+    };
+    let ed = 260.0 * (std::f64::consts::PI * (13.5 - 5.5) / 15.5).sin();
+    let k = sky.horizontal_illuminance_lx / ed.round();
+    assert!((100.0..140.0).contains(&k), "diffuse efficacy {k} lm/W");
+    // Errors name the field.
+    use candela::scene::{self, Overrides};
+    let path = std::path::Path::new("bad.ron");
+    for (time, why) in [
+        ("06-23 10:00", "no record"),
+        ("06-21 02:00", "no daylight"),
+        ("6/21 10:00", "MM-DD hh:mm"),
+        ("06-21 25:00", "MM-DD hh:mm"),
+    ] {
+        let text = format!("({CAMERA}, lights: [Weather(file: \"{file}\", time: \"{time}\")])");
+        let s = scene::parse(&text, path).unwrap();
+        let e = scene::build(&s, path, &Overrides::default())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            e.contains("lights[0].time") && e.contains(why),
+            "{time}: {e}"
+        );
+    }
+    let text =
+        format!("({CAMERA}, lights: [Weather(file: \"missing.epw\", time: \"06-21 10:00\")])");
+    let s = scene::parse(&text, path).unwrap();
+    let e = scene::build(&s, path, &Overrides::default())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("lights[0].file") && e.contains("missing.epw"),
+        "{e}"
+    );
+}

@@ -587,6 +587,21 @@ pub enum LightDesc {
         #[serde(default)]
         sun_disk: Option<bool>,
     },
+    /// The Perez sky and the sun of one hour of an EnergyPlus weather file (docs/daylight.md):
+    /// `time` is `"MM-DD hh:mm"` in the file's local standard time; the other fields as for
+    /// `Sky`.
+    Weather {
+        file: String,
+        time: String,
+        #[serde(default)]
+        spectrum: Option<SpectrumDesc>,
+        #[serde(default)]
+        ground_reflectance: Option<f64>,
+        #[serde(default)]
+        portals: Vec<PortalDesc>,
+        #[serde(default)]
+        sun_disk: Option<bool>,
+    },
     /// The sun's disk (0.533°): position `sun`, amount `NormalIlluminance(lx)`, spectrum
     /// (default `Named("D50")`).
     Sun {

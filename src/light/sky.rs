@@ -531,3 +531,121 @@ mod tests {
         }
     }
 }
+
+/// The sky model and sun of `Weather(file, time)` (`field` is `lights[i]`): the record of
+/// `file` covering `time` ("MM-DD hh:mm", the file's local standard time; record hour h covers
+/// (h − 1):00 to h:00), as a Perez sky from its illuminances (or, where the file lacks them,
+/// its irradiances through the Perez efficacy model) and its dew point, the sun placed by the
+/// file's site at that time.
+pub fn weather_sky(
+    ctx: &crate::description::context::Context,
+    field: &str,
+    file: &str,
+    time: &str,
+) -> Result<
+    (
+        crate::description::schema::SkyModelDesc,
+        crate::description::schema::SunDesc,
+    ),
+    crate::description::context::SceneError,
+> {
+    use crate::daylight::epw::Weather;
+    use crate::daylight::perez::{
+        eccentricity, precipitable_water, SkyCondition, DEFAULT_DEW_POINT_C,
+    };
+    use crate::description::schema::{SkyModelDesc, SunDesc};
+    let tfield = format!("{field}.time");
+    let bad_time = || {
+        ctx.err(
+            &tfield,
+            format!("{time:?} is not \"MM-DD hh:mm\" (e.g. \"06-21 10:30\")"),
+        )
+    };
+    let (date, clock) = time.trim().split_once(' ').ok_or_else(bad_time)?;
+    let (mo, da) = date.split_once('-').ok_or_else(bad_time)?;
+    let (hh, mm) = clock.split_once(':').ok_or_else(bad_time)?;
+    let num = |t: &str, max: u32| -> Result<u32, crate::description::context::SceneError> {
+        t.parse::<u32>()
+            .ok()
+            .filter(|v| *v <= max && t.len() <= 2)
+            .ok_or_else(bad_time)
+    };
+    let (month, day, hour, minute) = (num(mo, 12)?, num(da, 31)?, num(hh, 23)?, num(mm, 59)?);
+    let path = ctx.resolve(file);
+    let w = Weather::read(&path).map_err(|m| ctx.err(format!("{field}.file"), m))?;
+    let r = w.at(month, day, hour, minute).ok_or_else(|| {
+        ctx.err(
+            &tfield,
+            format!("{} has no record for {time}", path.display()),
+        )
+    })?;
+    let tz = w.site.time_zone_h;
+    let offset_min = (tz * 60.0).round() as i64;
+    let sign = if offset_min < 0 { '-' } else { '+' };
+    let iso = format!(
+        "{:04}-{month:02}-{day:02}T{hour:02}:{minute:02}:00{sign}{:02}:{:02}",
+        r.year.clamp(1, 9999),
+        offset_min.abs() / 60,
+        offset_min.abs() % 60
+    );
+    let sun = SunDesc {
+        latitude_deg: Some(w.site.latitude_deg),
+        longitude_deg: Some(w.site.longitude_deg),
+        elevation_m: Some(w.site.elevation_m),
+        time: Some(iso),
+        ..Default::default()
+    };
+    let dew = r.dew_point_c.unwrap_or(DEFAULT_DEW_POINT_C);
+    let line = format!(
+        "{} record {month:02}-{day:02} hour {}",
+        path.display(),
+        r.hour
+    );
+    let (dn, dh) = match (r.direct_normal_lx, r.diffuse_horizontal_lx) {
+        (Some(dn), Some(dh)) => (dn, dh),
+        _ => {
+            let (Some(en), Some(ed)) = (r.direct_normal_w_m2, r.diffuse_horizontal_w_m2) else {
+                return Err(ctx.err(
+                    &tfield,
+                    format!("{line}: neither the illuminances nor the irradiances are given"),
+                ));
+            };
+            let place = super::sun::place_sun(ctx, &tfield, &sun)?;
+            let zenith = (90.0 - place.altitude_deg).to_radians();
+            let day_of_year =
+                crate::daylight::sun::CivilTime::parse(sun.time.as_deref().unwrap_or(""))
+                    .map(|t| t.day_of_year() as f64)
+                    .unwrap_or(1.0);
+            if ed + en == 0.0 {
+                (0.0, 0.0)
+            } else {
+                let c = SkyCondition::from_irradiance(
+                    ed,
+                    en,
+                    zenith.min(std::f64::consts::FRAC_PI_2),
+                    eccentricity(day_of_year),
+                )
+                .map_err(|e| ctx.err(&tfield, format!("{line}: {e}")))?;
+                let water = precipitable_water(dew);
+                (
+                    en * c.direct_efficacy(water),
+                    ed * c.diffuse_efficacy(water),
+                )
+            }
+        }
+    };
+    if dn + dh == 0.0 {
+        return Err(ctx.err(
+            &tfield,
+            format!("{line}: no daylight at that hour (zero direct and diffuse light)"),
+        ));
+    }
+    Ok((
+        SkyModelDesc::Perez {
+            direct_normal_lx: dn,
+            diffuse_horizontal_lx: dh,
+            dew_point_c: r.dew_point_c,
+        },
+        sun,
+    ))
+}

@@ -360,7 +360,7 @@ pub fn build_for(
     for (i, l) in scene.lights.iter().enumerate() {
         let field = format!("lights[{i}]");
         let light = match l {
-            LightDesc::Sky { .. } => {
+            LightDesc::Sky { .. } | LightDesc::Weather { .. } => {
                 if let Some((j, _)) = sky {
                     return Err(ctx.err(
                         &field,
@@ -393,28 +393,59 @@ pub fn build_for(
         };
         push(light, &mut lights);
     }
-    if let Some((
-        i,
-        LightDesc::Sky {
-            model,
-            sun,
-            amount,
-            spectrum,
-            ground_reflectance,
-            portals,
-            sun_disk,
-        },
-    )) = sky
-    {
-        let desc = crate::light::sky::SkyDesc {
-            model,
-            sun: sun.as_ref(),
-            amount: *amount,
-            spectrum: spectrum.as_ref(),
-            ground_reflectance: *ground_reflectance,
-            portals,
-            sun_disk: *sun_disk,
-        };
+    let weather;
+    let desc = match sky {
+        Some((
+            i,
+            LightDesc::Sky {
+                model,
+                sun,
+                amount,
+                spectrum,
+                ground_reflectance,
+                portals,
+                sun_disk,
+            },
+        )) => Some((
+            i,
+            crate::light::sky::SkyDesc {
+                model,
+                sun: sun.as_ref(),
+                amount: *amount,
+                spectrum: spectrum.as_ref(),
+                ground_reflectance: *ground_reflectance,
+                portals,
+                sun_disk: *sun_disk,
+            },
+        )),
+        Some((
+            i,
+            LightDesc::Weather {
+                file,
+                time,
+                spectrum,
+                ground_reflectance,
+                portals,
+                sun_disk,
+            },
+        )) => {
+            weather = crate::light::sky::weather_sky(&ctx, &format!("lights[{i}]"), file, time)?;
+            Some((
+                i,
+                crate::light::sky::SkyDesc {
+                    model: &weather.0,
+                    sun: Some(&weather.1),
+                    amount: None,
+                    spectrum: spectrum.as_ref(),
+                    ground_reflectance: *ground_reflectance,
+                    portals,
+                    sun_disk: *sun_disk,
+                },
+            ))
+        }
+        _ => None,
+    };
+    if let Some((i, desc)) = desc {
         let (s, perez_sun) = crate::light::SkyLight::build(
             &ctx,
             &format!("lights[{i}]"),
@@ -531,7 +562,7 @@ fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, Scene
                 multiplier: *multiplier,
             },
         )?)),
-        LightDesc::Sky { .. } | LightDesc::Sun { .. } => {
+        LightDesc::Sky { .. } | LightDesc::Weather { .. } | LightDesc::Sun { .. } => {
             unreachable!("skies and suns are built beside the site's frame")
         }
     })
