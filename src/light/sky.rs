@@ -437,101 +437,6 @@ impl SkyLight {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::daylight::perez::SkyCondition;
-
-    /// χ² of the directions `sample_li` draws against its `pdf_li` integrated over 24 × 48
-    /// cells of the sphere (equal in cos Z and azimuth of the scene frame), for a clear CIE
-    /// sky and a Perez sky in a tilted site frame, ground included.
-    #[test]
-    fn sampling_matches_pdf_chi2() {
-        let frame = SiteFrame::new(DVec3::new(0.2, 0.9, 0.3), DVec3::new(0.0, 0.1, -1.0)).unwrap();
-        let sun = DVec3::new(0.4, -0.5, 0.77).normalize();
-        let perez = SkyCondition::from_irradiance(120.0, 600.0, sun.z.acos(), 1.0).unwrap();
-        for dist in [
-            SkyDistribution::Cie(CieSky::general(13).unwrap()),
-            SkyDistribution::Perez(PerezSky::new(perez)),
-        ] {
-            let sky = SkyLight::new(
-                frame,
-                dist,
-                sun,
-                DenseSpectrum::constant(1.0),
-                DenseSpectrum::constant(0.05),
-                1.0,
-                0.2,
-                Portals::new(Vec::new()),
-            );
-            let wl = SampledWavelengths::sample_uniform(0.5);
-            let (nz, nphi) = (24usize, 48usize);
-            let cell = |w: Vec3| {
-                let w = w.as_dvec3();
-                let u = ((1.0 - w.y) * 0.5 * nz as f64).min(nz as f64 - 1.0) as usize;
-                let mut phi = w.z.atan2(w.x) / std::f64::consts::TAU;
-                if phi < 0.0 {
-                    phi += 1.0;
-                }
-                u * nphi + ((phi * nphi as f64) as usize).min(nphi - 1)
-            };
-            let n = 200_000usize;
-            let mut counts = vec![0f64; nz * nphi];
-            let mut state = 99u64;
-            let mut rnd = || {
-                state = crate::sampling::mix64(state.wrapping_add(0x9E37_79B9_7F4A_7C15));
-                ((state >> 40) as f32) / (1u32 << 24) as f32
-            };
-            for _ in 0..n {
-                let ls = sky
-                    .sample_li(Vec3::ZERO, rnd(), Vec2::new(rnd(), rnd()), &wl)
-                    .unwrap();
-                let p = sky.pdf_li(Vec3::ZERO, ls.wi);
-                assert!((p / ls.pdf - 1.0).abs() < 1e-3, "pdf {p} vs {}", ls.pdf);
-                counts[cell(ls.wi)] += 1.0;
-            }
-            // Expected: the pdf integrated over each cell by a 12 × 12 midpoint rule.
-            let k = 12;
-            let mut chi2 = 0.0;
-            let mut dof = 0;
-            let mut pooled = (0.0, 0.0);
-            for (c, &count) in counts.iter().enumerate() {
-                let (iu, ip) = (c / nphi, c % nphi);
-                let mut p = 0.0;
-                for a in 0..k {
-                    for b in 0..k {
-                        let y = 1.0 - 2.0 * (iu as f64 + (a as f64 + 0.5) / k as f64) / nz as f64;
-                        let phi = std::f64::consts::TAU * (ip as f64 + (b as f64 + 0.5) / k as f64)
-                            / nphi as f64;
-                        let s = (1.0 - y * y).max(0.0).sqrt();
-                        let w = Vec3::new((s * phi.cos()) as f32, y as f32, (s * phi.sin()) as f32);
-                        p += sky.pdf_li(Vec3::ZERO, w) as f64;
-                    }
-                }
-                let expected =
-                    p / (k * k) as f64 * 4.0 * std::f64::consts::PI / (nz * nphi) as f64 * n as f64;
-                if expected < 5.0 {
-                    pooled.0 += expected;
-                    pooled.1 += count;
-                    continue;
-                }
-                chi2 += (count - expected).powi(2) / expected;
-                dof += 1;
-            }
-            if pooled.0 > 0.0 {
-                chi2 += (pooled.1 - pooled.0).powi(2) / pooled.0;
-                dof += 1;
-            }
-            // Wilson–Hilferty: χ² with ν dof beyond ν + 4.3 √(2ν) has p < 1e-5.
-            let limit = dof as f64 + 4.3 * (2.0 * dof as f64).sqrt();
-            assert!(
-                chi2 < limit,
-                "χ² = {chi2:.1} over {dof} cells (limit {limit:.1})"
-            );
-        }
-    }
-}
-
 /// The sky model and sun of `Weather(file, time)` (`field` is `lights[i]`): the record of
 /// `file` covering `time` ("MM-DD hh:mm", the file's local standard time; record hour h covers
 /// (h − 1):00 to h:00), as a Perez sky from its illuminances (or, where the file lacks them,
@@ -648,4 +553,99 @@ pub fn weather_sky(
         },
         sun,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::daylight::perez::SkyCondition;
+
+    /// χ² of the directions `sample_li` draws against its `pdf_li` integrated over 24 × 48
+    /// cells of the sphere (equal in cos Z and azimuth of the scene frame), for a clear CIE
+    /// sky and a Perez sky in a tilted site frame, ground included.
+    #[test]
+    fn sampling_matches_pdf_chi2() {
+        let frame = SiteFrame::new(DVec3::new(0.2, 0.9, 0.3), DVec3::new(0.0, 0.1, -1.0)).unwrap();
+        let sun = DVec3::new(0.4, -0.5, 0.77).normalize();
+        let perez = SkyCondition::from_irradiance(120.0, 600.0, sun.z.acos(), 1.0).unwrap();
+        for dist in [
+            SkyDistribution::Cie(CieSky::general(13).unwrap()),
+            SkyDistribution::Perez(PerezSky::new(perez)),
+        ] {
+            let sky = SkyLight::new(
+                frame,
+                dist,
+                sun,
+                DenseSpectrum::constant(1.0),
+                DenseSpectrum::constant(0.05),
+                1.0,
+                0.2,
+                Portals::new(Vec::new()),
+            );
+            let wl = SampledWavelengths::sample_uniform(0.5);
+            let (nz, nphi) = (24usize, 48usize);
+            let cell = |w: Vec3| {
+                let w = w.as_dvec3();
+                let u = ((1.0 - w.y) * 0.5 * nz as f64).min(nz as f64 - 1.0) as usize;
+                let mut phi = w.z.atan2(w.x) / std::f64::consts::TAU;
+                if phi < 0.0 {
+                    phi += 1.0;
+                }
+                u * nphi + ((phi * nphi as f64) as usize).min(nphi - 1)
+            };
+            let n = 200_000usize;
+            let mut counts = vec![0f64; nz * nphi];
+            let mut state = 99u64;
+            let mut rnd = || {
+                state = crate::sampling::mix64(state.wrapping_add(0x9E37_79B9_7F4A_7C15));
+                ((state >> 40) as f32) / (1u32 << 24) as f32
+            };
+            for _ in 0..n {
+                let ls = sky
+                    .sample_li(Vec3::ZERO, rnd(), Vec2::new(rnd(), rnd()), &wl)
+                    .unwrap();
+                let p = sky.pdf_li(Vec3::ZERO, ls.wi);
+                assert!((p / ls.pdf - 1.0).abs() < 1e-3, "pdf {p} vs {}", ls.pdf);
+                counts[cell(ls.wi)] += 1.0;
+            }
+            // Expected: the pdf integrated over each cell by a 12 × 12 midpoint rule.
+            let k = 12;
+            let mut chi2 = 0.0;
+            let mut dof = 0;
+            let mut pooled = (0.0, 0.0);
+            for (c, &count) in counts.iter().enumerate() {
+                let (iu, ip) = (c / nphi, c % nphi);
+                let mut p = 0.0;
+                for a in 0..k {
+                    for b in 0..k {
+                        let y = 1.0 - 2.0 * (iu as f64 + (a as f64 + 0.5) / k as f64) / nz as f64;
+                        let phi = std::f64::consts::TAU * (ip as f64 + (b as f64 + 0.5) / k as f64)
+                            / nphi as f64;
+                        let s = (1.0 - y * y).max(0.0).sqrt();
+                        let w = Vec3::new((s * phi.cos()) as f32, y as f32, (s * phi.sin()) as f32);
+                        p += sky.pdf_li(Vec3::ZERO, w) as f64;
+                    }
+                }
+                let expected =
+                    p / (k * k) as f64 * 4.0 * std::f64::consts::PI / (nz * nphi) as f64 * n as f64;
+                if expected < 5.0 {
+                    pooled.0 += expected;
+                    pooled.1 += count;
+                    continue;
+                }
+                chi2 += (count - expected).powi(2) / expected;
+                dof += 1;
+            }
+            if pooled.0 > 0.0 {
+                chi2 += (pooled.1 - pooled.0).powi(2) / pooled.0;
+                dof += 1;
+            }
+            // Wilson–Hilferty: χ² with ν dof beyond ν + 4.3 √(2ν) has p < 1e-5.
+            let limit = dof as f64 + 4.3 * (2.0 * dof as f64).sqrt();
+            assert!(
+                chi2 < limit,
+                "χ² = {chi2:.1} over {dof} cells (limit {limit:.1})"
+            );
+        }
+    }
 }
