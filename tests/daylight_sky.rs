@@ -480,3 +480,30 @@ fn weather_file_hour() {
         "{e}"
     );
 }
+
+/// A vertical surface in the open sees half the sky and half the ground: under a uniform sky
+/// of horizontal illuminance E_h over a ground of reflectance ρ_g, E_v = E_h (1 + ρ_g) / 2
+/// (the sky component 50 % and the externally reflected component 50 ρ_g % of closed-forms.md
+/// §2.7, for a façade element with nothing in front of it).
+#[test]
+fn vertical_surface_sees_half_sky_half_ground() {
+    let meters = r#"Illuminance(name: "east", position: (0, 0, 0), normal: (1, 0, 0)),
+                    Illuminance(name: "north", position: (0, 0, 0), normal: (0, 0, -1))"#;
+    for rho in [0.0, 0.2, 0.5] {
+        let r = measure(
+            &format!("Sky(model: Uniform, amount: HorizontalIlluminance(10000.0), ground_reflectance: {rho})"),
+            "",
+            meters,
+            4096,
+        );
+        for (m, label) in r.iter().zip(["east", "north"]) {
+            assert_estimate_near(
+                m.0,
+                m.1,
+                5000.0 * (1.0 + rho),
+                0.01,
+                &format!("{label}, ρ_g {rho}"),
+            );
+        }
+    }
+}
