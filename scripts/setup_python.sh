@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Create the Python virtual environment used to regenerate data/ and to run the
-# colour-science validation test (tests/colour_science.rs).
+# colour-science validation test (tests/colour_science.rs) and the Radiance sky comparison
+# and EPW comparisons (tests/daylight_peers.rs).
 #
 #   scripts/setup_python.sh            # creates <repo>/target/venv if missing, installs pins
 #   PYTHON=python3.11 scripts/setup_python.sh
@@ -12,11 +13,16 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 VENV="$ROOT/target/venv"
 PYTHON="${PYTHON:-python3}"
 
-# Pinned versions: colour-science 0.4.7 and the only dependency it pulls in (numpy).
+# Pinned versions: colour-science 0.4.7 and the only dependency it pulls in (numpy);
+# pyradiance 1.3.1 (Radiance 6's binaries: gensky, gendaylit, rtrace) and ladybug-core
+# 0.44.62 (EPW weather files) for the daylight tests.
 # SciPy/matplotlib are optional for colour-science and not needed by candela's scripts.
 PINS=(
   "colour-science==0.4.7"
   "numpy==2.4.6"
+  "pyradiance==1.3.1"
+  "ladybug-core==0.44.62"
+  "ladybug-geometry==1.35.6"
 )
 
 if [ ! -x "$VENV/bin/python" ]; then
@@ -31,5 +37,6 @@ import warnings
 warnings.filterwarnings("ignore")
 import colour, numpy
 assert colour.__version__ == "0.4.7", colour.__version__
+import pyradiance, ladybug.epw
 print(f"ok: colour-science {colour.__version__}, numpy {numpy.__version__}")
 PY

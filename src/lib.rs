@@ -9,6 +9,7 @@
 pub mod bxdf;
 pub mod camera;
 pub mod colour;
+pub mod daylight;
 pub mod description;
 pub mod film;
 pub mod geometry;

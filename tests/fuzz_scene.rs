@@ -84,7 +84,12 @@ fn fixture() -> tempfile::TempDir {
 fn seeds() -> Vec<Vec<u8>> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut v = vec![ALL_FEATURES.as_bytes().to_vec()];
-    for s in ["cornell-box.ron", "room-spot.ron", "furnace.ron"] {
+    for s in [
+        "cornell-box.ron",
+        "room-spot.ron",
+        "furnace.ron",
+        "sun-patch.ron",
+    ] {
         v.push(std::fs::read(root.join("scenes").join(s)).unwrap());
     }
     v

@@ -252,6 +252,7 @@ pub fn mesh_scene(mesh: candela::geometry::TriangleMesh, spp: u32, resolution: u
         meters: Vec::new(),
         grids: Vec::new(),
         measure: MeasureDesc::default(),
+        site: Default::default(),
     }
 }
 

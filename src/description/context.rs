@@ -195,6 +195,28 @@ impl Context<'_> {
                 let norm = planck_law(560e-9, t);
                 DenseSpectrum::from_fn(|nm| planck_law(nm * 1e-9, t) / norm)
             }
+            SpectrumDesc::Daylight(cct) => {
+                if role == Role::Reflectance {
+                    return Err(self.err(
+                        field,
+                        "a daylight spectrum describes emission, not a reflectance",
+                    ));
+                }
+                let t = self.finite(field, *cct)?;
+                if !(4000.0..=25_000.0).contains(&t) {
+                    return Err(self.err(
+                        field,
+                        format!("CIE daylight is defined from 4000 K to 25 000 K, not {t} K"),
+                    ));
+                }
+                let sd = crate::colour::illuminants::sd_cie_daylight(t);
+                DenseSpectrum::from_fn(|nm| {
+                    let x = (nm - 360.0).clamp(0.0, (sd.len() - 1) as f64);
+                    let (i, f) = (x.floor() as usize, x.fract());
+                    let j = (i + 1).min(sd.len() - 1);
+                    sd[i] * (1.0 - f) + sd[j] * f
+                })
+            }
             SpectrumDesc::Named(name) => {
                 let sd = tables::named_spectrum(name).ok_or_else(|| {
                     self.err(

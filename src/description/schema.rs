@@ -30,6 +30,33 @@ pub struct SceneFile {
     /// Sample budget of meters and grids.
     #[serde(default)]
     pub measure: MeasureDesc,
+    /// Which way is up and where north is, for skies and the sun (docs/daylight.md).
+    #[serde(default)]
+    pub site: SiteDesc,
+}
+
+/// The site's orientation in scene coordinates: `up` (default +y) and `north` (default −z;
+/// made perpendicular to `up`). East is north × up.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SiteDesc {
+    #[serde(default = "default_up")]
+    pub up: V3,
+    #[serde(default = "default_north")]
+    pub north: V3,
+}
+
+fn default_north() -> V3 {
+    [0.0, 0.0, -1.0]
+}
+
+impl Default for SiteDesc {
+    fn default() -> Self {
+        Self {
+            up: default_up(),
+            north: default_north(),
+        }
+    }
 }
 
 fn unique_material_keys<'de, D>(d: D) -> Result<BTreeMap<String, MaterialDesc>, D::Error>
@@ -274,6 +301,9 @@ pub enum SpectrumDesc {
     Constant(f64),
     /// Planck's law at this temperature, K (emission only).
     Blackbody(f64),
+    /// CIE daylight (D series) at this correlated colour temperature, 4000–25 000 K (emission
+    /// only).
+    Daylight(f64),
     /// A spectrum shipped in data/ (CIE illuminants, Cornell box, ColorChecker, TCS).
     Named(String),
     /// (wavelength nm, value) pairs, strictly increasing in wavelength; linear interpolation,
@@ -466,6 +496,12 @@ pub enum Amount {
     Intensity(f64),
     /// Illuminance, lx.
     Illuminance(f64),
+    /// A sky's horizontal illuminance (unobstructed, the sky alone), lx.
+    HorizontalIlluminance(f64),
+    /// A sky's zenith luminance, cd/m².
+    ZenithLuminance(f64),
+    /// The sun's direct-normal illuminance (on a surface facing it), lx.
+    NormalIlluminance(f64),
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -544,4 +580,90 @@ pub enum LightDesc {
         #[serde(default)]
         multiplier: Option<f64>,
     },
+    /// A sky over a ground (docs/daylight.md): its luminance distribution `model`, the sun's
+    /// position `sun` (for the models that depend on it), amount `HorizontalIlluminance(lx)`
+    /// or `ZenithLuminance(cd/m²)`, spectrum (default `Daylight(6504)`), ground reflectance
+    /// (default 0.2) and portals as for `Environment`. A Perez sky also brings its sun's
+    /// disk unless `sun_disk: false`.
+    Sky {
+        model: SkyModelDesc,
+        #[serde(default)]
+        sun: Option<SunDesc>,
+        #[serde(default)]
+        amount: Option<Amount>,
+        #[serde(default)]
+        spectrum: Option<SpectrumDesc>,
+        #[serde(default)]
+        ground_reflectance: Option<f64>,
+        #[serde(default)]
+        portals: Vec<PortalDesc>,
+        #[serde(default)]
+        sun_disk: Option<bool>,
+    },
+    /// The Perez sky and the sun of one hour of an EnergyPlus weather file (docs/daylight.md):
+    /// `time` is `"MM-DD hh:mm"` in the file's local standard time; the other fields as for
+    /// `Sky`.
+    Weather {
+        file: String,
+        time: String,
+        #[serde(default)]
+        spectrum: Option<SpectrumDesc>,
+        #[serde(default)]
+        ground_reflectance: Option<f64>,
+        #[serde(default)]
+        portals: Vec<PortalDesc>,
+        #[serde(default)]
+        sun_disk: Option<bool>,
+    },
+    /// The sun's disk (0.533°): position `sun`, amount `NormalIlluminance(lx)`, spectrum
+    /// (default `Named("D50")`).
+    Sun {
+        sun: SunDesc,
+        amount: Amount,
+        #[serde(default)]
+        spectrum: Option<SpectrumDesc>,
+    },
+}
+
+/// A sky's luminance distribution (docs/daylight.md).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum SkyModelDesc {
+    /// CIE standard general sky 1–15 (ISO 15469:2004).
+    CieGeneral(u32),
+    /// The traditional CIE overcast sky, L(Z) = L_z (1 + 2 cos Z)/3.
+    CieOvercast,
+    /// The same luminance everywhere.
+    Uniform,
+    /// The CIE 1973 clear sky of Radiance's `gensky +s`.
+    CieClear,
+    /// The Perez all-weather sky from the direct-normal and diffuse-horizontal illuminance
+    /// (lx), as `gendaylit -L`; dew point (°C) for the efficacy model (default: 2 cm of
+    /// precipitable water).
+    Perez {
+        direct_normal_lx: f64,
+        diffuse_horizontal_lx: f64,
+        #[serde(default)]
+        dew_point_c: Option<f64>,
+    },
+}
+
+/// Where the sun is: `altitude_deg` and `azimuth_deg` (from north toward east), or
+/// `latitude_deg`, `longitude_deg` (east positive), `time` (ISO 8601 with its UTC offset) and
+/// optionally `elevation_m`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunDesc {
+    #[serde(default)]
+    pub altitude_deg: Option<f64>,
+    #[serde(default)]
+    pub azimuth_deg: Option<f64>,
+    #[serde(default)]
+    pub latitude_deg: Option<f64>,
+    #[serde(default)]
+    pub longitude_deg: Option<f64>,
+    #[serde(default)]
+    pub time: Option<String>,
+    #[serde(default)]
+    pub elevation_m: Option<f64>,
 }

@@ -108,7 +108,7 @@ pub fn trace(
         let Some(hit) = hit else {
             for &li in &world.infinite_lights {
                 let light = &world.lights[li as usize];
-                let le = light.escaped(wl);
+                let le = light.escaped(ray_d, wl);
                 if le.is_black() {
                     continue;
                 }

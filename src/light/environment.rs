@@ -18,6 +18,28 @@ pub struct EnvironmentLight {
     pub portals: Portals,
 }
 
+/// The portals of `lights[i]` (`field`), as parallelograms.
+pub fn build_portals(
+    ctx: &Context,
+    field: &str,
+    portals: &[PortalDesc],
+) -> Result<Portals, SceneError> {
+    let mut built = Vec::with_capacity(portals.len());
+    for (k, d) in portals.iter().enumerate() {
+        let pf = format!("{field}.portals[{k}]");
+        let origin = ctx.vec3(&format!("{pf}.origin"), d.origin)?;
+        let eu = ctx.vec3(&format!("{pf}.edge_u"), d.edge_u)?;
+        let ev = ctx.vec3(&format!("{pf}.edge_v"), d.edge_v)?;
+        built.push(Portal::new(origin, eu, ev).ok_or_else(|| {
+            ctx.err(
+                &pf,
+                "the portal has zero area (its edges are zero or parallel)",
+            )
+        })?);
+    }
+    Ok(Portals::new(built))
+}
+
 impl EnvironmentLight {
     pub const FLAGS: LightFlags = LightFlags::INFINITE;
 
@@ -35,22 +57,9 @@ impl EnvironmentLight {
             Amount::Luminance(l) => ctx.nonneg(&afield, l)?,
             a => return Err(super::wrong_amount(ctx, &afield, &a, "Luminance(cd/m²)")),
         };
-        let mut built = Vec::with_capacity(portals.len());
-        for (k, d) in portals.iter().enumerate() {
-            let pf = format!("{field}.portals[{k}]");
-            let origin = ctx.vec3(&format!("{pf}.origin"), d.origin)?;
-            let eu = ctx.vec3(&format!("{pf}.edge_u"), d.edge_u)?;
-            let ev = ctx.vec3(&format!("{pf}.edge_v"), d.edge_v)?;
-            built.push(Portal::new(origin, eu, ev).ok_or_else(|| {
-                ctx.err(
-                    &pf,
-                    "the portal has zero area (its edges are zero or parallel)",
-                )
-            })?);
-        }
         Ok(Self {
             radiance: ctx.emission(&format!("{field}.spectrum"), &afield, spectrum, lum)?,
-            portals: Portals::new(built),
+            portals: build_portals(ctx, field, portals)?,
         })
     }
 

@@ -6,7 +6,8 @@
 //! |---|---|---|
 //! | point, spot, goniometric | radiant intensity I_e(λ) | W·sr⁻¹·nm⁻¹ (goniometric: per table cd) |
 //! | distant | irradiance at normal incidence E_e(λ) | W·m⁻²·nm⁻¹ |
-//! | environment, area | radiance L_e(λ) | W·m⁻²·sr⁻¹·nm⁻¹ |
+//! | environment, area, sun | radiance L_e(λ) | W·m⁻²·sr⁻¹·nm⁻¹ |
+//! | sky | radiance per unit relative luminance, and the ground's radiance | W·m⁻²·sr⁻¹·nm⁻¹ |
 
 pub mod area;
 pub mod bounds;
@@ -17,7 +18,9 @@ pub mod goniometric;
 pub mod point;
 pub mod portal;
 pub mod sampler;
+pub mod sky;
 pub mod spot;
+pub mod sun;
 
 use crate::description::context::{Context, SceneError};
 use crate::description::schema::Amount;
@@ -32,7 +35,9 @@ pub use goniometric::GoniometricLight;
 pub use point::PointLight;
 pub use portal::{Portal, Portals};
 pub use sampler::{LightSampler, LightSamplerKind};
+pub use sky::{SiteFrame, SkyLight};
 pub use spot::SpotLight;
+pub use sun::SunLight;
 
 #[derive(Clone, Debug)]
 pub enum Light {
@@ -48,6 +53,10 @@ pub enum Light {
     Area(AreaLight),
     /// A luminaire measured by a photometric file (IES/EULUMDAT): see [`goniometric`].
     Goniometric(Box<GoniometricLight>),
+    /// A CIE or Perez sky over a ground: see [`sky`].
+    Sky(Box<SkyLight>),
+    /// The sun's disk: see [`sun`].
+    Sun(SunLight),
 }
 
 /// What kind of distribution a light type is (each type's `FLAGS`), as a set of bits.
@@ -121,6 +130,8 @@ impl Light {
             Light::Environment(_) => EnvironmentLight::FLAGS,
             Light::Area(_) => AreaLight::FLAGS,
             Light::Goniometric(_) => GoniometricLight::FLAGS,
+            Light::Sky(_) => SkyLight::FLAGS,
+            Light::Sun(_) => SunLight::FLAGS,
         }
     }
 
@@ -145,7 +156,7 @@ impl Light {
             Light::Spot(l) => at(l.position),
             Light::Goniometric(g) => at(g.position),
             Light::Area(a) => Some(a.sample_emission_point(geom, uc, u)),
-            Light::Distant(_) | Light::Environment(_) => None,
+            Light::Distant(_) | Light::Environment(_) | Light::Sky(_) | Light::Sun(_) => None,
         }
     }
 
@@ -163,7 +174,9 @@ impl Light {
             Light::Spot(l) => l.intensity_toward(dir, wl),
             Light::Goniometric(g) => g.intensity_toward(dir, wl),
             Light::Area(a) => a.emission_toward(at, dir, wl),
-            Light::Distant(_) | Light::Environment(_) => SampledSpectrum::ZERO,
+            Light::Distant(_) | Light::Environment(_) | Light::Sky(_) | Light::Sun(_) => {
+                SampledSpectrum::ZERO
+            }
         }
     }
 
@@ -176,6 +189,8 @@ impl Light {
             Light::Environment(l) => l.power_lm(scene_radius),
             Light::Area(a) => a.power_lm(geom),
             Light::Goniometric(g) => g.power_lm(),
+            Light::Sky(l) => l.power_lm(scene_radius),
+            Light::Sun(l) => l.power_lm(scene_radius),
         }
     }
 
@@ -195,6 +210,8 @@ impl Light {
             Light::Distant(l) => Some(l.sample_li(wl)),
             Light::Environment(l) => l.sample_li(p, uc, u, wl),
             Light::Area(a) => a.sample_li(geom, p, uc, u, wl),
+            Light::Sky(l) => l.sample_li(p, uc, u, wl),
+            Light::Sun(l) => l.sample_li(u, wl),
         }
     }
 
@@ -263,10 +280,12 @@ impl Light {
     }
 
     /// Density (solid angle) with which [`Light::sample_li`] at `p` picks unit direction `wi`,
-    /// for an environment light (zero for the others).
+    /// for a light at infinity (zero for the others).
     pub fn pdf_li_escape(&self, p: Vec3, wi: Vec3) -> f32 {
         match self {
             Light::Environment(l) => l.pdf_li(p, wi),
+            Light::Sky(l) => l.pdf_li(p, wi),
+            Light::Sun(l) => l.pdf_li(wi),
             _ => 0.0,
         }
     }
@@ -279,10 +298,12 @@ impl Light {
         }
     }
 
-    /// Radiance arriving along an escaped ray.
-    pub fn escaped(&self, wl: &SampledWavelengths) -> SampledSpectrum {
+    /// Radiance arriving along an escaped ray of unit direction `wi`.
+    pub fn escaped(&self, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
         match self {
             Light::Environment(l) => l.escaped(wl),
+            Light::Sky(l) => l.escaped(wi, wl),
+            Light::Sun(l) => l.escaped(wi, wl),
             _ => SampledSpectrum::ZERO,
         }
     }

@@ -286,7 +286,7 @@ pub fn emitters(lights: &[Light], geom: &SceneGeometry) -> Vec<Emitter> {
                     });
                 }
             }
-            Light::Distant(_) | Light::Environment(_) => {}
+            Light::Distant(_) | Light::Environment(_) | Light::Sky(_) | Light::Sun(_) => {}
         }
     }
     out

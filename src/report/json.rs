@@ -107,6 +107,11 @@ fn stats(values: impl Iterator<Item = f64>) -> Value {
 
 /// Build the JSON report.
 pub fn report_json(r: &ReportInput) -> Value {
+    let daylight = crate::light::sky::daylight_reference(&r.world.lights);
+    // Daylight factor, %, per lx of illuminance.
+    let kdf = daylight
+        .as_ref()
+        .map(|d| 100.0 / d.horizontal_illuminance_lx);
     let ke = r.units.from_si(Quantity::Illuminance, 1.0);
     let kl = r.units.from_si(Quantity::Luminance, 1.0);
     let w = r.world;
@@ -134,6 +139,9 @@ pub fn report_json(r: &ReportInput) -> Value {
                 v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
                 v["position"] = v3(*position);
                 v["normal"] = v3(*normal);
+                if let Some(k) = kdf {
+                    v["daylight_factor_percent"] = estimate(e, k);
+                }
                 v
             }
             MeterKind::Luminance {
@@ -158,6 +166,17 @@ pub fn report_json(r: &ReportInput) -> Value {
         .zip(&r.measurements.grids)
         .map(|(g, est)| {
             let s = grid_stats(est);
+            let df = kdf.map(|k| {
+                json!({
+                    "values": (0..g.ny as usize)
+                        .map(|j| (0..g.nx as usize).map(|i| est[j * g.nx as usize + i].mean * k).collect::<Vec<_>>())
+                        .collect::<Vec<_>>(),
+                    "stderr": (0..g.ny as usize)
+                        .map(|j| (0..g.nx as usize).map(|i| est[j * g.nx as usize + i].stderr * k).collect::<Vec<_>>())
+                        .collect::<Vec<_>>(),
+                    "DF_min": s.min * k, "DF_avg": s.avg * k, "DF_max": s.max * k,
+                })
+            });
             let rows = |f: &dyn Fn(&Estimate) -> Value| -> Value {
                 (0..g.ny as usize)
                     .map(|j| {
@@ -180,6 +199,7 @@ pub fn report_json(r: &ReportInput) -> Value {
                 "non_finite_samples": grid_non_finite(est),
                 "E_min": s.min * ke, "E_avg": s.avg * ke, "E_max": s.max * ke,
                 "U0": s.u0, "E_min_over_E_max": s.min_over_max,
+                "daylight_factor_percent": df,
             })
         })
         .collect();
@@ -218,6 +238,10 @@ pub fn report_json(r: &ReportInput) -> Value {
             "illuminance": illuminance,
             "non_finite_samples": r.render.stats.non_finite,
         },
+        "daylight": daylight.map(|d| json!({
+            "sky": d.sky,
+            "horizontal_illuminance": d.horizontal_illuminance_lx * ke,
+        })),
         "meters": meters,
         "grids": grids,
         "outputs": r.outputs,
@@ -231,13 +255,26 @@ pub fn grid_csv(world: &World, grid: usize, est: &[Estimate], units: UnitSystem)
     let g = &world.grids[grid];
     let k = units.from_si(Quantity::Illuminance, 1.0);
     let u = units.symbol(Quantity::Illuminance);
+    let daylight = crate::light::sky::daylight_reference(&world.lights);
     let mut s = format!(
-        "# candela {} grid {:?}: illuminance on the plane facing ({}, {}, {}); positions in m\ni,j,x,y,z,E_{u},stderr_{u},ci95_low_{u},ci95_high_{u},samples\n",
+        "# candela {} grid {:?}: illuminance on the plane facing ({}, {}, {}); positions in m{}\ni,j,x,y,z,E_{u},stderr_{u},ci95_low_{u},ci95_high_{u},samples{}\n",
         env!("CARGO_PKG_VERSION"),
         g.name,
         g.normal.x,
         g.normal.y,
-        g.normal.z
+        g.normal.z,
+        match &daylight {
+            Some(d) => format!(
+                "; daylight factor DF = 100 E / {} lx ({} sky)",
+                d.horizontal_illuminance_lx, d.sky
+            ),
+            None => String::new(),
+        },
+        if daylight.is_some() {
+            ",DF_percent,DF_ci95_low_percent,DF_ci95_high_percent"
+        } else {
+            ""
+        }
     );
     for j in 0..g.ny {
         for i in 0..g.nx {
@@ -254,6 +291,16 @@ pub fn grid_csv(world: &World, grid: usize, est: &[Estimate], units: UnitSystem)
                 (e.mean + e.ci95()) * k,
                 e.samples
             ));
+            if let Some(d) = &daylight {
+                let kdf = 100.0 / d.horizontal_illuminance_lx;
+                s.pop();
+                s.push_str(&format!(
+                    ",{},{},{}\n",
+                    e.mean * kdf,
+                    (e.mean - e.ci95()) * kdf,
+                    (e.mean + e.ci95()) * kdf
+                ));
+            }
         }
     }
     s

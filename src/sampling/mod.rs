@@ -1,11 +1,14 @@
 //! Sampling: the random streams ([`sobol`]), the warps from the unit square to the shapes the
 //! renderer samples, each beside its density ([`warp`]), and choosing among weighted items
-//! ([`discrete`]). Every caller that warps a sample uses these.
+//! ([`discrete`]), and tabulated densities ([`piecewise`]). Every caller that warps a sample
+//! uses these.
 
 pub mod discrete;
+pub mod piecewise;
 pub mod sobol;
 pub mod warp;
 
 pub use discrete::{cdf_from_weights, choose_by_weight, pick_from_cdf};
+pub use piecewise::{Piecewise1D, Piecewise2D};
 pub use sobol::{batch_stream, mix64, Sampler, ONE_MINUS_EPSILON};
 pub use warp::*;

@@ -312,10 +312,12 @@ pub fn build_for(
         && crate::world::caustic_lights::may_trace(
             &caustic_targets,
             !pending_area.is_empty(),
-            scene
-                .lights
-                .iter()
-                .any(|l| !matches!(l, LightDesc::Environment { .. })),
+            scene.lights.iter().any(|l| {
+                !matches!(
+                    l,
+                    LightDesc::Environment { .. } | LightDesc::Sky { .. } | LightDesc::Sun { .. }
+                )
+            }),
         );
     check_film_memory(
         &ctx,
@@ -349,13 +351,116 @@ pub fn build_for(
         objects[object as usize].light = Some(lights.len() as u32);
         lights.push(Light::Area(light));
     }
-    for (i, l) in scene.lights.iter().enumerate() {
-        let field = format!("lights[{i}]");
-        let light = build_light(&ctx, &field, l)?;
+    let frame = site_frame(&ctx, &scene.site)?;
+    // Skies come last: their ground reflects the suns.
+    let mut sky = None;
+    let mut suns_horizontal = crate::spectrum::DenseSpectrum::constant(0.0);
+    let mut push = |light: Light, lights: &mut Vec<Light>| {
         if light.flags().contains(LightFlags::INFINITE) {
             infinite_lights.push(lights.len() as u32);
         }
         lights.push(light);
+    };
+    for (i, l) in scene.lights.iter().enumerate() {
+        let field = format!("lights[{i}]");
+        let light = match l {
+            LightDesc::Sky { .. } | LightDesc::Weather { .. } => {
+                if let Some((j, _)) = sky {
+                    return Err(ctx.err(
+                        &field,
+                        format!("a scene has one sky, and lights[{j}] is one already"),
+                    ));
+                }
+                sky = Some((i, l));
+                continue;
+            }
+            LightDesc::Sun {
+                sun,
+                amount,
+                spectrum,
+            } => {
+                let (s, _) = crate::light::SunLight::build(
+                    &ctx,
+                    &field,
+                    sun,
+                    *amount,
+                    spectrum.as_ref(),
+                    &frame,
+                )?;
+                let h = s.horizontal_irradiance(&frame);
+                for (a, b) in suns_horizontal.values.iter_mut().zip(h.values.iter()) {
+                    *a += *b;
+                }
+                Light::Sun(s)
+            }
+            _ => build_light(&ctx, &field, l)?,
+        };
+        push(light, &mut lights);
+    }
+    let weather;
+    let desc = match sky {
+        Some((
+            i,
+            LightDesc::Sky {
+                model,
+                sun,
+                amount,
+                spectrum,
+                ground_reflectance,
+                portals,
+                sun_disk,
+            },
+        )) => Some((
+            i,
+            crate::light::sky::SkyDesc {
+                model,
+                sun: sun.as_ref(),
+                amount: *amount,
+                spectrum: spectrum.as_ref(),
+                ground_reflectance: *ground_reflectance,
+                portals,
+                sun_disk: *sun_disk,
+            },
+        )),
+        Some((
+            i,
+            LightDesc::Weather {
+                file,
+                time,
+                spectrum,
+                ground_reflectance,
+                portals,
+                sun_disk,
+            },
+        )) => {
+            weather = crate::light::sky::weather_sky(&ctx, &format!("lights[{i}]"), file, time)?;
+            Some((
+                i,
+                crate::light::sky::SkyDesc {
+                    model: &weather.0,
+                    sun: Some(&weather.1),
+                    amount: None,
+                    spectrum: spectrum.as_ref(),
+                    ground_reflectance: *ground_reflectance,
+                    portals,
+                    sun_disk: *sun_disk,
+                },
+            ))
+        }
+        _ => None,
+    };
+    if let Some((i, desc)) = desc {
+        let (s, perez_sun) = crate::light::SkyLight::build(
+            &ctx,
+            &format!("lights[{i}]"),
+            &desc,
+            &frame,
+            &suns_horizontal,
+        )?;
+        push(Light::Sky(Box::new(s)), &mut lights);
+        if let Some(sun) = perez_sun {
+            push(Light::Sun(sun), &mut lights);
+        }
     }
     let light_sampler = LightSampler::new(settings.light_sampler, &lights, &geometry, scene_radius);
     let (meters, grids, measure) =
@@ -394,6 +499,20 @@ pub fn build_for(
         caustics,
         sources: ctx.sources.into_inner(),
     })
+}
+
+/// The site's frame from `site`.
+fn site_frame(
+    ctx: &Context,
+    site: &crate::description::schema::SiteDesc,
+) -> Result<crate::light::SiteFrame, SceneError> {
+    let up = ctx.unit("site.up", site.up)?.as_dvec3();
+    let north = ctx.unit("site.north", site.north)?.as_dvec3();
+    if up.normalize().cross(north.normalize()).length() < 1e-3 {
+        return Err(ctx.err("site.north", "north is parallel to up"));
+    }
+    crate::light::SiteFrame::new(up, north)
+        .ok_or_else(|| ctx.err("site.north", "north is parallel to up"))
 }
 
 fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, SceneError> {
@@ -447,5 +566,8 @@ fn build_light(ctx: &Context, field: &str, l: &LightDesc) -> Result<Light, Scene
                 multiplier: *multiplier,
             },
         )?)),
+        LightDesc::Sky { .. } | LightDesc::Weather { .. } | LightDesc::Sun { .. } => {
+            unreachable!("skies and suns are built beside the site's frame")
+        }
     })
 }
