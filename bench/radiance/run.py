@@ -61,7 +61,7 @@ class Bench:
     def __init__(self, a):
         self.a = a
         self.out = os.path.join(ROOT, "target", "bench", "radiance")
-        self.candela = os.path.join(ROOT, "target", "release", "candela")
+        self.candela = a.candela
         os.makedirs(self.out, exist_ok=True)
 
     # ---------- scenes ----------
@@ -233,6 +233,7 @@ def main():
     ap.add_argument("--reps", type=int, default=3, help="timed runs of each configuration")
     ap.add_argument("--reps-high", type=int, default=3, help="timed runs of Radiance \"high\" (minutes each)")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--candela", default=os.path.join(ROOT, "target", "release", "candela"), help="candela binary")
     ap.add_argument("--settings", default="mc,medium", help="Radiance settings to time: mc, medium, high")
     ap.add_argument("--mc-ad", type=int, default=256, help="-ad of the timed Monte Carlo mode")
     ap.add_argument("--ref-samples", type=int, default=16384, help="candela reference samples per point")
