@@ -64,17 +64,18 @@ def run_candela(args, spp, seed, stem):
         rep = json.load(f)
     y, se = compare.read_candela_exr(stem + ".exr")
     return {"renderer": "candela", "spp": spp, "seed": seed, "render_s": rep["timing"]["render_seconds"],
+            "rays_per_sample": rep["timing"]["rays"] / (y.size * spp),
             "wall_s": wall, "cpu_s": cpu, "peak_rss_mib": rss, "Y": y, "var": se ** 2}
 
 
-def run_mitsuba(args, spp, seed, out, parts=1):
-    cmd = [sys.executable, os.path.join(HERE, "render.py"), "--scene", XML, "--variant", "llvm_ad_spectral",
+def run_mitsuba(args, spp, seed, out, parts=1, variant="llvm_ad_spectral"):
+    cmd = [sys.executable, os.path.join(HERE, "render.py"), "--scene", XML, "--variant", variant,
            "--spp", str(spp), "--seed", str(seed), "--threads", str(args.threads), "--parts", str(parts),
            "--sampler", args.mitsuba_sampler, "--out", out]
     stdout, _, wall, cpu, rss = timed(cmd)
     info = json.loads([line for line in stdout.splitlines() if line.startswith("{")][-1])
     ys = np.load(out) * compare.MITSUBA_Y_TO_CD_M2
-    return {"renderer": "mitsuba", "spp": spp, "seed": seed, "render_s": info["render_s"], "wall_s": wall,
+    return {"renderer": "mitsuba" if variant == "llvm_ad_spectral" else "scalar", "spp": spp, "seed": seed, "render_s": info["render_s"], "wall_s": wall,
             "cpu_s": cpu, "peak_rss_mib": rss, "Y": ys.mean(axis=0), "parts": ys}
 
 
@@ -180,14 +181,21 @@ def markdown(res):
              f"{meta['loadavg_end'][0]:.1f} at end); medians of {meta['reps']} alternated rounds (min–max).", "",
              "| renderer | spp | render time (s) | CPU time (s) | Msamples/s | peak RSS (MiB) | RMSE Y (cd/m²) | rel. RMSE |",
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
-    for key, label in (("candela", "candela"), ("mitsuba", f"Mitsuba {meta['mitsuba']} llvm_ad_spectral, {meta['sampler']}")):
+    for key, label in (("candela", "candela"), ("mitsuba", f"Mitsuba {meta['mitsuba']} llvm_ad_spectral, {meta['sampler']}"),
+                       ("scalar", f"Mitsuba {meta['mitsuba']} scalar_spectral, {meta['sampler']}")):
+        if key not in s:
+            continue
         g = s[key]
         lines.append(f"| {label} | {g['spp']} | {rng(g['render_s'])} | {rng(g['cpu_s'])} | {g['samples_per_s']['median'] / 1e6:.3f} | "
                      f"{g['peak_rss_mib']['median']:.0f} | {rng(g['rmse'], '{:.3f}')} | {100 * g['rel_rmse']['median']:.2f} % |")
     r = res["ratios"]
     lines += ["", "| candela ÷ Mitsuba, per round | throughput | efficiency at equal error, render time | "
               "efficiency at equal error, CPU time |", "|---|---:|---:|---:|",
-              f"| median (min–max) | {rng(r['throughput'])}× | **{rng(r['eff_render'])}×** | {rng(r['eff_cpu'])}× |", "",
+              f"| vs llvm_ad_spectral: median (min–max) | {rng(r['throughput'])}× | {rng(r['eff_render'])}× | **{rng(r['eff_cpu'])}×** |"]
+    if res.get("ratios_scalar"):
+        r = res["ratios_scalar"]
+        lines.append(f"| vs scalar_spectral: median (min–max) | {rng(r['throughput'])}× | {rng(r['eff_render'])}× | **{rng(r['eff_cpu'])}×** |")
+    lines += ["",
               f"Converged references: candela {meta['ref_parts']} × {meta['ref_spp'] // meta['ref_parts']} spp, Mitsuba "
               f"{meta['ref_parts']} × {meta['ref_spp'] // meta['ref_parts']} spp; luminance in cd/m² ± 1σ:", "",
               "| region | candela | Mitsuba | Δ | Δ/σ |", "|---|---:|---:|---:|---:|"]
@@ -209,6 +217,7 @@ def main():
     ap.add_argument("--ref-parts", type=int, default=8)
     ap.add_argument("--fresh-refs", action="store_true")
     ap.add_argument("--mitsuba-sampler", default="multijitter")
+    ap.add_argument("--scalar", action="store_true", help="also time Mitsuba scalar_spectral (one ray at a time)")
     ap.add_argument("--candela", default=compare.CANDELA, help="candela binary (default target/release/candela)")
     ap.add_argument("--json", default=os.path.join(OUT, "mitsuba-interior-results.json"))
     ap.add_argument("--quick", action="store_true", help="smoke run: 1 round, 8 x 64 spp references")
@@ -237,23 +246,32 @@ def main():
     run_candela(args, 4, 7, os.path.join(runs, "interior-warmup"))
     run_mitsuba(args, args.spp, 7, os.path.join(runs, "interior-warmup.npy"))
     groups = {"candela": [], "mitsuba": []}
+    if args.scalar:
+        groups["scalar"] = []
     for rep in range(args.reps):
         log(f"round {rep + 1}/{args.reps} at {args.spp} spp")
         groups["candela"].append(finish(run_candela(args, args.spp, rep + 1, os.path.join(runs, "interior-candela")), cref, mask))
         groups["mitsuba"].append(finish(run_mitsuba(args, args.spp, rep + 1, os.path.join(runs, "interior-mitsuba.npy")), mref, mask))
+        if args.scalar:
+            # Same code as the LLVM variant, so the same converged image: the LLVM reference.
+            groups["scalar"].append(finish(run_mitsuba(args, args.spp, rep + 1, os.path.join(runs, "interior-scalar.npy"),
+                                                       variant="scalar_spectral"), mref, mask))
     meta["loadavg_end"] = os.getloadavg()
     summary = {}
     for k, g in groups.items():
+        if k == "candela":
+            meta["candela_rays_per_sample"] = statistics.median(r["rays_per_sample"] for r in g)
         summary[k] = {q: med(g, q) for q in ("render_s", "cpu_s", "wall_s", "peak_rss_mib", "rmse", "rel_rmse", "mse",
                                              "eff_render", "eff_cpu", "samples_per_s")}
         summary[k]["spp"] = args.spp
-    pairs = list(zip(groups["candela"], groups["mitsuba"]))
 
-    def ratio(q):
-        v = [c[q] / m[q] for c, m in pairs]
+    def ratio(q, other="mitsuba"):
+        v = [c[q] / m[q] for c, m in zip(groups["candela"], groups[other])]
         return {"median": statistics.median(v), "min": min(v), "max": max(v)}
     res = {"meta": meta, "agreement": {"regions": agree, **chi}, "summary": summary,
            "ratios": {q: ratio(k) for q, k in (("throughput", "samples_per_s"), ("eff_render", "eff_render"), ("eff_cpu", "eff_cpu"))},
+           "ratios_scalar": ({q: ratio(k, "scalar") for q, k in (("throughput", "samples_per_s"), ("eff_render", "eff_render"),
+                                                                  ("eff_cpu", "eff_cpu"))} if args.scalar else None),
            "runs": groups, "references": {"candela": {k: cref[k] for k in ("render_s", "cpu_s")},
                                           "mitsuba": {k: mref[k] for k in ("render_s", "cpu_s")}}}
     res["markdown"] = markdown(res)

@@ -263,7 +263,7 @@ def main():
     ap.add_argument("--reps-high", type=int, default=3, help="timed runs at QUALITY=High (minutes each)")
     ap.add_argument("--threads", type=int, default=2, help="candela threads (rpict is one process)")
     ap.add_argument("--candela", default=os.path.join(ROOT, "target", "release", "candela"))
-    ap.add_argument("--ref-spp", type=int, default=1024, help="candela reference spp per part")
+    ap.add_argument("--ref-spp", type=int, default=256, help="candela reference spp per part")
     ap.add_argument("--ref-parts", type=int, default=4)
     ap.add_argument("--calib-spp", type=int, default=64, help="candela run that sets its spp")
     ap.add_argument("--rad-ref-ad", type=int, default=256)
