@@ -138,7 +138,28 @@ class Images:
         pf = re.search(r"pfilt (.*?) \S+\.unf >", txt)
         return rp, (pf.group(1).split() if pf else [])
 
+    def precomputed(self, quality, q):
+        """A run made beforehand in --precomputed DIR: QUALITY-Q.hdr (rpict, then pfilt),
+        QUALITY-Q.rpict.time and .pfilt.time (GNU time '%e wall %U user %S sys'), QUALITY-Q.cmd."""
+        d = self.a.precomputed
+        stem = os.path.join(d, f"{quality}-{q}") if d else None
+        if not stem or not os.path.exists(stem + ".hdr"):
+            return None
+        wall = cpu = 0.0
+        for part in ("rpict", "pfilt"):
+            with open(f"{stem}.{part}.time") as f:
+                t = f.read().split()
+            wall += float(t[0])
+            cpu += float(t[2]) + float(t[4])
+        with open(stem + ".cmd") as f:
+            cmd = f.read().strip()
+        return {"wall_s": wall, "cpu_s": cpu, "rpict": cmd, "pfilt": "", "precomputed": stem,
+                "img": read_pic(stem + ".hdr", self.w, self.h)}
+
     def radiance(self, quality, illuminance):
+        pre = self.precomputed(quality, "E" if illuminance else "Y")
+        if pre:
+            return pre
         rp, pf = self.rad_commands(quality)
         unf, pic = os.path.join(self.d, "r.unf"), os.path.join(self.d, "r.hdr")
         cmd = ["rpict"] + (["-i"] if illuminance else []) + rp + [self.oct]
@@ -271,6 +292,8 @@ def main():
     ap.add_argument("--ref-step", type=int, default=4, help="Radiance reference at every STEP-th pixel centre")
     ap.add_argument("--no-radiance-ref", action="store_true", help="skip the agreement check against Radiance")
     ap.add_argument("--fresh-refs", action="store_true")
+    ap.add_argument("--precomputed", metavar="DIR", help="use the Radiance runs made beforehand in DIR "
+                    "(QUALITY-Y.hdr, QUALITY-E.hdr with .rpict.time, .pfilt.time, .cmd; e.g. one long High run)")
     ap.add_argument("--results", default="images-results.json")
     ap.add_argument("--quick", action="store_true", help="smoke run: 128x96, Medium only, 1 rep, small references")
     a = ap.parse_args()
@@ -298,7 +321,8 @@ def main():
             for q in a.quantities.split(","):
                 ill = q == "E"
                 rr_runs, cc_runs, spp = [], [], None
-                for rep in range(a.reps_high if quality.lower() == "high" else a.reps):
+                pre = b.precomputed(quality, q) is not None
+                for rep in range(a.reps_high if quality.lower() == "high" and not pre else a.reps):
                     rr = b.radiance(quality, ill)
                     rr["rel_rms"], rr["bias"] = rel_rms(rr.pop("img"), ref[q], ref["var" + q], mask)
                     rr_runs.append(rr)
