@@ -150,7 +150,9 @@ def candela_scene_files():
 def mitsuba_scene_files():
     out = []
     for d, _, fs in os.walk(MITSUBA_DIR):
-        out += [os.path.join(d, f) for f in fs if f.endswith((".xml", ".obj", ".spd"))]
+        # The Cornell scene's files only (not the diffuse interior's, bench/mitsuba/interior.*).
+        out += [os.path.join(d, f) for f in fs
+                if f.endswith((".xml", ".obj", ".spd")) and "interior" not in os.path.relpath(os.path.join(d, f), MITSUBA_DIR)]
     return out
 
 

@@ -3,7 +3,8 @@
 
 The room is 8 m x 6 m x 3 m, grey and Lambertian (ceiling 0.8, walls 0.7, floor 0.2), lit by N
 copies of one IES luminaire on a regular ceiling layout, with a 16 x 12 work-plane grid at
-0.8 m. Radiance is z-up; candela is y-up. A Radiance point (X, Y, Z) is candela's
+0.8 m. N = 500 is an open-plan floor instead, 60 m x 48 m x 3 m with 25 x 20 luminaires on a
+2.4 m square pitch (about the N = 6 office's 8 m^2 per luminaire), the grid over the whole floor. Radiance is z-up; candela is y-up. A Radiance point (X, Y, Z) is candela's
 (X, Z, 6 - Y): a proper rotation (no mirror), so an asymmetric luminaire keeps its handedness.
 Both tools put C0 along +X and C90 along Radiance's +Y (= candela's -Z), nadir down.
 
@@ -20,7 +21,9 @@ import os
 import subprocess
 import sys
 
-ROOM = (8.0, 6.0, 3.0)  # X (length), Y (depth), Z (height), metres
+OFFICE = (8.0, 6.0, 3.0)  # X (length), Y (depth), Z (height), metres
+OPEN_PLAN = (60.0, 48.0, 3.0)  # the N = 500 floor
+ROOM = OFFICE  # set by main() from --n
 RHO = {"ceiling": 0.8, "wall": 0.7, "floor": 0.2}
 GRID_NX, GRID_NY, GRID_H = 16, 12, 0.8
 LUM_Z = 2.95  # luminaire centre height, m (5 cm below the ceiling)
@@ -28,6 +31,11 @@ LUM_RADIUS = 0.01  # radius of Radiance's illum sphere, m: a near point source, 
 
 # Layouts: columns x rows of luminaires at the centres of equal cells of the ceiling.
 LAYOUTS = {6: (3, 2), 48: (8, 6), 500: (25, 20)}
+# The camera of the images (Radiance coordinates): eye 1.6 m high, 0.5 m from the wall y = 6,
+# looking across the room at a point 1.2 m high on the wall y = 0; vertical field of view 60 deg.
+VIEW_EYE = (4.0, 5.5, 1.6)
+VIEW_TARGET = (4.0, 0.0, 1.2)
+VIEW_VFOV = 60.0
 
 
 def layout(n):
@@ -61,18 +69,36 @@ def fmt(v):
     return "(" + ", ".join(f"{c:.6g}" for c in v) + ")"
 
 
-def candela_scene(n, ies_rel, samples, max_depth):
+def view_args(width, height):
+    """Radiance view options of the image camera, the same view as candela's camera."""
+    import math
+
+    d = [t - e for t, e in zip(VIEW_TARGET, VIEW_EYE)]
+    vh = 2 * math.degrees(math.atan(width / height * math.tan(math.radians(VIEW_VFOV / 2))))
+    return (f"-vtv -vp {VIEW_EYE[0]:g} {VIEW_EYE[1]:g} {VIEW_EYE[2]:g} -vd {d[0]:g} {d[1]:g} {d[2]:g} "
+            f"-vu 0 0 1 -vv {VIEW_VFOV:g} -vh {vh:.6f}")
+
+
+def candela_scene(n, ies_rel, samples, max_depth, image=None):
+    """The RON; with image = (width, height), a picture of the camera view and no grid."""
     lx, ly, lz = ROOM
     lights = "\n".join(
         f"        Goniometric(file: \"{ies_rel}\", position: {fmt(to_candela(p))}, spectrum: Named(\"E\")),"
         for p in layout(n)
     )
-    # Quads in candela coordinates: x in [0, 8], y in [0, 3] (up), z in [0, 6].
+    res, spp = (image, 64) if image else ((1, 1), 1)
+    grids = (f"""    grids: [
+        (name: "work plane", origin: (0.0, {GRID_H}, 0.0), edge_u: ({lx}, 0.0, 0.0), edge_v: (0.0, 0.0, {ly}), nx: {GRID_NX}, ny: {GRID_NY}),
+    ],
+    measure: (samples: {samples}),
+""" if not image else "")
+    what = f"a {res[0]} x {res[1]} picture" if image else f"{GRID_NX} x {GRID_NY} work-plane grid at {GRID_H} m"
+    # Quads in candela coordinates: x in [0, lx], y in [0, lz] (up), z in [0, ly].
     return f"""// Radiance benchmark office (bench/radiance/gen_scene.py): {lx:g} x {ly:g} x {lz:g} m, N = {n}
-// luminaires, grey Lambertian surfaces, 16 x 12 work-plane grid at 0.8 m. Generated; do not edit.
+// luminaires, grey Lambertian surfaces, {what}. Generated; do not edit.
 Scene(
-    camera: (position: (4.0, 1.6, 0.5), look_at: (4.0, 1.2, 6.0), vfov_deg: 60.0, resolution: (1, 1)),
-    render: (spp: 1, max_depth: {max_depth}),
+    camera: (position: {fmt(to_candela(VIEW_EYE))}, look_at: {fmt(to_candela(VIEW_TARGET))}, vfov_deg: {VIEW_VFOV}, resolution: {res}),
+    render: (spp: {spp}, max_depth: {max_depth}),
     materials: {{
         "ceiling": Diffuse(reflectance: Constant({RHO['ceiling']})),
         "wall": Diffuse(reflectance: Constant({RHO['wall']})),
@@ -92,11 +118,7 @@ Scene(
         (name: "wall z=6", material: "wall",
          shape: Quad(origin: (0.0, 0.0, {ly}), edge_u: (0.0, {lz}, 0.0), edge_v: ({lx}, 0.0, 0.0))),
     ],
-    grids: [
-        (name: "work plane", origin: (0.0, {GRID_H}, 0.0), edge_u: ({lx}, 0.0, 0.0), edge_v: (0.0, 0.0, {ly}), nx: {GRID_NX}, ny: {GRID_NY}),
-    ],
-    measure: (samples: {samples}),
-    lights: [
+{grids}    lights: [
 {lights}
     ],
 )
@@ -139,7 +161,10 @@ def main():
     ap.add_argument("--max-depth", type=int, default=1000, help="candela render.max_depth")
     ap.add_argument("--ies2rad", default="ies2rad")
     ap.add_argument("--name", help="file stem (default office-N)")
+    ap.add_argument("--image", metavar="WxH", help="also write office-N-image.ron: a W x H picture, no grid")
     a = ap.parse_args()
+    global ROOM
+    ROOM = OPEN_PLAN if a.n == 500 else OFFICE
 
     os.makedirs(a.out_dir, exist_ok=True)
     stem = a.name or f"office-{a.n}"
@@ -147,6 +172,10 @@ def main():
     ies_rel = os.path.relpath(ies_abs, os.path.abspath(a.out_dir))
     with open(os.path.join(a.out_dir, stem + ".ron"), "w") as f:
         f.write(candela_scene(a.n, ies_rel, a.samples, a.max_depth))
+    if a.image:
+        w, h = (int(x) for x in a.image.lower().split("x"))
+        with open(os.path.join(a.out_dir, stem + "-image.ron"), "w") as f:
+            f.write(candela_scene(a.n, ies_rel, a.samples, a.max_depth, image=(w, h)))
     # -dm: the file's dimensions and Radiance's output in metres; -i: ignore the file's luminous
     # opening (0.3 x 1.2 m) and emit from a sphere of LUM_RADIUS, as candela's point source;
     # -t default: white lamp (RGB 1 1 1), so 179 lm/W turns its radiance back into the candela.

@@ -61,7 +61,7 @@ class Bench:
     def __init__(self, a):
         self.a = a
         self.out = os.path.join(ROOT, "target", "bench", "radiance")
-        self.candela = os.path.join(ROOT, "target", "release", "candela")
+        self.candela = a.candela
         os.makedirs(self.out, exist_ok=True)
 
     # ---------- scenes ----------
@@ -109,6 +109,19 @@ class Bench:
         ses = [v for row in g["stderr"] for v in row]
         return {"wall_s": wall, "cpu_s": cpu, "measure_s": rep["timing"]["measure_seconds"], "values": vals, "stderr": ses,
                 "samples": samples, "seed": seed}
+
+    def load_radiance(self, directory):
+        """A Radiance run made outside this script (--precomputed): out.txt = rtrace -I -h -ov
+        over points.txt, time.txt = GNU time's '%e wall %U user %S sys ...', cmd.txt = the command."""
+        with open(os.path.join(directory, "out.txt")) as f:
+            rows = [line.split() for line in f.read().strip().splitlines()]
+        with open(os.path.join(directory, "time.txt")) as f:
+            t = f.read().split()
+        with open(os.path.join(directory, "cmd.txt")) as f:
+            cmd = f.read().strip()
+        lux = [EFFICACY * sum(w * float(c) for w, c in zip(RGB_Y, r[:3])) for r in rows]
+        return {"wall_s": float(t[0]), "cpu_s": float(t[2]) + float(t[4]), "values": lux, "args": cmd, "nproc": 1,
+                "seed": 0, "precomputed": directory}
 
     def run_radiance(self, n, args, nproc, seed):
         """One rtrace -I process over the grid; rtrace has no seed option, so `seed` leading
@@ -233,7 +246,11 @@ def main():
     ap.add_argument("--reps", type=int, default=3, help="timed runs of each configuration")
     ap.add_argument("--reps-high", type=int, default=3, help="timed runs of Radiance \"high\" (minutes each)")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--candela", default=os.path.join(ROOT, "target", "release", "candela"), help="candela binary")
     ap.add_argument("--settings", default="mc,medium", help="Radiance settings to time: mc, medium, high")
+    ap.add_argument("--precomputed", metavar="SETTING=DIR,...",
+                    help="use the Radiance run in DIR (out.txt, time.txt, cmd.txt) for SETTING, e.g. one long "
+                         "'high' run made beforehand; candela still runs --reps times")
     ap.add_argument("--mc-ad", type=int, default=256, help="-ad of the timed Monte Carlo mode")
     ap.add_argument("--ref-samples", type=int, default=16384, help="candela reference samples per point")
     ap.add_argument("--ref-seeds", type=int, default=2)
@@ -286,14 +303,15 @@ def main():
         cal_rms = rel_rms(cal["values"], ref_v, ref_se)[0]
         entry["candela_calibration"] = {"samples": a.calib_samples, "rel_rms": cal_rms, "wall_s": cal["wall_s"]}
         log(f"N={n}: candela {a.calib_samples} samples/point: rel. RMS {cal_rms:.4%} in {cal['wall_s']:.2f} s")
-        for setting in a.settings.split(","):
-            args = mc_args(a.mc_ad, 12) if setting == "mc" else PRESETS[setting]
+        pre = dict(x.split("=", 1) for x in a.precomputed.split(",")) if a.precomputed else {}
+        for setting in a.settings.split(",") + [k for k in pre if k not in a.settings.split(",")]:
+            args = mc_args(a.mc_ad, 12) if setting == "mc" else PRESETS.get(setting, "")
             log(f"N={n}: {setting}: {args}")
             rad_runs, can_runs = [], []
             samples = None
-            for rep in range(a.reps_high if setting == "high" else a.reps):
+            for rep in range(a.reps_high if setting == "high" and setting not in pre else a.reps):
                 # rtrace seeds its random numbers itself (repeated runs differ): no dummy points here.
-                rr = b.run_radiance(n, args, a.threads, 0)
+                rr = b.load_radiance(pre[setting]) if setting in pre else b.run_radiance(n, args, a.threads, 0)
                 rr["rel_rms"], rr["rel_rms_raw"] = rel_rms(rr["values"], ref_v, ref_se)
                 rr["bias"] = bias(rr["values"], ref_v)
                 del rr["values"]
