@@ -507,3 +507,48 @@ fn vertical_surface_sees_half_sky_half_ground() {
         }
     }
 }
+
+/// A one-pixel camera with a 0.05° field of view aimed at the sun's centre sees only the disk:
+/// its pixel is the disk's luminance E_n / Ω in every sample.
+#[test]
+fn camera_sees_the_sun_disk_luminance() {
+    let (alt, az) = (50f64.to_radians(), 160f64.to_radians());
+    let to_sun = [alt.cos() * az.sin(), alt.sin(), -alt.cos() * az.cos()];
+    let e_n = 100_000.0;
+    let w = world(&format!(
+        "(camera: (position: (0, 0, 0), look_at: ({}, {}, {}), vfov_deg: 0.05, resolution: (1, 1)),
+          render: (spp: 64),
+          lights: [Sun(sun: (altitude_deg: 50.0, azimuth_deg: 160.0), amount: NormalIlluminance({e_n}))])",
+        to_sun[0], to_sun[1], to_sun[2]
+    ));
+    let film = common::render(&w, 1);
+    let (mean, se) = common::luminance(&film.pixels[0]);
+    let expected = e_n / candela::daylight::sun::sun_solid_angle_sr();
+    println!("sun disk in a pixel: {mean:.6e} ± {se:.1e} cd/m² (E_n/Ω = {expected:.6e})");
+    // Every sample lands on the disk; what varies is the spectral sampling of its colour.
+    assert_estimate_near(mean, se, expected, 0.01, "the sun's disk in one pixel");
+}
+
+/// `solar_time: true`: 12:00 local apparent solar time puts the sun on the meridian, due south.
+#[test]
+fn solar_time_noon_is_due_south() {
+    // A meter facing south (+z with the default north −z) and one facing east (+x) under the
+    // sun alone. At solar noon the east-facing meter's plane cuts the disk (radius α) through
+    // its centre, and it receives L ∫ cos over the half disk in front: E_n · 2α / (3π) (79 lx
+    // here). One hundredth of a degree of azimuth moves that by about 10 lx.
+    let lights = "Sun(sun: (latitude_deg: 45.76, longitude_deg: 4.84, time: \"2026-04-15T12:00:00\", solar_time: true), amount: NormalIlluminance(80000.0))";
+    let meters = r#"Illuminance(name: "south", position: (0, 0, 0), normal: (0, 0, 1)),
+                    Illuminance(name: "east", position: (0, 0, 0), normal: (1, 0, 0))"#;
+    let r = measure(lights, "", meters, 256);
+    assert!(r[0].0 > 30_000.0, "south {r:?}");
+    let alpha = (0.5 * candela::daylight::sun::SUN_DIAMETER_DEG).to_radians();
+    let grazing = 80_000.0 * 2.0 * alpha / (3.0 * PI);
+    println!(
+        "solar noon: east-facing meter {:.2} ± {:.2} lx (exactly on the meridian: {grazing:.2})",
+        r[1].0, r[1].1
+    );
+    assert!(
+        (r[1].0 - grazing).abs() < 5.0 * r[1].1 + 10.0,
+        "east {r:?}, expected {grazing}"
+    );
+}

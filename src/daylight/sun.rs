@@ -64,8 +64,22 @@ impl CivilTime {
     /// Parse `YYYY-MM-DDThh:mm[:ss[.fff]]` followed by `Z` or `±hh:mm`. The offset is
     /// required: a time without it names no instant.
     pub fn parse(s: &str) -> Result<Self, String> {
-        let bad =
-            |why: &str| format!("time {s:?}: {why} (expected e.g. \"2026-06-21T10:00:00+02:00\")");
+        Self::parse_with(s, true)
+    }
+
+    /// Parse a local apparent solar time, `YYYY-MM-DDThh:mm[:ss[.fff]]` without an offset
+    /// (solar time is fixed by the sun, not by a time zone); `offset_s` is 0.
+    pub fn parse_solar(s: &str) -> Result<Self, String> {
+        Self::parse_with(s, false)
+    }
+
+    fn parse_with(s: &str, with_offset: bool) -> Result<Self, String> {
+        let example = if with_offset {
+            "2026-06-21T10:00:00+02:00"
+        } else {
+            "2026-06-21T10:00:00, local apparent solar time without an offset"
+        };
+        let bad = |why: &str| format!("time {s:?}: {why} (expected e.g. \"{example}\")");
         let (date, rest) = s
             .split_once(['T', ' '])
             .ok_or_else(|| bad("no 'T' between date and time"))?;
@@ -80,7 +94,12 @@ impl CivilTime {
             t.parse::<i64>().map_err(|_| bad(&format!("bad {what}")))
         };
         let (year, month, day) = (num(y, "year")?, num(mo, "month")?, num(da, "day")?);
-        let (clock, offset_s) = if let Some(c) = rest.strip_suffix('Z') {
+        if !with_offset && (rest.ends_with('Z') || rest.contains(['+', '-'])) {
+            return Err(bad("a solar time has no UTC offset"));
+        }
+        let (clock, offset_s) = if !with_offset {
+            (rest, 0.0)
+        } else if let Some(c) = rest.strip_suffix('Z') {
             (c, 0.0)
         } else if let Some(i) = rest.rfind(['+', '-']) {
             let (c, off) = rest.split_at(i);
@@ -168,6 +187,27 @@ impl Default for Atmosphere {
     }
 }
 
+/// The UT Julian date of local apparent solar time `t` (its date and clock; `offset_s`
+/// ignored) at `longitude_deg`: the sun's upper meridian transit of that day (by SPA) plus the
+/// clock's distance from 12:00. The equation of time drifts by under 30 s a day, so the
+/// instant is right to a few seconds.
+pub fn solar_time_to_julian(
+    t: &CivilTime,
+    longitude_deg: f64,
+    delta_t_s: f64,
+) -> Result<f64, String> {
+    use solar_positioning::SolarEvents;
+    let noon = JulianDate::from_utc(t.year, t.month, t.day, 12, 0, 0.0, delta_t_s)
+        .map_err(|e| format!("time: {e}"))?
+        .julian_date()
+        - longitude_deg / 360.0;
+    let transit = SolarEvents::new()
+        .next_transit_from_julian(noon - 0.5, noon + 0.5, longitude_deg, delta_t_s)
+        .map_err(|e| format!("solar noon: {e}"))?
+        .ok_or_else(|| "no solar noon found on that date".to_string())?;
+    Ok(transit + (t.seconds - 43_200.0) / 86_400.0)
+}
+
 /// The sun's position at `latitude_deg` (north positive), `longitude_deg` (east positive),
 /// `elevation_m` above sea level, at `time`; ΔT (TT − UT, s) estimated from the date unless
 /// given.
@@ -176,6 +216,28 @@ pub fn sun_position(
     longitude_deg: f64,
     elevation_m: f64,
     time: &CivilTime,
+    atmosphere: Atmosphere,
+    delta_t_s: Option<f64>,
+) -> Result<SunPosition, String> {
+    sun_position_at(
+        latitude_deg,
+        longitude_deg,
+        elevation_m,
+        time,
+        false,
+        atmosphere,
+        delta_t_s,
+    )
+}
+
+/// [`sun_position`], with `time` read as local apparent solar time when `solar_time` (see
+/// [`CivilTime::parse_solar`]).
+pub fn sun_position_at(
+    latitude_deg: f64,
+    longitude_deg: f64,
+    elevation_m: f64,
+    time: &CivilTime,
+    solar_time: bool,
     atmosphere: Atmosphere,
     delta_t_s: Option<f64>,
 ) -> Result<SunPosition, String> {
@@ -196,17 +258,22 @@ pub fn sun_position(
         None => solar_positioning::delta_t::estimate_from_date(y, m)
             .map_err(|e| format!("ΔT for {y}-{m:02}: {e}"))?,
     };
-    let (h, rem) = ((s / 3600.0).floor(), s % 3600.0);
-    let (mi, sec) = ((rem / 60.0).floor(), rem % 60.0);
-    // 24:00 is the next day's midnight.
-    let (y, m, d, h) = if h >= 24.0 {
-        let (y2, m2, d2) = civil_from_days(days_from_civil(y as i64, m, d) + 1);
-        (y2 as i32, m2, d2, 0.0)
+    let jd = if solar_time {
+        JulianDate::new(solar_time_to_julian(time, longitude_deg, delta_t)?, delta_t)
+            .map_err(|e| format!("time: {e}"))?
     } else {
-        (y, m, d, h)
+        let (h, rem) = ((s / 3600.0).floor(), s % 3600.0);
+        let (mi, sec) = ((rem / 60.0).floor(), rem % 60.0);
+        // 24:00 is the next day's midnight.
+        let (y, m, d, h) = if h >= 24.0 {
+            let (y2, m2, d2) = civil_from_days(days_from_civil(y as i64, m, d) + 1);
+            (y2 as i32, m2, d2, 0.0)
+        } else {
+            (y, m, d, h)
+        };
+        JulianDate::from_utc(y, m, d, h as u32, mi as u32, sec, delta_t)
+            .map_err(|e| format!("time: {e}"))?
     };
-    let jd = JulianDate::from_utc(y, m, d, h as u32, mi as u32, sec, delta_t)
-        .map_err(|e| format!("time: {e}"))?;
     let refraction = RefractionCorrection::new(atmosphere.pressure_hpa, atmosphere.temperature_c)
         .map_err(|e| format!("atmosphere: {e}"))?;
     let p = SolarPositions::new()
@@ -270,6 +337,35 @@ mod tests {
             (p.azimuth_deg - 90.0).abs() < 0.5 && p.altitude_deg.abs() < 3.0,
             "{p:?}"
         );
+    }
+
+    #[test]
+    fn solar_time() {
+        // At 12:00 local apparent solar time the sun is due south (north of the tropics), and
+        // 09:00 and 15:00 mirror each other about the meridian.
+        let at = |clock: &str| {
+            let t = CivilTime::parse_solar(&format!("2026-04-15T{clock}")).unwrap();
+            sun_position_at(45.76, 4.84, 0.0, &t, true, Atmosphere::default(), None).unwrap()
+        };
+        let noon = at("12:00:00");
+        assert!((noon.azimuth_deg - 180.0).abs() < 0.01, "{noon:?}");
+        let (am, pm) = (at("09:00:00"), at("15:00:00"));
+        // The declination moves by about 0.1° in six hours in April.
+        assert!(
+            (am.altitude_deg - pm.altitude_deg).abs() < 0.1,
+            "{am:?} {pm:?}"
+        );
+        assert!(
+            (am.azimuth_deg + pm.azimuth_deg - 360.0).abs() < 0.2,
+            "{am:?} {pm:?}"
+        );
+        // The same instant by the clock: solar noon in Lyon on 15 April 2026 is near
+        // 11:40:30 UTC (longitude −19.4 min, equation of time +0.1 min).
+        let t = CivilTime::parse("2026-04-15T11:40:30Z").unwrap();
+        let clock = sun_position(45.76, 4.84, 0.0, &t, Atmosphere::default(), None).unwrap();
+        assert!((clock.azimuth_deg - 180.0).abs() < 0.2, "{clock:?}");
+        assert!(CivilTime::parse_solar("2026-04-15T12:00:00+02:00").is_err());
+        assert!(CivilTime::parse_solar("2026-04-15T12:00Z").is_err());
     }
 
     #[test]

@@ -649,8 +649,9 @@ pub enum SkyModelDesc {
 }
 
 /// Where the sun is: `altitude_deg` and `azimuth_deg` (from north toward east), or
-/// `latitude_deg`, `longitude_deg` (east positive), `time` (ISO 8601 with its UTC offset) and
-/// optionally `elevation_m`.
+/// `latitude_deg`, `longitude_deg` (east positive), `time` (ISO 8601 with its UTC offset, or
+/// local apparent solar time without one when `solar_time: true`) and optionally
+/// `elevation_m`.
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SunDesc {
@@ -666,4 +667,7 @@ pub struct SunDesc {
     pub time: Option<String>,
     #[serde(default)]
     pub elevation_m: Option<f64>,
+    /// `time` is local apparent solar time (no UTC offset) instead of clock time.
+    #[serde(default)]
+    pub solar_time: bool,
 }

@@ -133,7 +133,7 @@ pub fn place_sun(
     field: &str,
     d: &crate::description::schema::SunDesc,
 ) -> Result<SunPlacement, crate::description::context::SceneError> {
-    use crate::daylight::sun::{sun_position, Atmosphere, CivilTime};
+    use crate::daylight::sun::{sun_position_at, Atmosphere, CivilTime};
     let by_angles = d.altitude_deg.is_some() || d.azimuth_deg.is_some();
     let by_place = d.latitude_deg.is_some()
         || d.longitude_deg.is_some()
@@ -166,12 +166,18 @@ pub fn place_sun(
                     "give latitude_deg, longitude_deg and time (or altitude_deg and azimuth_deg)",
                 ));
             };
-            let t = CivilTime::parse(time).map_err(|m| ctx.err(format!("{field}.time"), m))?;
-            let p = sun_position(
+            let t = if d.solar_time {
+                CivilTime::parse_solar(time)
+            } else {
+                CivilTime::parse(time)
+            }
+            .map_err(|m| ctx.err(format!("{field}.time"), m))?;
+            let p = sun_position_at(
                 lat,
                 lon,
                 d.elevation_m.unwrap_or(0.0),
                 &t,
+                d.solar_time,
                 Atmosphere::default(),
                 None,
             )
