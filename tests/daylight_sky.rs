@@ -552,3 +552,38 @@ fn solar_time_noon_is_due_south() {
         "east {r:?}, expected {grazing}"
     );
 }
+
+/// `PerezIrradiance`: a Perez sky from W/m², as `gendaylit -W`. The efficacy model turns them
+/// into illuminances (diffuse efficacies of clear skies reach 140–150 lm/W, direct 60–120),
+/// and the sky and its sun then light an unobstructed horizontal meter with
+/// E_vd + E_vn sin(altitude).
+#[test]
+fn perez_from_irradiance() {
+    use candela::daylight::perez::{SkyCondition, DEFAULT_DEW_POINT_C};
+    let (en, ed) = (600.0, 150.0);
+    let (dn, dh) = SkyCondition::illuminance_from_irradiance(
+        ed,
+        en,
+        50f64.to_radians(),
+        1.0,
+        DEFAULT_DEW_POINT_C,
+    )
+    .unwrap();
+    assert!(
+        (90.0..160.0).contains(&(dh / ed)),
+        "diffuse efficacy {}",
+        dh / ed
+    );
+    assert!(
+        (60.0..120.0).contains(&(dn / en)),
+        "direct efficacy {}",
+        dn / en
+    );
+    let sky = format!(
+        "Sky(model: PerezIrradiance(direct_normal_w_m2: {en}, diffuse_horizontal_w_m2: {ed}), \
+         sun: (altitude_deg: 40.0, azimuth_deg: 200.0))"
+    );
+    let r = measure(&sky, "", UP_METER, 4096);
+    let expected = dh + dn * 40f64.to_radians().sin();
+    assert_estimate_near(r[0].0, r[0].1, expected, 0.01, "Perez from irradiance");
+}

@@ -646,6 +646,14 @@ pub enum SkyModelDesc {
         #[serde(default)]
         dew_point_c: Option<f64>,
     },
+    /// The Perez sky from the direct-normal and diffuse-horizontal irradiance (W/m²), as
+    /// `gendaylit -W`: the Perez (1990) efficacy model gives the illuminances.
+    PerezIrradiance {
+        direct_normal_w_m2: f64,
+        diffuse_horizontal_w_m2: f64,
+        #[serde(default)]
+        dew_point_c: Option<f64>,
+    },
 }
 
 /// Where the sun is: `altitude_deg` and `azimuth_deg` (from north toward east), or

@@ -295,7 +295,42 @@ impl SkyLight {
             )
         };
         let mut perez_sun = None;
-        let (distribution, sky_lx) = match d.model {
+        // A Perez sky given by irradiance becomes one given by illuminance through the
+        // efficacy model.
+        let converted;
+        let model = match d.model {
+            SkyModelDesc::PerezIrradiance {
+                direct_normal_w_m2,
+                diffuse_horizontal_w_m2,
+                dew_point_c,
+            } => {
+                let en =
+                    ctx.nonneg(&format!("{mfield}.direct_normal_w_m2"), *direct_normal_w_m2)?;
+                let ed = ctx.nonneg(
+                    &format!("{mfield}.diffuse_horizontal_w_m2"),
+                    *diffuse_horizontal_w_m2,
+                )?;
+                let dew = match dew_point_c {
+                    Some(t) => ctx.finite(&format!("{mfield}.dew_point_c"), *t)?,
+                    None => DEFAULT_DEW_POINT_C,
+                };
+                let (Some(p), Some(s)) = (place, sun_local) else {
+                    return Err(need_sun("the Perez sky"));
+                };
+                let zenith = s.z.clamp(-1.0, 1.0).acos();
+                let (dn, dh) =
+                    SkyCondition::illuminance_from_irradiance(ed, en, zenith, p.eccentricity, dew)
+                        .map_err(|e| ctx.err(&mfield, e.to_string()))?;
+                converted = SkyModelDesc::Perez {
+                    direct_normal_lx: dn,
+                    diffuse_horizontal_lx: dh,
+                    dew_point_c: *dew_point_c,
+                };
+                &converted
+            }
+            m => m,
+        };
+        let (distribution, sky_lx) = match model {
             SkyModelDesc::Perez {
                 direct_normal_lx,
                 diffuse_horizontal_lx,
@@ -345,7 +380,9 @@ impl SkyLight {
                     SkyModelDesc::CieOvercast => CieSky::Overcast,
                     SkyModelDesc::Uniform => CieSky::Uniform,
                     SkyModelDesc::CieClear => CieSky::Clear,
-                    SkyModelDesc::Perez { .. } => unreachable!(),
+                    SkyModelDesc::Perez { .. } | SkyModelDesc::PerezIrradiance { .. } => {
+                        unreachable!("handled above")
+                    }
                 };
                 if cie.needs_sun() {
                     match place {
@@ -431,7 +468,7 @@ impl SkyLight {
             SkyModelDesc::CieOvercast => "CieOvercast".into(),
             SkyModelDesc::Uniform => "Uniform".into(),
             SkyModelDesc::CieClear => "CieClear".into(),
-            SkyModelDesc::Perez { .. } => "Perez".into(),
+            SkyModelDesc::Perez { .. } | SkyModelDesc::PerezIrradiance { .. } => "Perez".into(),
         };
         Ok((sky, perez_sun))
     }
@@ -455,9 +492,7 @@ pub fn weather_sky(
     crate::description::context::SceneError,
 > {
     use crate::daylight::epw::Weather;
-    use crate::daylight::perez::{
-        eccentricity, precipitable_water, SkyCondition, DEFAULT_DEW_POINT_C,
-    };
+    use crate::daylight::perez::{eccentricity, SkyCondition, DEFAULT_DEW_POINT_C};
     use crate::description::schema::{SkyModelDesc, SunDesc};
     let tfield = format!("{field}.time");
     let bad_time = || {
@@ -524,18 +559,14 @@ pub fn weather_sky(
             if ed + en == 0.0 {
                 (0.0, 0.0)
             } else {
-                let c = SkyCondition::from_irradiance(
+                SkyCondition::illuminance_from_irradiance(
                     ed,
                     en,
                     zenith.min(std::f64::consts::FRAC_PI_2),
                     eccentricity(day_of_year),
+                    dew,
                 )
-                .map_err(|e| ctx.err(&tfield, format!("{line}: {e}")))?;
-                let water = precipitable_water(dew);
-                (
-                    en * c.direct_efficacy(water),
-                    ed * c.diffuse_efficacy(water),
-                )
+                .map_err(|e| ctx.err(&tfield, format!("{line}: {e}")))?
             }
         }
     };
