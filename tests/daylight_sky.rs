@@ -561,7 +561,7 @@ fn solar_time_noon_is_due_south() {
 fn perez_from_irradiance() {
     use candela::daylight::perez::{SkyCondition, DEFAULT_DEW_POINT_C};
     let (en, ed) = (600.0, 150.0);
-    let (dn, dh) = SkyCondition::illuminance_from_irradiance(
+    let (_, dn, dh) = SkyCondition::illuminance_from_irradiance(
         ed,
         en,
         50f64.to_radians(),

@@ -259,16 +259,17 @@ impl SkyCondition {
         Ok((cond, [ed, en]))
     }
 
-    /// The direct-normal and diffuse-horizontal illuminance (lx) of irradiances (W/m²) by the
-    /// Perez efficacy model at this sky's condition, from the irradiances as
-    /// [`SkyCondition::from_irradiance`] takes them and the dew point (°C): (E_vn, E_vd).
+    /// The sky's condition from irradiances (W/m², as [`SkyCondition::from_irradiance`] takes
+    /// them), with the direct-normal and diffuse-horizontal illuminance (lx) the Perez
+    /// efficacy model gives them at that condition and the dew point (°C): (condition, E_vn,
+    /// E_vd).
     pub fn illuminance_from_irradiance(
         diffuse_horizontal_w_m2: f64,
         direct_normal_w_m2: f64,
         sun_zenith: f64,
         eccentricity: f64,
         dew_point_c: f64,
-    ) -> Result<(f64, f64), PerezError> {
+    ) -> Result<(Self, f64, f64), PerezError> {
         if !dew_point_c.is_finite() {
             return Err(PerezError::Invalid("dew point"));
         }
@@ -280,6 +281,7 @@ impl SkyCondition {
         )?;
         let water = precipitable_water(dew_point_c);
         Ok((
+            c,
             direct_normal_w_m2 * c.direct_efficacy(water),
             diffuse_horizontal_w_m2 * c.diffuse_efficacy(water),
         ))

@@ -295,52 +295,27 @@ impl SkyLight {
             )
         };
         let mut perez_sun = None;
-        // A Perez sky given by irradiance becomes one given by illuminance through the
-        // efficacy model.
-        let converted;
-        let model = match d.model {
-            SkyModelDesc::PerezIrradiance {
-                direct_normal_w_m2,
-                diffuse_horizontal_w_m2,
-                dew_point_c,
-            } => {
-                let en =
-                    ctx.nonneg(&format!("{mfield}.direct_normal_w_m2"), *direct_normal_w_m2)?;
-                let ed = ctx.nonneg(
-                    &format!("{mfield}.diffuse_horizontal_w_m2"),
-                    *diffuse_horizontal_w_m2,
-                )?;
-                let dew = match dew_point_c {
-                    Some(t) => ctx.finite(&format!("{mfield}.dew_point_c"), *t)?,
-                    None => DEFAULT_DEW_POINT_C,
-                };
-                let (Some(p), Some(s)) = (place, sun_local) else {
-                    return Err(need_sun("the Perez sky"));
-                };
-                let zenith = s.z.clamp(-1.0, 1.0).acos();
-                let (dn, dh) =
-                    SkyCondition::illuminance_from_irradiance(ed, en, zenith, p.eccentricity, dew)
-                        .map_err(|e| ctx.err(&mfield, e.to_string()))?;
-                converted = SkyModelDesc::Perez {
-                    direct_normal_lx: dn,
-                    diffuse_horizontal_lx: dh,
-                    dew_point_c: *dew_point_c,
-                };
-                &converted
-            }
-            m => m,
-        };
-        let (distribution, sky_lx) = match model {
+        let (distribution, sky_lx) = match d.model {
+            // Given by illuminance (lx, as `gendaylit -L`) or by irradiance (W/m², as
+            // `gendaylit -W`).
             SkyModelDesc::Perez {
-                direct_normal_lx,
-                diffuse_horizontal_lx,
+                direct_normal_lx: direct,
+                diffuse_horizontal_lx: diffuse,
+                dew_point_c,
+            }
+            | SkyModelDesc::PerezIrradiance {
+                direct_normal_w_m2: direct,
+                diffuse_horizontal_w_m2: diffuse,
                 dew_point_c,
             } => {
-                let dn = ctx.nonneg(&format!("{mfield}.direct_normal_lx"), *direct_normal_lx)?;
-                let dh = ctx.nonneg(
-                    &format!("{mfield}.diffuse_horizontal_lx"),
-                    *diffuse_horizontal_lx,
-                )?;
+                let by_irradiance = matches!(d.model, SkyModelDesc::PerezIrradiance { .. });
+                let (dfield, hfield) = if by_irradiance {
+                    ("direct_normal_w_m2", "diffuse_horizontal_w_m2")
+                } else {
+                    ("direct_normal_lx", "diffuse_horizontal_lx")
+                };
+                let direct = ctx.nonneg(&format!("{mfield}.{dfield}"), *direct)?;
+                let diffuse = ctx.nonneg(&format!("{mfield}.{hfield}"), *diffuse)?;
                 let dew = match dew_point_c {
                     Some(t) => ctx.finite(&format!("{mfield}.dew_point_c"), *t)?,
                     None => DEFAULT_DEW_POINT_C,
@@ -351,17 +326,29 @@ impl SkyLight {
                 if d.amount.is_some() {
                     return Err(ctx.err(
                         &afield,
-                        "a Perez sky's amount is its diffuse_horizontal_lx; remove `amount`",
+                        format!("a Perez sky's amount is its {hfield}; remove `amount`"),
                     ));
                 }
                 let zenith = s.z.clamp(-1.0, 1.0).acos();
-                let (cond, _) = SkyCondition::from_illuminance(dh, dn, zenith, p.eccentricity, dew)
-                    .map_err(|e| ctx.err(&mfield, e.to_string()))?;
+                let (cond, dn, dh) = if by_irradiance {
+                    SkyCondition::illuminance_from_irradiance(
+                        diffuse,
+                        direct,
+                        zenith,
+                        p.eccentricity,
+                        dew,
+                    )
+                } else {
+                    SkyCondition::from_illuminance(diffuse, direct, zenith, p.eccentricity, dew)
+                        .map(|(cond, _)| (cond, direct, diffuse))
+                }
+                .map_err(|e| ctx.err(&mfield, e.to_string()))?;
+
                 if dn > 0.0 && d.sun_disk.unwrap_or(true) {
                     let d50 = SpectrumDesc::Named("D50".into());
                     let radiance = ctx.emission(
                         &format!("{field}.sun"),
-                        &format!("{mfield}.direct_normal_lx"),
+                        &format!("{mfield}.{dfield}"),
                         &d50,
                         SunLight::luminance_for(dn),
                     )?;
@@ -559,14 +546,15 @@ pub fn weather_sky(
             if ed + en == 0.0 {
                 (0.0, 0.0)
             } else {
-                SkyCondition::illuminance_from_irradiance(
+                let (_, dn, dh) = SkyCondition::illuminance_from_irradiance(
                     ed,
                     en,
                     zenith.min(std::f64::consts::FRAC_PI_2),
                     eccentricity(day_of_year),
                     dew,
                 )
-                .map_err(|e| ctx.err(&tfield, format!("{line}: {e}")))?
+                .map_err(|e| ctx.err(&tfield, format!("{line}: {e}")))?;
+                (dn, dh)
             }
         }
     };
