@@ -11,6 +11,9 @@
 //! Python: `$CANDELA_PYTHON` if set, else `<repo>/target/venv/bin/python` (created by
 //! `scripts/setup_python.sh`).  A missing interpreter is a failure, not a skip.
 
+mod common;
+use common::python;
+
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::PathBuf;
@@ -36,27 +39,6 @@ use candela::photometry::{
     luminous_efficiency_trapezoid, luminous_flux_trapezoid, scotopic_luminous_efficiency_trapezoid,
 };
 use serde_json::{json, Value};
-
-fn python() -> PathBuf {
-    if let Some(p) = std::env::var_os("CANDELA_PYTHON") {
-        let p = PathBuf::from(p);
-        assert!(
-            p.exists(),
-            "CANDELA_PYTHON={} does not exist; unset it or run scripts/setup_python.sh",
-            p.display()
-        );
-        return p;
-    }
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/venv/bin/python");
-    assert!(
-        p.exists(),
-        "no Python with colour-science found: {} is missing and CANDELA_PYTHON is not set.\n\
-         Run scripts/setup_python.sh (creates target/venv with colour-science 0.4.7) or set \
-         CANDELA_PYTHON to an interpreter that has colour-science==0.4.7 installed.",
-        p.display()
-    );
-    p
-}
 
 /// SplitMix64: small deterministic generator for the random spectra.
 struct SplitMix(u64);

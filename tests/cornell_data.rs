@@ -5,7 +5,9 @@
 //! chromaticity against colour-science 0.4.7 (run in the project venv, as in
 //! tests/colour_science.rs).
 
-use std::path::PathBuf;
+mod common;
+use common::python;
+
 use std::process::Command;
 
 use candela::colour::colorimetry::sd_to_xyz_emissive;
@@ -33,20 +35,6 @@ const ROWS: &[(f64, f64, f64, f64)] = &[
 /// The light's emission in cornell-box.md (relative, linear interpolation, zero outside
 /// 400–700 nm).
 const LIGHT: [(f64, f64); 4] = [(400.0, 0.0), (500.0, 8.0), (600.0, 15.6), (700.0, 18.4)];
-
-fn python() -> PathBuf {
-    if let Some(p) = std::env::var_os("CANDELA_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/venv/bin/python");
-    assert!(
-        p.exists(),
-        "no Python with colour-science: {} is missing and CANDELA_PYTHON is not set (run \
-         scripts/setup_python.sh)",
-        p.display()
-    );
-    p
-}
 
 #[test]
 fn reflectances_match_the_published_table() {

@@ -7,23 +7,13 @@
 //! weights (cos Z + 1.01)^±10, moves the sky by less than 0.05 %. The Perez clearness ε and
 //! brightness Δ that gendaylit prints must match candela's to its four decimals.
 
+mod common;
+use common::python;
+
 use candela::daylight::{angle_to_sun, CieSky, PerezSky, SkyCondition};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
-
-fn python() -> PathBuf {
-    if let Some(p) = std::env::var_os("CANDELA_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/venv/bin/python");
-    assert!(
-        p.exists(),
-        "{} is missing: run scripts/setup_python.sh (installs pyradiance)",
-        p.display()
-    );
-    p
-}
 
 fn radiance(cases: &Value) -> Vec<Value> {
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/daylight/radiance_sky.py");

@@ -227,3 +227,26 @@ pub fn listing(dir: &Path) -> Vec<String> {
     files.sort();
     files
 }
+
+/// The Python interpreter of the reference tests (colour-science, pyradiance, ladybug-core):
+/// `$CANDELA_PYTHON` if set, else `<repo>/target/venv/bin/python` (scripts/setup_python.sh).
+pub fn python() -> std::path::PathBuf {
+    if let Some(p) = std::env::var_os("CANDELA_PYTHON") {
+        let p = std::path::PathBuf::from(p);
+        assert!(
+            p.exists(),
+            "CANDELA_PYTHON={} does not exist; unset it or run scripts/setup_python.sh",
+            p.display()
+        );
+        return p;
+    }
+    let p = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/venv/bin/python");
+    assert!(
+        p.exists(),
+        "no Python for the reference tests: {} is missing and CANDELA_PYTHON is not set.\n\
+         Run scripts/setup_python.sh (creates target/venv with colour-science 0.4.7, pyradiance \
+         and ladybug-core) or set CANDELA_PYTHON to an interpreter that has them.",
+        p.display()
+    );
+    p
+}
