@@ -7,6 +7,7 @@
 
 pub mod cie;
 pub mod epw;
+pub mod patches;
 pub mod perez;
 pub mod sky_map;
 pub mod sun;
