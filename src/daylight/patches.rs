@@ -112,7 +112,7 @@ impl SkyPatches {
 
     /// The patch a unit direction (east, north, up) falls in: 0 at or below the horizon.
     pub fn index(&self, d: [f64; 3]) -> usize {
-        if !(d[2] > 0.0) {
+        if d[2].is_nan() || d[2] <= 0.0 {
             return 0;
         }
         let alt = d[2].min(1.0).asin();
