@@ -375,7 +375,10 @@ fn sky_vectors_against_gendaymtx() {
                 theirs[0]
             );
             // Centre values, gendaymtx's way, from candela's Perez sky.
-            let zenith = sun[2].max(0.0).acos().clamp(3f64.to_radians(), 1.5707963);
+            let zenith = sun[2]
+                .max(0.0)
+                .acos()
+                .clamp(3f64.to_radians(), std::f64::consts::FRAC_PI_2 - 1e-9);
             let (cond, _, e_vd) = SkyCondition::illuminance_from_irradiance(
                 s.4,
                 if sun[2] > 0.0 { s.3 } else { 0.0 },
