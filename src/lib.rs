@@ -6,6 +6,7 @@
 //! Data flow: `scene` (RON) → `world` (spectra resolved, lights in W, one BVH) →
 //! `integrator` per sample → `film` (absolute XYZ sums) → `output` (EXR, PNG).
 
+pub mod annual;
 pub mod bxdf;
 pub mod camera;
 pub mod colour;

@@ -1,0 +1,5 @@
+//! Annual, climate-based daylight: a year of hourly illuminances on a grid and the metrics
+//! drawn from them (daylight autonomy, UDI, sDA, ASE, EN 17037 provision). The skies of the
+//! year come from [`crate::daylight::patches`].
+
+pub mod metrics;
