@@ -358,7 +358,8 @@ fn sky_vectors_against_gendaymtx() {
                 .collect();
             let sun = [sun[0], sun[1], sun[2]];
             let day = [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334][s.0 - 1] + s.1;
-            let v = SkyVector::perez(&patches, s.4, s.3, sun, day, 11.0, 0.2).unwrap();
+            let ecc = candela::daylight::perez::eccentricity(day as f64);
+            let v = SkyVector::perez(&patches, s.4, s.3, sun, ecc, 11.0, 0.2).unwrap();
             let theirs: Vec<f64> = r["luminance"][t]
                 .as_array()
                 .unwrap()

@@ -2,4 +2,5 @@
 //! drawn from them (daylight autonomy, UDI, sDA, ASE, EN 17037 provision). The skies of the
 //! year come from [`crate::daylight::patches`].
 
+pub mod coefficients;
 pub mod metrics;

@@ -167,8 +167,8 @@ fn quadrature_side(mf: u32) -> usize {
 impl SkyVector {
     /// The Perez sky (Perez, Seals & Michalsky 1993; luminous efficacies of Perez et al. 1990
     /// at the dew point `dew_point_c`, °C) of diffuse-horizontal and direct-normal irradiance
-    /// (W/m²) with the sun at unit direction `sun` (east, north, up), on day of year `day`,
-    /// over `patches`, above a ground of reflectance `ground_reflectance`. A sun at or below
+    /// (W/m²) with the sun at unit direction `sun` (east, north, up), the Earth–Sun distance
+    /// correction `eccentricity` ([`super::perez::eccentricity`] of the day), over `patches`, above a ground of reflectance `ground_reflectance`. A sun at or below
     /// the horizon counts as on it for the sky's shape, as gendaymtx does, and its direct light
     /// is then dropped.
     pub fn perez(
@@ -176,7 +176,7 @@ impl SkyVector {
         diffuse_horizontal_w_m2: f64,
         direct_normal_w_m2: f64,
         sun: [f64; 3],
-        day: u32,
+        eccentricity: f64,
         dew_point_c: f64,
         ground_reflectance: f64,
     ) -> Result<Self, PerezError> {
@@ -208,7 +208,7 @@ impl SkyVector {
             diffuse_horizontal_w_m2,
             direct,
             zenith,
-            super::perez::eccentricity(day as f64),
+            eccentricity,
             dew_point_c,
         )?;
         let sky = PerezSky::new(cond);
@@ -291,16 +291,16 @@ mod tests {
         let mut errors = vec![];
         for (mf, tolerance) in [(1, 6e-3), (2, 2e-3), (4, 5e-4)] {
             let p = SkyPatches::new(mf).unwrap();
-            let v = SkyVector::perez(&p, 120.0, 600.0, sun, 172, 11.0, 0.2).unwrap();
+            let v = SkyVector::perez(&p, 120.0, 600.0, sun, 1.0, 11.0, 0.2).unwrap();
             let e = v.horizontal_illuminance(&p) / v.diffuse_horizontal_lx - 1.0;
             errors.push(e);
             assert!(e.abs() < tolerance, "MF {mf}: {e}");
         }
         println!("Σ L̄ cos ω / E_vd − 1 at MF 1, 2, 4: {errors:?}");
         let p = SkyPatches::new(1).unwrap();
-        let night = SkyVector::perez(&p, 0.0, 0.0, sun, 172, 11.0, 0.2).unwrap();
+        let night = SkyVector::perez(&p, 0.0, 0.0, sun, 1.0, 11.0, 0.2).unwrap();
         assert!(night.luminance_cd_m2.iter().all(|&l| l == 0.0));
-        assert!(SkyVector::perez(&p, 100.0, f64::NAN, sun, 172, 11.0, 0.2).is_err());
-        assert!(SkyVector::perez(&p, -1.0, 0.0, sun, 172, 11.0, 0.2).is_err());
+        assert!(SkyVector::perez(&p, 100.0, f64::NAN, sun, 1.0, 11.0, 0.2).is_err());
+        assert!(SkyVector::perez(&p, -1.0, 0.0, sun, 1.0, 11.0, 0.2).is_err());
     }
 }

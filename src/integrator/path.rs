@@ -81,6 +81,33 @@ pub fn trace(
     sampler: &mut Sampler,
     stats: &mut RayStats,
 ) -> SampledSpectrum {
+    trace_tallied(
+        world,
+        origin,
+        dir,
+        start,
+        wl,
+        sampler,
+        stats,
+        &mut |_, _| {},
+    )
+}
+
+/// [`trace`], also handing `tally` each part of the result that comes from a light at
+/// infinity, with the direction (scene frame) it arrives from at its last vertex: daylight
+/// coefficients sort the sky's light into patches by it. The parts sum to the result less the
+/// emission of lights in the scene.
+#[allow(clippy::too_many_arguments)]
+pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
+    world: &World,
+    origin: Vec3,
+    dir: Vec3,
+    start: PathStart,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+    tally: &mut T,
+) -> SampledSpectrum {
     let settings = &world.settings;
     let mut l = SampledSpectrum::ZERO;
     let mut beta = SampledSpectrum::ONE;
@@ -112,13 +139,15 @@ pub fn trace(
                 if le.is_black() {
                     continue;
                 }
-                if prev_specular {
-                    l += beta * le;
+                let c = if prev_specular {
+                    beta * le
                 } else {
                     let p_light = world.light_sampler.pmf(prev_p, prev_n, li as usize, 0)
                         * light.pdf_li_escape(prev_p, ray_d);
-                    l += beta * le * power_heuristic(prev_pdf, p_light);
-                }
+                    beta * le * power_heuristic(prev_pdf, p_light)
+                };
+                l += c;
+                tally(ray_d, c);
             }
             break;
         };
@@ -220,7 +249,11 @@ pub fn trace(
                             } else {
                                 power_heuristic(pdf, material.pdf(wo, wi, wl))
                             };
-                            l += beta * f * tr * ls.li * (w / pdf);
+                            let c = beta * f * tr * ls.li * (w / pdf);
+                            l += c;
+                            if ls.dist.is_infinite() {
+                                tally(ls.wi, c);
+                            }
                         }
                     }
                 }
@@ -339,6 +372,31 @@ pub fn irradiance(
     sampler: &mut Sampler,
     stats: &mut RayStats,
 ) -> SampledSpectrum {
+    irradiance_tallied(
+        world,
+        at,
+        n,
+        caustics_by_light_tracing,
+        wl,
+        sampler,
+        stats,
+        &mut |_, _| {},
+    )
+}
+
+/// [`irradiance`], handing `tally` each part that comes from a light at infinity with the
+/// direction it arrives from at its last vertex (see [`trace_tallied`]).
+#[allow(clippy::too_many_arguments)]
+pub fn irradiance_tallied<T: FnMut(Vec3, SampledSpectrum)>(
+    world: &World,
+    at: &RayStart,
+    n: Vec3,
+    caustics_by_light_tracing: bool,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+    tally: &mut T,
+) -> SampledSpectrum {
     use std::f32::consts::PI;
     let mut e = SampledSpectrum::ZERO;
     if world.settings.max_depth == Some(0) {
@@ -363,7 +421,11 @@ pub fn irradiance(
                     } else {
                         power_heuristic(pdf, crate::sampling::cosine_hemisphere_pdf(cos))
                     };
-                    e += tr * ls.li * (cos * w / pdf);
+                    let c = tr * ls.li * (cos * w / pdf);
+                    e += c;
+                    if ls.dist.is_infinite() {
+                        tally(ls.wi, c);
+                    }
                 }
             }
         }
@@ -383,7 +445,8 @@ pub fn irradiance(
                 caustics_by_light_tracing,
             };
             // cos θ / pdf = π.
-            e += trace(world, origin, wi, start, wl, sampler, stats) * PI;
+            let mut scaled = |d: Vec3, c: SampledSpectrum| tally(d, c * PI);
+            e += trace_tallied(world, origin, wi, start, wl, sampler, stats, &mut scaled) * PI;
         }
     }
     e

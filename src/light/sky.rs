@@ -183,6 +183,15 @@ impl SkyLight {
         }
     }
 
+    /// Whether every direction, sky and ground, has a luminance of 1 cd/m² (the sky of
+    /// daylight coefficients, [`crate::annual::coefficients`]).
+    pub fn is_unit(&self) -> bool {
+        let near_one = |x: f64| (x - 1.0).abs() < 1e-6;
+        self.distribution == SkyDistribution::Cie(CieSky::Uniform)
+            && near_one(luminous_integral(&self.radiance))
+            && near_one(luminous_integral(&self.ground))
+    }
+
     /// Radiance arriving along unit scene direction `wi` (sky above the horizon, ground below).
     pub fn escaped(&self, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
         let d = self.frame.to_local(wi.as_dvec3());
