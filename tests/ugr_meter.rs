@@ -140,3 +140,47 @@ fn background_is_the_light_a_diffuse_floor_reflects_to_the_eye() {
     assert!((u.background_cd_m2 - u.ev_indirect_lx / PI).abs() < 1e-12);
     assert_eq!(u.luminaires.len(), 1);
 }
+
+#[test]
+fn an_area_light_on_the_line_of_sight_by_hand() {
+    // A one-sided 0.5 m × 0.5 m emitter of 2000 cd/m² 3 m ahead, centred on the line of
+    // sight and facing the eye, under a uniform 20 cd/m² sky. Its solid angle is
+    // Ω = 4 asin(ab/√((a² + 4d²)(b² + 4d²))) = 0.0275867 sr, P = 1, and it hides Ω·cos ≈ Ω of
+    // the sky's π·20 lx (cos ≥ 0.9966 over it). UGR = 8 log10(0.25/L_b · 2000² Ω).
+    let w = world(
+        r#"(
+        camera: (position: (0, 1.2, 0), look_at: (0, 1.2, -1), vfov_deg: 10, resolution: (1, 1)),
+        render: (spp: 1),
+        objects: [(shape: Quad(origin: (-0.25, 0.95, -3.0), edge_u: (0.5, 0, 0), edge_v: (0, 0.5, 0)),
+                   material: "black", emission: (spectrum: Named("E"), amount: Luminance(2000.0)))],
+        lights: [Environment(spectrum: Named("E"), amount: Luminance(20.0))],
+        meters: [Ugr(name: "eye", position: (0, 1.2, 0), direction: (0, 0, -1))],
+        measure: (samples: 16384),
+    )"#,
+    );
+    let m = measure_all(&w);
+    let u = w.meters[0].ugr(&w, &m.meters[0]).unwrap();
+    let omega = 4.0 * (0.25f64 / (0.25f64 + 36.0)).asin();
+    assert_eq!(u.luminaires.len(), 1, "{u:?}");
+    let lv = &u.luminaires[0];
+    assert!((lv.luminance_cd_m2 / 2000.0 - 1.0).abs() < 1e-4, "{lv:?}");
+    assert!(
+        (lv.solid_angle_sr / omega - 1.0).abs() < 1e-3,
+        "{lv:?} vs Ω = {omega}"
+    );
+    assert!((lv.position_index - 1.0).abs() < 1e-3, "{lv:?}");
+    assert!(
+        (u.ev_direct_lx / (2000.0 * omega) - 1.0).abs() < 4e-3,
+        "{u:?}"
+    );
+    let se = u.ev_stderr_lx;
+    let e_ind = 20.0 * (PI - omega);
+    assert!(se > 0.0 && (u.ev_indirect_lx - e_ind).abs() <= 4.0 * se + 4e-3 * 20.0 * omega);
+    let expected = 8.0 * (0.25 / (e_ind / PI) * 2000.0f64.powi(2) * omega).log10();
+    let (lo, hi) = u.ugr_interval;
+    println!(
+        "area light: UGR {:.3} (95 %: {lo:.3} to {hi:.3}), expected {expected:.3}",
+        u.ugr
+    );
+    assert!((u.ugr - expected).abs() < 0.05 && hi - lo < 0.2, "{u:?}");
+}
