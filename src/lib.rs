@@ -14,6 +14,7 @@ pub mod daylight;
 pub mod description;
 pub mod film;
 pub mod geometry;
+pub mod glare;
 pub mod integrator;
 pub mod job;
 pub mod light;

@@ -140,7 +140,12 @@ fn sample_meter(
     let mut sampler = Sampler::new(world.settings.seed, batch_stream(stream, batch), s);
     let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
     let v = match kind {
-        MeterKind::Illuminance { position, normal } => {
+        MeterKind::Illuminance { position, normal }
+        | MeterKind::Ugr {
+            position,
+            direction: normal,
+            ..
+        } => {
             let e = irradiance(
                 world,
                 &RayStart::free(*position),

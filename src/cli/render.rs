@@ -261,7 +261,7 @@ pub fn render(a: &RenderOpts) -> Result<()> {
     let units = job.units;
     for m in &out.meters {
         let q = match m.kind {
-            MeterKind::Illuminance { .. } => Quantity::Illuminance,
+            MeterKind::Illuminance { .. } | MeterKind::Ugr { .. } => Quantity::Illuminance,
             MeterKind::Luminance { .. } => Quantity::Luminance,
         };
         let (k, unit) = (units.from_si(q, 1.0), units.symbol(q));
@@ -273,6 +273,17 @@ pub fn render(a: &RenderOpts) -> Result<()> {
             e.ci95() * k,
             e.samples
         );
+        if let Some(u) = &m.ugr {
+            say!(
+                "meter {:?}: UGR {:.1} (95 %: {:.1} to {:.1}), L_b {:.3} cd/m², {} luminaires",
+                m.name,
+                u.ugr,
+                u.ugr_interval.0,
+                u.ugr_interval.1,
+                u.background_cd_m2,
+                u.luminaires.len()
+            );
+        }
         if e.non_finite > 0 {
             eprintln!(
                 "warning: meter {:?}: {} of {} samples were not finite and were counted as 0; its value is not reliable",

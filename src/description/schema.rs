@@ -119,6 +119,16 @@ pub enum MeterDesc {
         #[serde(default)]
         half_angle_deg: f32,
     },
+    /// CIE 117 unified glare rating for an eye at `position` looking along `direction`, from
+    /// the scene's luminaires, with the background luminance from the measured indirect
+    /// vertical illuminance (docs/glare.md); `up` (default +y) orients the position index.
+    Ugr {
+        name: String,
+        position: V3,
+        direction: V3,
+        #[serde(default)]
+        up: Option<V3>,
+    },
 }
 
 #[derive(Debug, Clone, Deserialize)]

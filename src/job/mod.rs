@@ -124,6 +124,8 @@ pub struct MeterResult {
     pub name: String,
     pub kind: MeterKind,
     pub estimate: Estimate,
+    /// The UGR of a `Ugr` meter (whose estimate is the vertical illuminance at the eye).
+    pub ugr: Option<crate::glare::luminaires::UgrResult>,
 }
 
 /// One grid's result: its size and statistics in SI units (lx).
@@ -559,6 +561,7 @@ pub fn run(
             name: m.name.clone(),
             kind: m.kind.clone(),
             estimate: *e,
+            ugr: m.ugr(&world, e),
         })
         .collect();
     outputs.grids = world

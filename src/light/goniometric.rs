@@ -34,6 +34,8 @@ pub struct GoniometricLight {
     pub distribution: Arc<Distribution>,
     /// Radiant intensity per candela of the table, W·sr⁻¹·nm⁻¹ per cd (times the multiplier).
     pub spectrum: DenseSpectrum,
+    /// The file's luminous opening, m: length (along C0), width, height (zero if not given).
+    pub luminous_size_m: [f64; 3],
 }
 
 /// The scene's fields of a goniometric light (see `LightDesc::Goniometric`).
@@ -121,6 +123,7 @@ impl GoniometricLight {
             rotation: Mat3::from_quat(crate::geometry::euler_rotation_deg(rotate_deg)),
             distribution: Arc::new(distribution),
             spectrum: spectrum.scaled(scale),
+            luminous_size_m: phot.size_m,
         })
     }
 

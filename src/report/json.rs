@@ -158,6 +158,22 @@ pub fn report_json(r: &ReportInput) -> Value {
                 v["half_angle_deg"] = json!(half_angle_rad.to_degrees());
                 v
             }
+            MeterKind::Ugr {
+                position,
+                direction,
+                up,
+            } => {
+                // The estimate is the vertical illuminance at the eye; UGR is unitless.
+                let mut v = estimate(e, ke);
+                v["name"] = json!(m.name);
+                v["kind"] = json!("ugr");
+                v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
+                v["position"] = v3(*position);
+                v["direction"] = v3(*direction);
+                v["up"] = v3(*up);
+                v["ugr"] = json!(m.ugr(w, e));
+                v
+            }
         })
         .collect();
     let grids: Vec<Value> = w

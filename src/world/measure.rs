@@ -21,6 +21,14 @@ pub enum MeterKind {
         direction: Vec3,
         half_angle_rad: f32,
     },
+    /// CIE 117 UGR (docs/glare.md) for an eye at `position` (m) looking along the unit
+    /// `direction`, `up` a unit vector across it; its Monte Carlo estimate is the vertical
+    /// illuminance (lx) at the eye, from which the background luminance comes.
+    Ugr {
+        position: Vec3,
+        direction: Vec3,
+        up: Vec3,
+    },
 }
 
 /// A named meter of the scene.
@@ -147,6 +155,30 @@ impl Meter {
                         position: ctx.vec3(&format!("{field}.position"), *position)?,
                         direction: ctx.unit(&format!("{field}.direction"), *direction)?,
                         half_angle_rad: (a as f32).to_radians(),
+                    },
+                )
+            }
+            MeterDesc::Ugr {
+                name,
+                position,
+                direction,
+                up,
+            } => {
+                let d = ctx.unit(&format!("{field}.direction"), *direction)?;
+                let u = ctx.unit(&format!("{field}.up"), up.unwrap_or([0.0, 1.0, 0.0]))?;
+                let across = u - d * d.dot(u);
+                if across.length() < 1e-3 {
+                    return Err(ctx.err(
+                        format!("{field}.up"),
+                        "the up vector must not be parallel to the direction",
+                    ));
+                }
+                (
+                    name,
+                    MeterKind::Ugr {
+                        position: ctx.vec3(&format!("{field}.position"), *position)?,
+                        direction: d,
+                        up: across.normalize(),
                     },
                 )
             }

@@ -1,0 +1,234 @@
+//! 95 % intervals of the glare indices from the per-pixel standard errors of a rendered image.
+//!
+//! The indices are not smooth functions of the pixels (a pixel that crosses the threshold
+//! joins or leaves a source), so the error is propagated by simulation, a parametric
+//! bootstrap: K images L + se·N(0, 1) are drawn (fixed seed), each is detected and evaluated
+//! again, and the spread of each index over the draws stands for the spread of the index of
+//! the rendered image about that of the noise-free image. The interval is the point value
+//! ± t₀.₉₇₅(K − 1)·sd. The draws also say whether the detection itself is stable: how often
+//! the number of sources changes, and how much luminous solid angle changes sides of the
+//! threshold.
+//!
+//! Limits: pixels are taken as independent and normal (a path-traced pixel's mean over many
+//! samples is, by the central limit theorem, but a firefly pixel's standard error is itself
+//! poorly known); the interval holds while the index is close to linear over the noise
+//! (see [`UncertainOptions::max_dgp_half_width`] and the stability checks), and it covers
+//! the noise of the image only, not the bias of a biased renderer or of the DGP model.
+
+use super::image::{GlareImage, ImageError};
+use super::indices::{evaluate_luminance, GlareOptions, GlareResult};
+use crate::meter::t95;
+use crate::sampling::mix64;
+
+/// Settings of the simulation and the limits past which the image is too noisy to trust.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UncertainOptions {
+    /// Perturbed images drawn (K).
+    pub draws: usize,
+    /// Seed of the draws.
+    pub seed: u64,
+    /// Largest 95 % half-width of DGP for a trustworthy result (default 0.01, a fifth of the
+    /// 0.05 steps between the DGP comfort classes).
+    pub max_dgp_half_width: f64,
+    /// Largest 95 % half-width of UGR for a trustworthy result (default 0.5, a sixth of the
+    /// 3-unit steps of the UGR limits).
+    pub max_ugr_half_width: f64,
+    /// Largest share of the draws whose number of sources differs from the image's own
+    /// (default 0.05).
+    pub max_source_count_changes: f64,
+    /// Largest mean share of the glare sources' L·ω that changes sides of the threshold in a
+    /// draw (default 0.05).
+    pub max_membership_flip: f64,
+}
+
+impl Default for UncertainOptions {
+    fn default() -> Self {
+        UncertainOptions {
+            draws: 64,
+            seed: 0x0067_6c61_7265,
+            max_dgp_half_width: 0.01,
+            max_ugr_half_width: 0.5,
+            max_source_count_changes: 0.05,
+            max_membership_flip: 0.05,
+        }
+    }
+}
+
+/// An index with its 95 % interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interval {
+    /// The index of the image itself.
+    pub value: f64,
+    /// Half-width of the 95 % interval: t₀.₉₇₅(K − 1) × the standard deviation over the draws.
+    pub half_width: f64,
+    /// 2.5 % and 97.5 % quantiles of the index over the draws (for skewed cases).
+    pub quantiles: (f64, f64),
+}
+
+impl Interval {
+    pub fn low(&self) -> f64 {
+        self.value - self.half_width
+    }
+    pub fn high(&self) -> f64 {
+        self.value + self.half_width
+    }
+    pub fn contains(&self, x: f64) -> bool {
+        (self.low()..=self.high()).contains(&x)
+    }
+}
+
+/// The glare result of an image with the 95 % interval of each index and the noise verdict.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UncertainGlare {
+    pub result: GlareResult,
+    pub dgp: Interval,
+    pub dgi: Interval,
+    pub ugr: Interval,
+    pub vcp: Interval,
+    pub cgi: Interval,
+    pub ev_lx: Interval,
+    /// Share of the draws whose number of sources differs from the image's own.
+    pub source_count_changes: f64,
+    /// Mean over the draws of the L·ω (of the image's own luminances) of the pixels whose
+    /// glare membership differs from the image's, over the L·ω of the image's glare pixels.
+    pub membership_flip: f64,
+    /// Whether the result is within every limit of [`UncertainOptions`].
+    pub trustworthy: bool,
+    /// The limits that were passed, in words.
+    pub warnings: Vec<String>,
+}
+
+/// A standard normal deviate from two 64-bit hashes (Box–Muller).
+fn normal(seed: u64, draw: u64, pixel: u64) -> f64 {
+    let h1 = mix64(seed ^ mix64(draw.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ pixel));
+    let h2 = mix64(h1 ^ 0x5851_f42d_4c95_7f2d);
+    let u1 = ((h1 >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+    let u2 = (h2 >> 11) as f64 / (1u64 << 53) as f64;
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+fn interval(value: f64, draws: &mut [f64]) -> Interval {
+    let k = draws.len();
+    if k < 2 {
+        return Interval {
+            value,
+            half_width: if k == 0 { 0.0 } else { f64::INFINITY },
+            quantiles: (value, value),
+        };
+    }
+    let mean = draws.iter().sum::<f64>() / k as f64;
+    let var = draws.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / (k - 1) as f64;
+    draws.sort_by(|a, b| a.total_cmp(b));
+    let q = |p: f64| {
+        let x = p * (k - 1) as f64;
+        let (i, f) = (x.floor() as usize, x - x.floor());
+        draws[i] + f * (draws[(i + 1).min(k - 1)] - draws[i])
+    };
+    Interval {
+        value,
+        half_width: t95((k - 1) as u32) * var.sqrt(),
+        quantiles: (q(0.025), q(0.975)),
+    }
+}
+
+/// Evaluate `img` with `opt` and propagate its standard errors (none: zero-width intervals).
+pub fn evaluate_uncertain(
+    img: &GlareImage,
+    opt: &GlareOptions,
+    u: &UncertainOptions,
+) -> Result<UncertainGlare, ImageError> {
+    img.validate()?;
+    let base = evaluate_luminance(img, &img.luminance_cd_m2, opt);
+    let glare_flag = |r: &GlareResult, lum: &[f64]| -> Vec<bool> {
+        // Pixels of the detected sources, recovered from the threshold (sources are exactly
+        // the valid pixels above it).
+        (0..img.len())
+            .map(|i| img.valid(i) && lum[i] > r.threshold_cd_m2)
+            .collect()
+    };
+    let base_flag = glare_flag(&base, &img.luminance_cd_m2);
+    let lw = |i: usize| img.luminance_cd_m2[i] * img.solid_angle_sr[i];
+    let base_lw: f64 = (0..img.len()).filter(|&i| base_flag[i]).map(lw).sum();
+    let k = if img.stderr_cd_m2.is_some() {
+        u.draws
+    } else {
+        0
+    };
+    let mut series: [Vec<f64>; 6] = Default::default();
+    let (mut count_changes, mut flip_sum) = (0usize, 0.0);
+    let mut lum = img.luminance_cd_m2.clone();
+    for d in 0..k {
+        let se = img.stderr_cd_m2.as_ref().expect("draws only with errors");
+        for i in 0..img.len() {
+            lum[i] = img.luminance_cd_m2[i] + se[i] * normal(u.seed, d as u64, i as u64);
+        }
+        let r = evaluate_luminance(img, &lum, opt);
+        if r.sources.len() != base.sources.len() {
+            count_changes += 1;
+        }
+        let flag = glare_flag(&r, &lum);
+        let flipped: f64 = (0..img.len())
+            .filter(|&i| flag[i] != base_flag[i])
+            .map(lw)
+            .sum();
+        flip_sum += if base_lw > 0.0 {
+            flipped / base_lw
+        } else if flipped > 0.0 {
+            1.0
+        } else {
+            0.0
+        };
+        for (s, v) in series
+            .iter_mut()
+            .zip([r.dgp, r.dgi, r.ugr, r.vcp, r.cgi, r.ev_lx])
+        {
+            s.push(v);
+        }
+    }
+    let [mut a, mut b, mut c, mut e, mut f, mut g] = series;
+    let out_dgp = interval(base.dgp, &mut a);
+    let out_ugr = interval(base.ugr, &mut c);
+    let (changes, flip) = if k > 0 {
+        (count_changes as f64 / k as f64, flip_sum / k as f64)
+    } else {
+        (0.0, 0.0)
+    };
+    let mut warnings = Vec::new();
+    if out_dgp.half_width > u.max_dgp_half_width {
+        warnings.push(format!(
+            "DGP ±{:.4} (95 %) is wider than ±{}",
+            out_dgp.half_width, u.max_dgp_half_width
+        ));
+    }
+    if !base.sources.is_empty() && out_ugr.half_width > u.max_ugr_half_width {
+        warnings.push(format!(
+            "UGR ±{:.2} (95 %) is wider than ±{}",
+            out_ugr.half_width, u.max_ugr_half_width
+        ));
+    }
+    if changes > u.max_source_count_changes {
+        warnings.push(format!(
+            "the number of glare sources changes in {:.0} % of the draws",
+            100.0 * changes
+        ));
+    }
+    if flip > u.max_membership_flip {
+        warnings.push(format!(
+            "{:.1} % of the sources' L·ω changes sides of the threshold per draw",
+            100.0 * flip
+        ));
+    }
+    Ok(UncertainGlare {
+        dgi: interval(base.dgi, &mut b),
+        vcp: interval(base.vcp, &mut e),
+        cgi: interval(base.cgi, &mut f),
+        ev_lx: interval(base.ev_lx, &mut g),
+        dgp: out_dgp,
+        ugr: out_ugr,
+        result: base,
+        source_count_changes: changes,
+        membership_flip: flip,
+        trustworthy: warnings.is_empty(),
+        warnings,
+    })
+}

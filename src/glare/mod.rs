@@ -1,0 +1,23 @@
+//! Glare evaluation of a luminance image seen from one eye point, as evalglare (Radiance 6,
+//! version 3.06) computes it, with 95 % intervals from the pixels' standard errors
+//! (docs/glare.md).
+//!
+//! - [`image`]: the input, plain per-pixel arrays (luminance, standard error, direction,
+//!   solid angle, inside mask), and the geometry of Radiance's angular fisheye;
+//! - [`sources`]: glare-source detection (threshold, merging, peak extraction);
+//! - [`indices`]: position index, vertical illuminance and the indices DGP, DGI, UGR, VCP, CGI;
+//! - [`interval`]: the intervals, by simulation, and the verdict on a too-noisy image.
+
+pub mod image;
+pub mod indices;
+pub mod interval;
+pub mod luminaires;
+pub mod sources;
+
+pub use image::{angular_fisheye, GlareImage, ImageError};
+pub use indices::{
+    evaluate, evaluate_luminance, position_index, Background, DgpCoefficients, GlareOptions,
+    GlareResult, SourceReport, SourceTerm,
+};
+pub use interval::{evaluate_uncertain, Interval, UncertainGlare, UncertainOptions};
+pub use sources::{DetectOptions, Task, Threshold};

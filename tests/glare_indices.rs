@@ -1,0 +1,234 @@
+//! The glare formulas against hand computations, the Guth position index against its
+//! published table, and the calibration of the 95 % intervals propagated from pixel noise.
+
+use candela::glare::{
+    angular_fisheye, evaluate, evaluate_uncertain, position_index, GlareImage, GlareOptions,
+    UncertainOptions,
+};
+
+/// An image of two "pixels": a background pixel on the line of sight whose solid angle is π
+/// (so that it gives the vertical illuminance of a uniform hemisphere of its luminance) and
+/// a source pixel 30° straight above the line of sight.
+fn one_source(background: f64, source: f64, omega: f64) -> GlareImage {
+    let s = 30f64.to_radians();
+    GlareImage {
+        width: 2,
+        height: 1,
+        luminance_cd_m2: vec![background, source],
+        stderr_cd_m2: None,
+        direction: vec![[0.0, 0.0, 1.0], [0.0, s.sin(), s.cos()]],
+        solid_angle_sr: vec![std::f64::consts::PI, omega],
+        inside: vec![true, true],
+        view_dir: [0.0, 0.0, 1.0],
+        up: [0.0, 1.0, 0.0],
+    }
+}
+
+#[test]
+fn one_source_on_a_uniform_background_by_hand() {
+    // L_b = 100 cd/m² over ω = π, source L = 20 000 cd/m², ω = 0.01 sr at σ = 30°, τ = 0:
+    // E_v = 100π + 20 000·cos 30°·0.01 = 314.159 + 173.205 = 487.364 lx, E_dir = 173.205 lx,
+    // L_b = (E_v − E_dir)/π = 100 cd/m²;
+    // P = exp((35.2 − 1.22)·0.030 + 21·10⁻⁵·900) = exp(1.2084) = 3.34812;
+    // DGP = 5.87·10⁻⁵·487.364 + 0.092·log10(1 + 20 000²·0.01/(487.364^1.87·3.34812²)) + 0.159
+    //     = 0.246429;
+    // UGR = 8 log10(0.25/100 · 20 000²·0.01/3.34812²) = 23.6032;
+    // DGI = 10 log10(0.478·20 000^1.6·(0.01/P²)^0.8/(100 + 0.07·√0.01·20 000)) = 17.4118;
+    // CGI = 8 log10(2(1 + 173.205/500)/487.364 · 20 000²·0.01/P²) = 26.3585;
+    // L_a = (100π + 200)/(π + 0.01) = 163.143, DGR = 0.5·20 000·(0.204 + 1.52·0.01^0.2
+    //     − 0.075)/(P·L_a^0.44) = 233.044, VCP = 50 erf((6.374 − 1.3227 ln DGR)/√2) + 50
+    //     = 20.148.
+    let r = evaluate(&one_source(100.0, 20_000.0, 0.01), &GlareOptions::default()).unwrap();
+    assert_eq!(r.sources.len(), 1);
+    let close = |a: f64, b: f64, tol: f64, what: &str| {
+        assert!((a - b).abs() <= tol, "{what}: {a} vs {b}");
+    };
+    close(r.ev_lx, 487.364_346, 1e-5, "Ev");
+    close(r.ev_direct_lx, 173.205_081, 1e-5, "Edir");
+    close(r.background_cd_m2, 100.0, 1e-9, "Lb");
+    close(r.sources[0].position_index, 3.348_123, 1e-5, "P");
+    close(r.dgp, 0.246_429_08, 1e-7, "DGP");
+    close(r.ugr, 23.603_177, 1e-5, "UGR");
+    close(r.dgi, 17.411_823, 1e-5, "DGI");
+    close(r.cgi, 26.358_486, 1e-5, "CGI");
+    close(r.dgr, 233.043_815, 1e-4, "DGR");
+    close(r.vcp, 20.148_26, 1e-3, "VCP");
+    // Below the threshold the source is background: no sources, evalglare's conventions.
+    let r = evaluate(&one_source(100.0, 1500.0, 0.01), &GlareOptions::default()).unwrap();
+    assert!(r.sources.is_empty());
+    assert_eq!((r.ugr, r.dgi, r.cgi, r.vcp), (0.0, 0.0, 0.0, 100.0));
+    close(
+        r.dgp,
+        5.87e-5 * r.ev_lx + 0.159,
+        1e-12,
+        "DGP without sources",
+    );
+}
+
+#[test]
+fn low_light_correction_below_1000_lx() {
+    let img = one_source(100.0, 20_000.0, 0.01);
+    let plain = evaluate(&img, &GlareOptions::default()).unwrap();
+    let o = GlareOptions {
+        low_light_correction: true,
+        ..Default::default()
+    };
+    let corrected = evaluate(&img, &o).unwrap();
+    // e^(0.024·487.364 − 4)/(1 + e^(…)) = e^7.6967/(1 + e^7.6967) = 0.999546.
+    let f = corrected.dgp / plain.dgp;
+    assert!((f - 0.999_546).abs() < 1e-6, "{f}");
+}
+
+#[test]
+fn guth_position_index_against_its_table() {
+    // The Luckiesh–Guth table (CIE 117, IES handbook) for a source straight above the line of
+    // sight (T/R = 0) at H/R = 0.1 … 1.0; the handbook's formula is a fit to it, within 3 %.
+    let table = [1.26, 1.53, 1.90, 2.35, 2.86, 3.50, 4.20, 5.00, 6.00, 7.00];
+    let (view, up) = ([0.0, 0.0, 1.0], [0.0, 1.0, 0.0]);
+    for (k, &p) in table.iter().enumerate() {
+        let hr = (k + 1) as f64 / 10.0;
+        let d = [0.0, hr, 1.0];
+        let got = position_index(d, view, up);
+        assert!((got / p - 1.0).abs() < 0.035, "H/R {hr}: {got} vs {p}");
+    }
+    // On the line of sight P = 1; far off it is capped at 16.
+    assert!((position_index(view, view, up) - 1.0).abs() < 1e-12);
+    assert_eq!(position_index([0.0, 1.0, 0.05], view, up), 16.0);
+    // Lateral, σ = 30°, τ = 90°: exp((35.2 − 28.70 − 1.22e⁻²⁰)·0.030 + (21 + 24.00 − 24.00)
+    // ·10⁻⁵·900) = 1.46814.
+    let s = 30f64.to_radians();
+    let lateral = position_index([s.sin(), 0.0, s.cos()], view, up);
+    assert!((lateral - 1.468_141).abs() < 1e-5, "{lateral}");
+    // Below the line of sight (Iwata & Osterhaus), σ = 30° straight down (τ = 180°):
+    // β = atan(tan 30°·√1.3225) = 33.5823°, P = exp(6.49·10⁻³β + 21·10⁻⁵β²) = 1.57583.
+    let below = position_index([0.0, -s.sin(), s.cos()], view, up);
+    assert!((below - 1.575_828).abs() < 1e-5, "{below}");
+}
+
+/// A 48 × 48 angular fisheye with a uniform background and a bright disc.
+fn disc_image(background: f64, source: f64, rel_se: f64) -> GlareImage {
+    let (w, h) = (48, 48);
+    let (direction, solid_angle_sr, inside) = angular_fisheye(w, h, 180.0, 180.0);
+    // Up and to the right of the line of sight (about 25° up, 15° right), at the corner of
+    // four pixels, so that the disc's L·ω-weighted centre lies mid-pixel and noise does not
+    // move it across a pixel edge (the position index is taken at the truncated centre, as
+    // evalglare does; a centre on an edge makes it jump, see docs/glare.md).
+    let centre = {
+        let (c, r) = (30, 14);
+        let mut s = [0.0; 3];
+        for i in [
+            r * w + c,
+            r * w + c + 1,
+            (r + 1) * w + c,
+            (r + 1) * w + c + 1,
+        ] {
+            for k in 0..3 {
+                s[k] += direction[i][k];
+            }
+        }
+        let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+        s.map(|v| v / n)
+    };
+    let cos_r = 12f64.to_radians().cos();
+    let luminance_cd_m2: Vec<f64> = direction
+        .iter()
+        .map(|d| {
+            let c = d[0] * centre[0] + d[1] * centre[1] + d[2] * centre[2];
+            if c >= cos_r {
+                source
+            } else {
+                background
+            }
+        })
+        .collect();
+    let stderr_cd_m2 = Some(luminance_cd_m2.iter().map(|l| rel_se * l).collect());
+    GlareImage {
+        width: w,
+        height: h,
+        luminance_cd_m2,
+        stderr_cd_m2,
+        direction,
+        solid_angle_sr,
+        inside,
+        view_dir: [0.0, 0.0, 1.0],
+        up: [0.0, 1.0, 0.0],
+    }
+}
+
+/// A standard normal deviate (Box–Muller on a 64-bit hash), independent of the library's.
+fn gauss(seed: u64, i: u64) -> f64 {
+    let h = |x: u64| {
+        let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    let a = h(seed.wrapping_mul(0x1000_0000_01b3) ^ (2 * i));
+    let b = h(a ^ (2 * i + 1));
+    let u1 = ((a >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+    let u2 = (b >> 11) as f64 / (1u64 << 53) as f64;
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+#[test]
+fn dgp_interval_covers_the_truth_95_percent_of_the_time() {
+    // Truth: the noise-free image. Each trial adds Gaussian noise of the stated standard error
+    // (15 % of each pixel) and asks for the DGP interval from 24 draws; over 1000 trials a
+    // calibrated 95 % interval covers the truth 950 ± 7 times (binomial sd), 930–970 allowed.
+    let truth_img = disc_image(300.0, 15_000.0, 0.15);
+    let opt = GlareOptions::default();
+    let truth = evaluate(&truth_img, &opt).unwrap();
+    assert_eq!(truth.sources.len(), 1);
+    let trials = 1000;
+    let (mut dgp_hits, mut ugr_hits, mut width) = (0, 0, 0.0);
+    for t in 0..trials {
+        let mut img = truth_img.clone();
+        let se = img.stderr_cd_m2.clone().unwrap();
+        for (i, l) in img.luminance_cd_m2.iter_mut().enumerate() {
+            *l += se[i] * gauss(t, i as u64);
+        }
+        let u = UncertainOptions {
+            draws: 24,
+            seed: 1000 + t,
+            ..Default::default()
+        };
+        let r = evaluate_uncertain(&img, &opt, &u).unwrap();
+        dgp_hits += r.dgp.contains(truth.dgp) as u32;
+        ugr_hits += r.ugr.contains(truth.ugr) as u32;
+        width += r.dgp.half_width / trials as f64;
+    }
+    println!(
+        "DGP {:.4}: covered {dgp_hits}/{trials}, mean half-width {width:.5}; UGR {:.3}: covered \
+         {ugr_hits}/{trials}",
+        truth.dgp, truth.ugr
+    );
+    assert!(
+        (930..=970).contains(&dgp_hits),
+        "DGP coverage {dgp_hits}/{trials}"
+    );
+    assert!(
+        (930..=970).contains(&ugr_hits),
+        "UGR coverage {ugr_hits}/{trials}"
+    );
+    assert!(width > 0.0);
+}
+
+#[test]
+fn a_noisy_background_near_the_threshold_is_flagged() {
+    let opt = GlareOptions::default();
+    let u = UncertainOptions::default();
+    // Background 1800 cd/m² ± 15 %: pixels cross the 2000 cd/m² threshold from draw to draw.
+    let noisy = evaluate_uncertain(&disc_image(1800.0, 15_000.0, 0.15), &opt, &u).unwrap();
+    assert!(!noisy.trustworthy, "{:?}", noisy.warnings);
+    assert!(noisy.membership_flip > u.max_membership_flip);
+    // The same scene with 0.2 % noise is trusted, with a narrow interval.
+    let clean = evaluate_uncertain(&disc_image(300.0, 15_000.0, 0.002), &opt, &u).unwrap();
+    assert!(clean.trustworthy, "{:?}", clean.warnings);
+    assert!(clean.dgp.half_width < 1e-3 && clean.dgp.half_width > 0.0);
+    // Without standard errors the intervals have no width.
+    let mut exact = disc_image(300.0, 15_000.0, 0.0);
+    exact.stderr_cd_m2 = None;
+    let e = evaluate_uncertain(&exact, &opt, &u).unwrap();
+    assert_eq!(e.dgp.half_width, 0.0);
+    assert!(e.trustworthy);
+}
