@@ -233,6 +233,18 @@ fn malformed_pictures_are_refused_naming_the_file() {
         b"#?RADIANCE\nEXPOSURE=-1\n\n-Y 1 +X 1\n\0\0\0\0",
         "EXPOSURE",
     );
+    // Brighter than f32 holds, and an exposure that underflows.
+    refused(
+        "bright.hdr",
+        &with(b"-Y 1 +X 1\n\xff\xff\xff\xff"),
+        "too bright",
+    );
+    let mut tiny = b"#?RADIANCE\n".to_vec();
+    for _ in 0..4 {
+        tiny.extend(b"EXPOSURE=1e-300\n");
+    }
+    tiny.extend(b"\n-Y 1 +X 1\n\x80\x80\x80\x80");
+    refused("exposures.hdr", &tiny, "out of range");
     // A run longer than its scanline.
     let mut rle = with(b"-Y 1 +X 8\n");
     rle.extend([2, 2, 0, 8, 128 + 9, 5]);

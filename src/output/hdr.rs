@@ -348,6 +348,9 @@ fn decode(bytes: &[u8]) -> Result<HdrImage, String> {
                 return Err(format!("EXPOSURE must be positive, got {e}"));
             }
             exposure = exposure.map(|x| x * e);
+            if !exposure.iter().all(|x| x.is_normal()) {
+                return Err("the EXPOSURE lines multiply to a factor out of range".into());
+            }
         } else if let Some(c) = line.strip_prefix("COLORCORR=") {
             let c = numbers(c, 3, "COLORCORR")?;
             if c.iter().any(|&x| x <= 0.0) {
@@ -355,6 +358,9 @@ fn decode(bytes: &[u8]) -> Result<HdrImage, String> {
             }
             for i in 0..3 {
                 exposure[i] *= c[i];
+            }
+            if !exposure.iter().all(|x| x.is_normal()) {
+                return Err("the COLORCORR lines multiply to a factor out of range".into());
             }
         } else if let Some(p) = line.strip_prefix("PRIMARIES=") {
             let v = numbers(p, 8, "PRIMARIES")?;
@@ -408,15 +414,21 @@ fn decode(bytes: &[u8]) -> Result<HdrImage, String> {
     let mut xyz = Vec::with_capacity(n);
     for y in 0..height {
         let src = if flip { height - 1 - y } else { y };
-        for p in &rgbe_px[src * width..(src + 1) * width] {
+        for (x, p) in rgbe_px[src * width..(src + 1) * width].iter().enumerate() {
             let c = if p[3] == 0 {
                 [0.0; 3]
             } else {
                 let f = 2f64.powi(p[3] as i32 - 136);
                 [0, 1, 2].map(|i| (p[i] as f64 + 0.5) * f / exposure[i])
             };
-            let v = mul(&m, c);
-            xyz.push(v.map(|k| (k.max(0.0) * RADIANCE_EFFICACY) as f32));
+            let v = mul(&m, c).map(|k| (k.max(0.0) * RADIANCE_EFFICACY) as f32);
+            if !v.iter().all(|k| k.is_finite()) {
+                return Err(format!(
+                    "pixel ({x}, {y}) is too bright for 32-bit floats ({} cd/m² or more)",
+                    f32::MAX
+                ));
+            }
+            xyz.push(v);
         }
     }
     Ok(HdrImage {
