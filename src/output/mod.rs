@@ -164,7 +164,8 @@ pub fn read_image(path: &Path) -> Result<Layers, OutputError> {
     // Only a regular file is opened here (opening a FIFO would block); anything else goes
     // to the EXR reader, which refuses it by kind.
     let regular = fs::metadata(path).is_ok_and(|m| m.is_file());
-    let is_hdr = match File::open(path).ok().filter(|_| regular) {
+    let file = if regular { File::open(path).ok() } else { None };
+    let is_hdr = match file {
         Some(mut f) => {
             use std::io::Read;
             f.read_exact(&mut head).is_ok() && head == *b"#?"
