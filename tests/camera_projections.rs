@@ -358,3 +358,66 @@ fn fisheyes_in_a_uniform_sky_integrate_to_the_illuminance_at_the_eye() {
         }
     }
 }
+
+/// Light tracing through a fisheye: a point light between a Lambertian floor and a metal
+/// ceiling, seen by an equisolid fisheye looking down. Light paths (the light's mirror image)
+/// are splatted through the fisheye's inverse map and importance; every pixel wholly inside the
+/// circle must show ρ/π · (direct + mirrored illuminance), the image-source law, averaged over
+/// its footprint, within 5 standard errors.
+#[test]
+fn light_traced_caustics_work_through_a_fisheye() {
+    use candela::world::Caustics;
+    let (i_cd, h_light, h_mirror, rho, n, k) = (100.0f64, 0.4f64, 1.0f64, 0.5f64, 0.2, 3.0);
+    let text = format!(
+        r#"(camera: (position: (0.1, 0.9, 0.0), look_at: (0.1, 0, 0), up: (0, 0, 1), resolution: (12, 12),
+            projection: Fisheye(mapping: Equisolid, fov_deg: 120)),
+          render: (spp: 256, max_depth: 2, light_paths_per_sample: 4),
+          materials: {{ "floor": Diffuse(reflectance: Constant({rho})),
+                        "mirror": Conductor(n: Constant({n}), k: Constant({k})) }},
+          objects: [
+            (shape: Quad(origin: (-50, 0, -50), edge_u: (0, 0, 100), edge_v: (100, 0, 0)), material: "floor"),
+            (shape: Quad(origin: (-50, {h_mirror}, -50), edge_u: (100, 0, 0), edge_v: (0, 0, 100)), material: "mirror"),
+          ],
+          lights: [Point(position: (0, {h_light}, 0), spectrum: Named("D65"), amount: Intensity({i_cd}))])"#
+    );
+    let w = common::world_with(&text, Caustics::LightTracing);
+    assert!(w.caustics.is_some());
+    let film = common::render(&w, 2);
+    let e_from = |p: Vec3, h: f64, i: f64| {
+        let d = Vec3::new(0.0, h as f32, 0.0) - p;
+        let d2 = d.length_squared() as f64;
+        i * (d.y as f64 / d2.sqrt()) / d2
+    };
+    let e = |p: Vec3| {
+        let d = Vec3::new(0.0, (2.0 * h_mirror - h_light) as f32, 0.0) - p;
+        let c = d.y as f64 / d.length() as f64;
+        let r = common::conductor_reflectance(c, n, k);
+        e_from(p, h_light, i_cd) + e_from(p, 2.0 * h_mirror - h_light, i_cd * r)
+    };
+    let (mut sum, mut sum_exp, mut var, mut checked) = (0.0, 0.0, 0.0, 0);
+    for y in 0..12 {
+        for x in 0..12 {
+            if w.camera.pixel_coverage(x, y) < 1.0 {
+                continue;
+            }
+            let (v, se) = common::luminance(&film.pixels[y * 12 + x]);
+            let want = rho / PI * common::floor_footprint_mean(&w, x, y, e);
+            assert!(
+                (v - want).abs() <= 5.0 * se,
+                "pixel ({x}, {y}): {v} ± {se}, expected {want}"
+            );
+            sum += v;
+            sum_exp += want;
+            var += se * se;
+            checked += 1;
+        }
+    }
+    assert!(checked >= 60, "{checked} pixels checked");
+    let se = var.sqrt();
+    eprintln!("{checked} pixels: Σ {sum:.4} ± {se:.4}, expected {sum_exp:.4}");
+    assert!(se < 0.01 * sum_exp, "standard error {se} of {sum_exp}");
+    assert!(
+        (sum - sum_exp).abs() <= 4.0 * se,
+        "Σ {sum} ± {se}, expected {sum_exp}"
+    );
+}

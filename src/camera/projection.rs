@@ -261,6 +261,14 @@ impl FilmMap {
         }
     }
 
+    /// Whether all of pixel (x, y) sees the scene (its farthest corner inside the circle).
+    fn pixel_wholly_inside(&self, x: usize, y: usize) -> bool {
+        let (cx, cy) = (0.5 * self.width as f64, 0.5 * self.height as f64);
+        let fx = (x as f64 - cx).abs().max((x as f64 + 1.0 - cx).abs());
+        let fy = (y as f64 - cy).abs().max((y as f64 + 1.0 - cy).abs());
+        (fx * fx + fy * fy).sqrt() * self.scale <= 1.0
+    }
+
     /// Solid angle of pixel (x, y), sr: the part of its footprint that sees the scene.
     pub fn pixel_solid_angle(&self, x: usize, y: usize) -> f64 {
         if !self.pixel_inside(x, y) {
@@ -310,6 +318,7 @@ impl FilmMap {
     pub fn pixel_coverage(&self, x: usize, y: usize) -> f64 {
         match self.projection {
             Projection::Fisheye { .. } if !self.pixel_inside(x, y) => 0.0,
+            Projection::Fisheye { .. } if self.pixel_wholly_inside(x, y) => 1.0,
             Projection::Fisheye { .. } => {
                 let a = self.contour(x, y, |m, r| 0.5 * r.min(m.r_max()).powi(2));
                 (a / (self.scale * self.scale)).clamp(0.0, 1.0)
