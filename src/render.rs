@@ -52,7 +52,11 @@ pub fn render_pixel(
         let off = world.settings.filter.sample(glam::Vec2::new(fx, fy));
         let u_lens = glam::Vec2::new(lx, ly);
         let mut wl = SampledWavelengths::sample_visible(u_wl);
-        let ray = cam.generate_ray(x as f32 + 0.5 + off.x, y as f32 + 0.5 + off.y, u_lens);
+        let Some(ray) = cam.try_ray(x as f32 + 0.5 + off.x, y as f32 + 0.5 + off.y, u_lens) else {
+            // Film outside a fisheye's image circle sees nothing.
+            sums.add([0.0; 3]);
+            continue;
+        };
         stats.camera_rays += 1;
         let start = PathStart::image(world, ray.origin);
         let l = trace(
@@ -220,6 +224,9 @@ fn plan_pass(world: &World, film: &Film, prog: &Progressive) -> (Vec<u64>, Optio
         _ => 0.0,
     };
     for (i, slot) in plan.iter_mut().enumerate() {
+        if !world.camera.pixel_inside(i % film.width, i / film.width) {
+            continue;
+        }
         let taken = film.samples_taken(i);
         if let (Some(t), Some(d)) = (&prog.target, &film.decision) {
             // A pixel at max_spp that misses the target still counts against the fraction:
@@ -279,7 +286,7 @@ pub fn render_progressive(
     let mut last_checkpoint = start;
     let mut stats = RayStats::default();
     let mut status = PassStatus {
-        max_samples: (w * h) as u64 * prog.max_spp as u64,
+        max_samples: world.camera.inside_pixels() as u64 * prog.max_spp as u64,
         ..Default::default()
     };
     let reason = 'passes: loop {

@@ -74,7 +74,10 @@ fn expect_error(text: &str, extra: &[(&str, &[u8])], needles: &[&str]) {
 fn good_scene_renders_all_outputs() {
     let (code, stderr, files) = run(GOOD, &[]);
     assert_eq!(code, 0, "{stderr}");
-    assert_eq!(files, vec!["scene.exr", "scene.png", "scene.report.json"]);
+    assert_eq!(
+        files,
+        vec!["scene.exr", "scene.hdr", "scene.png", "scene.report.json"]
+    );
 }
 
 #[test]

@@ -193,8 +193,9 @@ pub fn mesh_scene(mesh: candela::geometry::TriangleMesh, spp: u32, resolution: u
             position: [0.0, 1.2, -3.2],
             look_at: [0.0, 0.9, 0.0],
             up: [0.0, 1.0, 0.0],
-            vfov_deg: 45.0,
+            vfov_deg: Some(45.0),
             resolution: (resolution, resolution),
+            projection: None,
             lens: None,
         },
         render: RenderDesc {

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use candela::output::read_exr;
+use candela::output::read_image;
 use candela::photometry::Quantity;
 use candela::report::check_photometric_layers;
 use candela::report::falsecolour::{
@@ -14,7 +14,7 @@ use candela::report::units::UnitSystem;
 /// Arguments of `candela falsecolour`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct FalsecolourArgs {
-    /// EXR image written by `candela render`.
+    /// EXR (or Radiance HDR) image written by `candela render`.
     pub exr: PathBuf,
     /// luminance (channel Y) or illuminance (channel E, needs a render with --illuminance).
     #[arg(long, default_value = "luminance", value_parser = parse_quantity)]
@@ -125,7 +125,7 @@ pub fn run(args: &FalsecolourArgs) -> anyhow::Result<String> {
             args.exr.display()
         );
     }
-    let layers = read_exr(&args.exr).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let layers = read_image(&args.exr).map_err(|e| anyhow::anyhow!("{e}"))?;
     check_photometric_layers(&args.exr, &layers).map_err(|e| anyhow::anyhow!(e))?;
     let file_name = args
         .exr

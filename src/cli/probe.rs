@@ -1,4 +1,4 @@
-//! `candela probe`: reads its arguments, probes the EXR with
+//! `candela probe`: reads its arguments, probes the EXR (or Radiance HDR) with
 //! [`candela::report::probe::probe_file`] and formats the result for the terminal (text, or
 //! the JSON that docs/reports.md documents).
 
@@ -14,7 +14,7 @@ use serde_json::json;
 #[derive(clap::Args, Debug, Clone)]
 pub struct ProbeArgs {
     /// EXR image written by `candela render` (channels X, Y, Z, stderr.Y; E, stderr.E, mask.E
-    /// with --illuminance).
+    /// with --illuminance), or a Radiance HDR picture (luminance and colour, no error).
     pub exr: PathBuf,
     /// Column of the pixel, 0 = left.
     #[arg(allow_hyphen_values = true)]

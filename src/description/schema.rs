@@ -187,13 +187,44 @@ pub struct CameraDesc {
     pub look_at: V3,
     #[serde(default = "default_up")]
     pub up: V3,
-    /// Full vertical field of view, degrees.
-    pub vfov_deg: f32,
+    /// Full vertical field of view of the perspective projection, degrees (shorthand for
+    /// `projection: Perspective(vfov_deg: …)`; not with `projection`).
+    #[serde(default)]
+    pub vfov_deg: Option<f32>,
     /// Image width and height, pixels.
     pub resolution: (u32, u32),
-    /// Thin lens; omitted = pinhole.
+    /// How directions map to the image; omitted = perspective with `vfov_deg`.
+    #[serde(default)]
+    pub projection: Option<ProjectionDesc>,
+    /// Thin lens (perspective only); omitted = pinhole.
     #[serde(default)]
     pub lens: Option<LensDesc>,
+}
+
+/// The camera's projection (docs/scene-format.md).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ProjectionDesc {
+    /// Pinhole or thin-lens perspective; full vertical field of view in degrees.
+    Perspective { vfov_deg: f32 },
+    /// Circular fisheye inscribed in the image's shorter side; `fov_deg` is the full angle
+    /// across the circle, degrees.
+    Fisheye {
+        mapping: FisheyeMappingDesc,
+        fov_deg: f32,
+    },
+    /// 360° × 180° latitude–longitude panorama centred on the view direction.
+    Equirectangular,
+}
+
+/// Radial mapping of a fisheye: image radius ∝ θ, sin θ, 2 sin(θ/2) or 2 tan(θ/2) for the
+/// angle θ to the view direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum FisheyeMappingDesc {
+    Equidistant,
+    Orthographic,
+    Equisolid,
+    Stereographic,
 }
 
 fn default_up() -> V3 {

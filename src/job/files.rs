@@ -289,10 +289,44 @@ pub fn film_layers(scene: &str, film: &Film, illuminance: bool) -> Layers {
     layers
 }
 
-/// Writes the film's EXR (see [`film_layers`]).
-pub fn write_exr(scene_path: &Path, film: &Film, illuminance: bool, exr_path: &Path) -> Result<()> {
-    let layers = film_layers(&scene_path.display().to_string(), film, illuminance);
+/// Writes the film's EXR (see [`film_layers`]) with the camera's projection and Radiance view.
+pub fn write_exr(
+    scene_path: &Path,
+    film: &Film,
+    illuminance: bool,
+    camera: &crate::camera::Camera,
+    exr_path: &Path,
+) -> Result<()> {
+    let mut layers = film_layers(&scene_path.display().to_string(), film, illuminance);
+    layers.attributes.push((
+        output::ATTRIBUTE_PROJECTION.to_string(),
+        crate::camera::describe(camera.projection()),
+    ));
+    if let Some(view) = camera.radiance_view() {
+        layers
+            .attributes
+            .push((output::ATTRIBUTE_VIEW.to_string(), view));
+    }
     output::write_exr(exr_path, &layers).context("cannot write the EXR")?;
+    Ok(())
+}
+
+/// Writes the film as a Radiance picture with the camera's `VIEW=` (where Radiance has one)
+/// and its projection in a `CANDELA_PROJECTION=` line.
+pub fn write_hdr(film: &Film, camera: &crate::camera::Camera, hdr_path: &Path) -> Result<()> {
+    let extra = [format!(
+        "CANDELA_PROJECTION={}",
+        crate::camera::describe(camera.projection())
+    )];
+    output::write_hdr(
+        hdr_path,
+        film.width,
+        film.height,
+        &film.xyz_image(),
+        camera.radiance_view().as_deref(),
+        &extra,
+    )
+    .context("cannot write the HDR")?;
     Ok(())
 }
 

@@ -11,8 +11,8 @@ use crate::output::with_suffix;
 pub use files::would_replace;
 pub use files::{check_exposure, MAX_ABS_EXPOSURE_EV};
 use files::{
-    check_output_dir, check_outputs, output_stem, state_bytes_at_least, write_exr, write_png,
-    Planned,
+    check_output_dir, check_outputs, output_stem, state_bytes_at_least, write_exr, write_hdr,
+    write_png, Planned,
 };
 pub use merge::{merge, MergeOutputs};
 
@@ -330,6 +330,7 @@ fn planned_outputs(job: &RenderJob, world: &World, stem: &Path) -> Vec<Planned> 
     let mut planned = vec![
         plan(".exr", "the EXR image"),
         plan(".png", "the PNG image"),
+        plan(".hdr", "the Radiance HDR image"),
         plan(".report.json", "the report"),
         plan(".state", "the render state"),
     ];
@@ -385,8 +386,9 @@ pub fn run(
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "render".into());
-    let stem = output_stem(job.out.as_deref(), &name, &["exr", "png"]);
+    let stem = output_stem(job.out.as_deref(), &name, &["exr", "png", "hdr"]);
     let (exr_path, png_path) = (with_suffix(&stem, ".exr"), with_suffix(&stem, ".png"));
+    let hdr_path = with_suffix(&stem, ".hdr");
     check_output_dir(&stem)?;
     let state_path = with_suffix(&stem, ".state");
     let report_path = with_suffix(&stem, ".report.json");
@@ -431,8 +433,9 @@ pub fn run(
     // The images before the state: on a nearly full disk the small files still get written.
     let write_images = |film: &Film, writes: &mut Writes| {
         writes.attempt(&exr_path, || {
-            write_exr(scene_path, film, illuminance, &exr_path)
+            write_exr(scene_path, film, illuminance, &world.camera, &exr_path)
         });
+        writes.attempt(&hdr_path, || write_hdr(film, &world.camera, &hdr_path));
         // The PNG too, so that the image pair on disk is always of the same estimate.
         writes.attempt(&png_path, || write_png(film, &png_path, job.exposure_ev));
     };
@@ -441,7 +444,7 @@ pub fn run(
             RenderState::new(scene_path, hash, &world, film.clone()).save(&state_path)
         });
     };
-    progress.start(prog.max_spp as u64 * (w * h) as u64)?;
+    progress.start(prog.max_spp as u64 * world.camera.inside_pixels() as u64)?;
     let progress = std::cell::RefCell::new(progress);
     let mut last = PassStatus::default();
     let (result, reason) = crate::render::render_progressive(

@@ -5,11 +5,14 @@
 //!   header attributes.
 //! * [`write_srgb_png`]: an 8-bit sRGB preview, exposed like a camera at a given (or
 //!   automatically metered) exposure value. See `docs/outputs.md` for the exact mapping.
+//! * [`write_hdr`] / [`read_hdr`]: Radiance RGBE pictures (luminance = 179 × Radiance's
+//!   brightness), for Radiance's tools; [`read_image`] reads either format.
 //! * [`write_atomic`]: every file this module writes goes through it, so a crash or an error
 //!   never leaves a half-written output behind.
 
 pub mod draw;
 mod exr_io;
+mod hdr;
 mod png;
 
 use std::fs::{self, File, OpenOptions};
@@ -18,6 +21,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 pub use exr_io::{read_exr, write_exr, Layers};
+pub use hdr::{
+    read_hdr, read_hdr_luminance, rgb_to_xyz_matrix, write_hdr, HdrImage, RADIANCE_EFFICACY,
+    RADIANCE_PRIMARIES,
+};
 pub use png::{
     auto_exposure_ev, ev_to_scale, log_average_luminance, write_rgb_png, write_srgb_png, PngInfo,
     PngSettings, CALIBRATION_K, ISO_SPEED, MIDDLE_GREY,
@@ -54,6 +61,12 @@ pub const CHANNEL_E_STDERR: &str = "stderr.E";
 pub const CHANNEL_E_MASK: &str = "mask.E";
 /// Value written to `E` where it is undefined (never NaN).
 pub const ILLUMINANCE_SENTINEL: f32 = -1.0;
+/// Header attribute (EXR) holding the camera's Radiance view options (`-vta -vp … -vh …`),
+/// where Radiance has a matching view type (OpenEXR reserves `view` for stereo views).
+pub const ATTRIBUTE_VIEW: &str = "radiance_view";
+/// Header attribute (EXR) holding the camera's projection in scene syntax, e.g.
+/// `Fisheye(mapping: Equisolid, fov_deg: 180)`.
+pub const ATTRIBUTE_PROJECTION: &str = "projection";
 /// Value of [`ATTRIBUTE_UNITS`] for candela's absolute photometric images.
 pub const UNITS_CD_PER_M2: &str = "cd/m^2";
 
@@ -77,6 +90,14 @@ pub enum OutputError {
         /// The file concerned.
         path: PathBuf,
         /// What the EXR library said.
+        message: String,
+    },
+    /// The file is not a readable Radiance picture (malformed, truncated, unsupported).
+    #[error("{}: not a valid Radiance HDR image: {message}", path.display())]
+    Hdr {
+        /// The file concerned.
+        path: PathBuf,
+        /// What is wrong.
         message: String,
     },
     /// A pixel value is NaN or infinite; such values are never written.
@@ -121,6 +142,7 @@ impl OutputError {
         match self {
             OutputError::Io { path, .. }
             | OutputError::Exr { path, .. }
+            | OutputError::Hdr { path, .. }
             | OutputError::NonFinite { path, .. }
             | OutputError::InvalidImage { path, .. }
             | OutputError::Png { path, .. } => path,
@@ -132,6 +154,28 @@ impl OutputError {
             path: path.to_path_buf(),
             reason: reason.into(),
         }
+    }
+}
+
+/// Reads an image candela can measure: a Radiance picture (a file starting with `#?`, as
+/// [`HdrImage::to_layers`]) or else an OpenEXR file ([`read_exr`]).
+pub fn read_image(path: &Path) -> Result<Layers, OutputError> {
+    let mut head = [0u8; 2];
+    // Only a regular file is opened here (opening a FIFO would block); anything else goes
+    // to the EXR reader, which refuses it by kind.
+    let regular = fs::metadata(path).is_ok_and(|m| m.is_file());
+    let file = if regular { File::open(path).ok() } else { None };
+    let is_hdr = match file {
+        Some(mut f) => {
+            use std::io::Read;
+            f.read_exact(&mut head).is_ok() && head == *b"#?"
+        }
+        None => false,
+    };
+    if is_hdr {
+        Ok(read_hdr(path)?.to_layers())
+    } else {
+        read_exr(path)
     }
 }
 

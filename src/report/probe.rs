@@ -12,7 +12,7 @@ use crate::colour::rgb::{srgb_encode, xyz_to_linear_srgb};
 use crate::colour::temperature::xyz_to_cct_ohno2013;
 use crate::limits::check_memory;
 use crate::output::{
-    read_exr, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR, CHANNEL_X, CHANNEL_Y,
+    read_image, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR, CHANNEL_X, CHANNEL_Y,
     CHANNEL_Y_STDERR, CHANNEL_Z, ILLUMINANCE_SENTINEL,
 };
 use crate::photometry::Quantity;
@@ -279,7 +279,7 @@ pub fn probe_file(
     radius: Option<f64>,
     units: UnitSystem,
 ) -> anyhow::Result<ProbeResult> {
-    let layers = read_exr(path)?;
+    let layers = read_image(path)?;
     super::check_photometric_layers(path, &layers).map_err(|e| anyhow!(e))?;
     probe(&layers, x, y, radius, units).map_err(|e| anyhow!("{}: {e}", path.display()))
 }

@@ -1,157 +1,22 @@
-//! Perspective camera with an optional thin lens, and pixel reconstruction filters.
+//! The camera: projections (perspective with an optional thin lens, fisheyes, equirectangular
+//! panorama) and pixel reconstruction filters.
 //!
 //! The camera is a radiance meter: each pixel reports the filter-weighted average of the
 //! radiance arriving along its rays, so a pixel's Y is luminance in cd/m² (no vignetting or
-//! cos⁴ falloff, no exposure). Image rows run top to bottom.
+//! cos⁴ falloff, no exposure). Image rows run top to bottom. A fisheye's film outside its
+//! image circle sees nothing: samples there carry zero radiance, and pixels wholly outside
+//! ([`Camera::pixel_inside`] false) are not sampled at all.
+
+mod filter;
+pub mod projection;
+
+pub use filter::{GaussianTable, PixelFilter};
+pub use projection::{describe, radiance_view, FisheyeMapping, Projection};
 
 use crate::description::context::{Context, SceneError};
-use crate::description::schema::{CameraDesc, FilterDesc};
+use crate::description::schema::{CameraDesc, FisheyeMappingDesc, ProjectionDesc};
 use glam::{Vec2, Vec3};
-
-/// Pixel reconstruction filter. Samples are drawn from the filter itself (filter importance
-/// sampling), so every sample carries weight 1 and belongs to exactly one pixel; the per-pixel
-/// mean and sample variance are then those of independent, identically weighted samples.
-#[derive(Clone, Debug, PartialEq)]
-pub enum PixelFilter {
-    /// Uniform over the pixel square (half-width 0.5 px): the pixel's value is the average
-    /// radiance over its footprint.
-    Box,
-    /// Tent (triangle) of the given radius in pixels.
-    Tent { radius: f32 },
-    /// Gaussian of standard deviation `sigma` px truncated at `radius` px.
-    Gaussian {
-        sigma: f32,
-        radius: f32,
-        table: GaussianTable,
-    },
-}
-
-/// Inverse CDF of a truncated Gaussian, tabulated.
-#[derive(Clone, Debug, PartialEq)]
-pub struct GaussianTable {
-    inv_cdf: Vec<f32>,
-    /// ∫ exp(−x²/2σ²) dx over [−radius, radius] (the 1-D normalisation of the density).
-    norm: f32,
-}
-
-impl GaussianTable {
-    fn new(sigma: f32, radius: f32) -> Self {
-        const N: usize = 1024;
-        // Tabulate the CDF on a fine grid, then invert at equally spaced probabilities.
-        let m = 8192;
-        let xs: Vec<f64> = (0..=m)
-            .map(|i| -radius as f64 + 2.0 * radius as f64 * i as f64 / m as f64)
-            .collect();
-        let f = |x: f64| (-(x * x) / (2.0 * (sigma as f64).powi(2))).exp();
-        let mut cdf = vec![0.0f64; m + 1];
-        for i in 1..=m {
-            cdf[i] = cdf[i - 1] + 0.5 * (f(xs[i - 1]) + f(xs[i])) * (xs[i] - xs[i - 1]);
-        }
-        let total = cdf[m];
-        let mut inv_cdf = Vec::with_capacity(N + 1);
-        let mut j = 0;
-        for k in 0..=N {
-            let p = total * k as f64 / N as f64;
-            while j < m - 1 && cdf[j + 1] < p {
-                j += 1;
-            }
-            let t = if cdf[j + 1] > cdf[j] {
-                ((p - cdf[j]) / (cdf[j + 1] - cdf[j])).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            inv_cdf.push((xs[j] + t * (xs[j + 1] - xs[j])) as f32);
-        }
-        Self {
-            inv_cdf,
-            norm: total as f32,
-        }
-    }
-    fn sample(&self, u: f32) -> f32 {
-        let n = self.inv_cdf.len() - 1;
-        let x = u * n as f32;
-        let i = (x as usize).min(n - 1);
-        let t = x - i as f32;
-        self.inv_cdf[i] * (1.0 - t) + self.inv_cdf[i + 1] * t
-    }
-}
-
-impl PixelFilter {
-    /// The filter of `render.filter` from its description (radius and sigma in pixels).
-    pub fn build(ctx: &Context, desc: &FilterDesc) -> Result<Self, SceneError> {
-        Ok(match *desc {
-            FilterDesc::Box => PixelFilter::Box,
-            FilterDesc::Tent { radius } => PixelFilter::Tent {
-                radius: ctx.positive("render.filter.radius", radius as f64)? as f32,
-            },
-            FilterDesc::Gaussian { sigma, radius } => PixelFilter::gaussian(
-                ctx.positive("render.filter.sigma", sigma as f64)? as f32,
-                ctx.positive("render.filter.radius", radius as f64)? as f32,
-            ),
-        })
-    }
-
-    pub fn gaussian(sigma: f32, radius: f32) -> Self {
-        PixelFilter::Gaussian {
-            sigma,
-            radius,
-            table: GaussianTable::new(sigma, radius),
-        }
-    }
-
-    /// Half-width of the filter's support, pixels.
-    pub fn radius(&self) -> f32 {
-        match self {
-            PixelFilter::Box => 0.5,
-            PixelFilter::Tent { radius } | PixelFilter::Gaussian { radius, .. } => *radius,
-        }
-    }
-
-    /// The density (px⁻², integrating to 1) with which [`Self::sample`] draws offset `d` from
-    /// the pixel centre: the weight of a film point at `d` in that pixel's value.
-    pub fn density(&self, d: Vec2) -> f32 {
-        let r = self.radius();
-        if d.x.abs() > r || d.y.abs() > r {
-            return 0.0;
-        }
-        match self {
-            // The half-open pixel square [−½, ½)², as `sample` produces.
-            PixelFilter::Box => {
-                if d.x < 0.5 && d.y < 0.5 {
-                    1.0
-                } else {
-                    0.0
-                }
-            }
-            PixelFilter::Tent { radius } => {
-                let t = |x: f32| (1.0 - x.abs() / radius) / radius;
-                t(d.x) * t(d.y)
-            }
-            PixelFilter::Gaussian { sigma, table, .. } => {
-                let g = |x: f32| (-(x * x) / (2.0 * sigma * sigma)).exp() / table.norm;
-                g(d.x) * g(d.y)
-            }
-        }
-    }
-
-    /// Offset from the pixel centre, in pixels, distributed as the filter.
-    pub fn sample(&self, u: Vec2) -> Vec2 {
-        match self {
-            PixelFilter::Box => u - Vec2::splat(0.5),
-            PixelFilter::Tent { radius } => {
-                let tent = |u: f32| {
-                    if u < 0.5 {
-                        -radius * (1.0 - (2.0 * u).sqrt())
-                    } else {
-                        radius * (1.0 - (2.0 - 2.0 * u).sqrt())
-                    }
-                };
-                Vec2::new(tent(u.x), tent(u.y))
-            }
-            PixelFilter::Gaussian { table, .. } => Vec2::new(table.sample(u.x), table.sample(u.y)),
-        }
-    }
-}
+use projection::FilmMap;
 
 /// A camera ray (unit direction).
 #[derive(Clone, Copy, Debug)]
@@ -169,7 +34,7 @@ pub struct ThinLens {
     pub focus_distance: f32,
 }
 
-/// Pinhole or thin-lens perspective camera.
+/// A camera: position, orientation, projection and (perspective only) thin lens.
 #[derive(Clone, Debug)]
 pub struct Camera {
     /// Position of the pinhole or lens centre, m.
@@ -184,6 +49,7 @@ pub struct Camera {
     lens_radius: f32,
     /// Distance to the plane in focus, metres, along the view direction.
     focus_distance: f32,
+    map: FilmMap,
 }
 
 impl Camera {
@@ -205,15 +71,7 @@ impl Camera {
         if forward.normalize().cross(up).length_squared() < 1e-12 {
             return Err(ctx.err("camera.up", "up is zero or parallel to the view direction"));
         }
-        let vfov = ctx.finite("camera.vfov_deg", c.vfov_deg as f64)?;
-        if !(vfov > 0.0 && vfov < 180.0) {
-            return Err(ctx.err(
-                "camera.vfov_deg",
-                format!(
-                    "the field of view must lie strictly between 0 and 180 degrees, got {vfov}"
-                ),
-            ));
-        }
+        let projection = build_projection(ctx, c)?;
         let (w, h) = c.resolution;
         if w == 0 || h == 0 {
             return Err(ctx.err(
@@ -224,6 +82,15 @@ impl Camera {
         check_film(w, h)?;
         let lens = match &c.lens {
             None => None,
+            Some(_) if !matches!(projection, Projection::Perspective { .. }) => {
+                return Err(ctx.err(
+                    "camera.lens",
+                    format!(
+                        "a thin lens works only with the perspective projection, not with {}; remove `lens`",
+                        describe(projection)
+                    ),
+                ));
+            }
             Some(l) => {
                 let r = ctx.finite("camera.lens.aperture_radius", l.aperture_radius as f64)?;
                 if r < 0.0 {
@@ -239,37 +106,58 @@ impl Camera {
                 })
             }
         };
-        Ok(Camera::new(
+        Ok(Camera::with_projection(
             position,
             look_at,
             up,
-            vfov as f32,
+            projection,
             (w as usize, h as usize),
             lens,
         ))
     }
 
-    /// `vfov_deg` is the full vertical field of view. `up` need not be orthogonal to the view
-    /// direction but must not be parallel to it.
+    /// A perspective camera; `vfov_deg` is the full vertical field of view. `up` need not be
+    /// orthogonal to the view direction but must not be parallel to it.
     pub fn new(
         position: Vec3,
         look_at: Vec3,
         up: Vec3,
         vfov_deg: f32,
+        resolution: (usize, usize),
+        lens: Option<ThinLens>,
+    ) -> Self {
+        let projection = Projection::Perspective {
+            vfov_deg: vfov_deg as f64,
+        };
+        Self::with_projection(position, look_at, up, projection, resolution, lens)
+    }
+
+    /// A camera with any projection (a lens is used only by the perspective).
+    pub fn with_projection(
+        position: Vec3,
+        look_at: Vec3,
+        up: Vec3,
+        projection: Projection,
         (width, height): (usize, usize),
         lens: Option<ThinLens>,
     ) -> Self {
         let ThinLens {
             radius: lens_radius,
             focus_distance,
-        } = lens.unwrap_or(ThinLens {
-            radius: 0.0,
-            focus_distance: 1.0,
-        });
+        } = lens
+            .filter(|_| matches!(projection, Projection::Perspective { .. }))
+            .unwrap_or(ThinLens {
+                radius: 0.0,
+                focus_distance: 1.0,
+            });
         let forward = (look_at - position).normalize();
         // With a right-handed world (+y up, camera looking along +z) +x appears on the left.
         let right = forward.cross(up).normalize();
         let up = right.cross(forward);
+        let vfov_deg = match projection {
+            Projection::Perspective { vfov_deg } => vfov_deg as f32,
+            _ => 90.0,
+        };
         Self {
             position,
             forward,
@@ -280,12 +168,54 @@ impl Camera {
             height,
             lens_radius,
             focus_distance,
+            map: FilmMap::new(projection, width, height),
         }
     }
 
+    /// The camera's projection.
+    pub fn projection(&self) -> Projection {
+        self.map.projection
+    }
+
+    /// Unit view direction, right and up vectors of the image (world space).
+    pub fn frame(&self) -> (Vec3, Vec3, Vec3) {
+        (self.forward, self.right, self.up)
+    }
+
     /// Ray through film position (`px`, `py`) in pixels (0,0 = top-left corner of the image),
-    /// with lens sample `u_lens` ∈ [0,1)².
+    /// with lens sample `u_lens` ∈ [0,1)²; None outside a fisheye's image circle.
+    pub fn try_ray(&self, px: f32, py: f32, u_lens: Vec2) -> Option<CameraRay> {
+        match self.map.projection {
+            Projection::Perspective { .. } => Some(self.perspective_ray(px, py, u_lens)),
+            _ => {
+                let d = self.map.direction(px as f64, py as f64)?;
+                Some(CameraRay {
+                    origin: self.position,
+                    dir: self.to_world(d),
+                })
+            }
+        }
+    }
+
+    /// As [`Self::try_ray`]; outside a fisheye's image circle, the ray of the circle's edge
+    /// in the same azimuth.
     pub fn generate_ray(&self, px: f32, py: f32, u_lens: Vec2) -> CameraRay {
+        self.try_ray(px, py, u_lens).unwrap_or_else(|| {
+            let (cx, cy) = (0.5 * self.width as f64, 0.5 * self.height as f64);
+            let (dx, dy) = (px as f64 - cx, py as f64 - cy);
+            let k = 0.5 * self.width.min(self.height) as f64 / (dx * dx + dy * dy).sqrt();
+            let d = self
+                .map
+                .direction(cx + dx * k * (1.0 - 1e-9), cy + dy * k * (1.0 - 1e-9))
+                .unwrap_or([0.0, 0.0, 1.0]);
+            CameraRay {
+                origin: self.position,
+                dir: self.to_world(d),
+            }
+        })
+    }
+
+    fn perspective_ray(&self, px: f32, py: f32, u_lens: Vec2) -> CameraRay {
         let aspect = self.width as f32 / self.height as f32;
         let sx = (2.0 * px / self.width as f32 - 1.0) * aspect * self.tan_half_vfov;
         let sy = (1.0 - 2.0 * py / self.height as f32) * self.tan_half_vfov;
@@ -301,6 +231,157 @@ impl Camera {
         CameraRay {
             origin,
             dir: (focus - origin).normalize(),
+        }
+    }
+
+    /// Camera-frame direction (x right, y up, z forward) to world space.
+    fn to_world(&self, d: [f64; 3]) -> Vec3 {
+        (d[0] as f32 * self.right + d[1] as f32 * self.up + d[2] as f32 * self.forward).normalize()
+    }
+
+    /// World direction to the camera frame (f64).
+    fn to_camera(&self, v: Vec3) -> [f64; 3] {
+        let v = v.as_dvec3().normalize();
+        let f = |a: Vec3| a.as_dvec3().dot(v);
+        [f(self.right), f(self.up), f(self.forward)]
+    }
+
+    /// Whether pixel (x, y) sees anything (false only wholly outside a fisheye's image
+    /// circle; such pixels are black and take no samples).
+    pub fn pixel_inside(&self, x: usize, y: usize) -> bool {
+        self.map.pixel_inside(x, y)
+    }
+
+    /// Number of pixels that see anything.
+    pub fn inside_pixels(&self) -> usize {
+        (0..self.height)
+            .map(|y| (0..self.width).filter(|&x| self.pixel_inside(x, y)).count())
+            .sum()
+    }
+
+    /// Unit direction (world space) through the centre of pixel (x, y); for a pixel whose
+    /// centre lies outside a fisheye's circle, through the nearest point of the circle.
+    pub fn pixel_direction(&self, x: usize, y: usize) -> Vec3 {
+        self.generate_ray(x as f32 + 0.5, y as f32 + 0.5, Vec2::splat(0.5))
+            .dir
+    }
+
+    /// Film position (pixels, 0,0 = top-left corner) where the pinhole ray of world
+    /// direction `dir` lands, or None if the projection does not see that direction.
+    pub fn film_position(&self, dir: Vec3) -> Option<(f64, f64)> {
+        self.map.film(self.to_camera(dir))
+    }
+
+    /// Solid angle of pixel (x, y), sr: the exact integral over the part of its footprint
+    /// that sees the scene (pinhole; a thin lens's pixels see the same directions on average).
+    pub fn pixel_solid_angle_sr(&self, x: usize, y: usize) -> f64 {
+        self.map.pixel_solid_angle(x, y)
+    }
+
+    /// ∫ max(cos θ, 0) dω over pixel (x, y), sr, θ the angle to the view direction: exact.
+    pub fn pixel_projected_solid_angle_sr(&self, x: usize, y: usize) -> f64 {
+        self.map.pixel_projected_solid_angle(x, y)
+    }
+
+    /// Fraction of pixel (x, y)'s area inside the image (below 1 only on a fisheye's rim).
+    pub fn pixel_coverage(&self, x: usize, y: usize) -> f64 {
+        self.map.pixel_coverage(x, y)
+    }
+
+    /// The Radiance view options of this camera (`-vta -vp … -vd … -vu … -vh … -vv …`), or
+    /// None where Radiance has no matching view type (equisolid fisheye, equirectangular).
+    pub fn radiance_view(&self) -> Option<String> {
+        let v = |a: Vec3| [a.x as f64, a.y as f64, a.z as f64];
+        radiance_view(
+            self.map.projection,
+            (self.width, self.height),
+            v(self.position),
+            v(self.forward),
+            v(self.up),
+        )
+    }
+}
+
+/// Vertical illuminance at the eye, lx, from a luminance image (cd/m², row-major, top row
+/// first) taken by `camera`: E_v = Σ L · ∫ max(cos θ, 0) dω over each pixel (θ to the view
+/// direction; the integral exact per pixel). A fisheye's rim pixel holds the mean over its
+/// whole area with zero outside the circle, so its term is divided by its coverage. Sums in
+/// f64. Panics if the image is not `width × height`.
+pub fn vertical_illuminance_lx(camera: &Camera, luminance_cd_m2: &[f32]) -> f64 {
+    assert_eq!(
+        luminance_cd_m2.len(),
+        camera.width * camera.height,
+        "luminance image size"
+    );
+    let mut e = 0.0f64;
+    for y in 0..camera.height {
+        for x in 0..camera.width {
+            if !camera.pixel_inside(x, y) {
+                continue;
+            }
+            let cov = camera.pixel_coverage(x, y);
+            if cov <= 0.0 {
+                continue;
+            }
+            let l = luminance_cd_m2[y * camera.width + x] as f64;
+            e += l * camera.pixel_projected_solid_angle_sr(x, y) / cov;
+        }
+    }
+    e
+}
+
+/// The projection the description asks for: `projection`, else perspective with
+/// `vfov_deg`; each field's limits checked.
+fn build_projection(ctx: &Context, c: &CameraDesc) -> Result<Projection, SceneError> {
+    let perspective = |field: &str, v: f32| -> Result<Projection, SceneError> {
+        let vfov = ctx.finite(field, v as f64)?;
+        if !(vfov > 0.0 && vfov < 180.0) {
+            return Err(ctx.err(
+                field,
+                format!(
+                    "the field of view must lie strictly between 0 and 180 degrees, got {vfov}"
+                ),
+            ));
+        }
+        Ok(Projection::Perspective { vfov_deg: vfov })
+    };
+    match (&c.projection, c.vfov_deg) {
+        (None, Some(v)) => perspective("camera.vfov_deg", v),
+        (None, None) => Err(ctx.err(
+            "camera.vfov_deg",
+            "missing: give `vfov_deg` (perspective) or a `projection`",
+        )),
+        (Some(_), Some(_)) => Err(ctx.err(
+            "camera.vfov_deg",
+            "conflicts with `projection`: give the field of view inside the projection (e.g. `Perspective(vfov_deg: 40)`) and remove `vfov_deg`",
+        )),
+        (Some(ProjectionDesc::Perspective { vfov_deg }), None) => {
+            perspective("camera.projection.vfov_deg", *vfov_deg)
+        }
+        (Some(ProjectionDesc::Equirectangular), None) => Ok(Projection::Equirectangular),
+        (Some(ProjectionDesc::Fisheye { mapping, fov_deg }), None) => {
+            let mapping = match mapping {
+                FisheyeMappingDesc::Equidistant => FisheyeMapping::Equidistant,
+                FisheyeMappingDesc::Orthographic => FisheyeMapping::Orthographic,
+                FisheyeMappingDesc::Equisolid => FisheyeMapping::Equisolid,
+                FisheyeMappingDesc::Stereographic => FisheyeMapping::Stereographic,
+            };
+            let field = "camera.projection.fov_deg";
+            let fov = ctx.finite(field, *fov_deg as f64)?;
+            let max = mapping.max_fov_deg();
+            if !(fov > 0.0 && fov <= max) {
+                return Err(ctx.err(
+                    field,
+                    format!(
+                        "the {} fisheye's field of view must lie in (0, {max}] degrees, got {fov}",
+                        mapping.name().to_lowercase()
+                    ),
+                ));
+            }
+            Ok(Projection::Fisheye {
+                mapping,
+                fov_deg: fov,
+            })
         }
     }
 }
@@ -342,6 +423,9 @@ impl Camera {
     /// the point is behind the camera or outside the film (farther than `margin` pixels from
     /// its edge: the reconstruction filter's radius).
     pub fn connect(&self, p: Vec3, u_lens: Vec2, margin: f32) -> Option<CameraConnection> {
+        if !matches!(self.map.projection, Projection::Perspective { .. }) {
+            return self.connect_pinhole(p, margin);
+        }
         let lens_point = self.lens_point(u_lens);
         let v = p - lens_point;
         let z = v.dot(self.forward);
@@ -379,6 +463,38 @@ impl Camera {
     }
 }
 
+impl Camera {
+    /// [`Self::connect`] for the projections without a lens: the film position is the
+    /// projection's inverse map, and dA_film = dω / (dω/dA_film) with the solid angle density
+    /// of the projection in place of A_pix·cos³θ.
+    fn connect_pinhole(&self, p: Vec3, margin: f32) -> Option<CameraConnection> {
+        let v = p - self.position;
+        let dist = v.length();
+        if dist == 0.0 || !dist.is_finite() {
+            return None;
+        }
+        let d = self.to_camera(v);
+        let (px, py) = self.map.film(d)?;
+        let (w, h, m) = (self.width as f64, self.height as f64, margin as f64);
+        if !(px >= -m && px < w + m && py >= -m && py < h + m) {
+            return None;
+        }
+        let density = self.map.solid_angle_density(d);
+        if density <= 0.0 || !density.is_finite() {
+            return None;
+        }
+        let importance = 1.0 / (density * dist as f64 * dist as f64);
+        Some(CameraConnection {
+            lens_point: self.position,
+            wi: -v / dist,
+            dist,
+            film: Vec2::new(px as f32, py as f32),
+            importance: importance as f32,
+        })
+    }
+}
+
+#[cfg(test)]
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -401,22 +517,6 @@ mod tests {
         assert!(top.dir.y > 0.0);
         // The top edge ray makes half the vertical field of view with the axis.
         assert!((top.dir.y.atan2(top.dir.z).to_degrees() - 20.0).abs() < 1e-4);
-    }
-
-    #[test]
-    fn gaussian_filter_sample_has_right_spread() {
-        let f = PixelFilter::gaussian(0.5, 1.5);
-        let n = 20_000;
-        let var: f32 = (0..n)
-            .map(|i| {
-                f.sample(Vec2::new((i as f32 + 0.5) / n as f32, 0.5))
-                    .x
-                    .powi(2)
-            })
-            .sum::<f32>()
-            / n as f32;
-        // Truncation at 3σ reduces the variance by ~2.7 %.
-        assert!((var.sqrt() - 0.5).abs() < 0.01, "σ = {}", var.sqrt());
     }
 
     #[test]
@@ -483,40 +583,6 @@ mod tests {
     }
 
     #[test]
-    fn filter_densities_integrate_to_one_and_match_their_samples() {
-        for f in [
-            PixelFilter::Box,
-            PixelFilter::Tent { radius: 1.5 },
-            PixelFilter::gaussian(0.5, 1.5),
-        ] {
-            let r = f.radius();
-            let n = 600;
-            let h = 2.0 * r / n as f32;
-            let mut total = 0.0f64;
-            let mut second = 0.0f64;
-            for j in 0..n {
-                for i in 0..n {
-                    let d = Vec2::new(-r + (i as f32 + 0.5) * h, -r + (j as f32 + 0.5) * h);
-                    let w = (f.density(d) * h * h) as f64;
-                    total += w;
-                    second += w * (d.x * d.x) as f64;
-                }
-            }
-            assert!((total - 1.0).abs() < 2e-3, "{f:?}: ∫ = {total}");
-            // E[x²] of the samples equals the density's.
-            let m = 4000;
-            let s: f64 = (0..m)
-                .map(|i| (f.sample(Vec2::new((i as f32 + 0.5) / m as f32, 0.5)).x as f64).powi(2))
-                .sum::<f64>()
-                / m as f64;
-            assert!(
-                (s - second).abs() < 2e-3 * (1.0 + second),
-                "{f:?}: {s} vs {second}"
-            );
-        }
-    }
-
-    #[test]
     fn build_checks_the_film_before_the_lens() {
         use crate::description::schema::LensDesc;
         let path = std::path::Path::new("t.ron");
@@ -529,8 +595,9 @@ mod tests {
             position: [0.0, 0.0, 0.0],
             look_at: [0.0, 0.0, 1.0],
             up: [0.0, 1.0, 0.0],
-            vfov_deg: 40.0,
+            vfov_deg: Some(40.0),
             resolution: (8, 6),
+            projection: None,
             lens: Some(LensDesc {
                 aperture_radius: -1.0,
                 focus_distance: 1.0,
