@@ -93,6 +93,8 @@ enum Command {
     Probe(cli::probe::ProbeArgs),
     /// False-colour PNG of luminance or illuminance with a legend; see docs/reports.md.
     Falsecolour(cli::falsecolour::FalsecolourArgs),
+    /// Glare of a fisheye luminance image (DGP, UGR, DGI, VCP, CGI, E_v with 95 % intervals, the glare sources), as evalglare computes them; see docs/glare.md.
+    Glare(cli::glare::GlareArgs),
 }
 
 fn main() -> ExitCode {
@@ -138,6 +140,13 @@ fn main() -> ExitCode {
             }
         }),
         Command::Falsecolour(args) => cli::falsecolour::run(&args).map(|s| say_raw!("{s}")),
+        Command::Glare(args) => cli::glare::run(&args).map(|s| {
+            if args.json {
+                say_json!("{s}")
+            } else {
+                say_raw!("{s}")
+            }
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod colour;
 pub mod falsecolour;
+pub mod glare;
 pub mod luminaire;
 pub mod probe;
 pub mod render;

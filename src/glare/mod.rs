@@ -8,6 +8,7 @@
 //! - [`indices`]: position index, vertical illuminance and the indices DGP, DGI, UGR, VCP, CGI;
 //! - [`interval`]: the intervals, by simulation, and the verdict on a too-noisy image.
 
+pub mod file;
 pub mod image;
 pub mod indices;
 pub mod interval;

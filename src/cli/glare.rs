@@ -1,0 +1,169 @@
+//! `candela glare`: reads a fisheye luminance image (candela EXR or Radiance HDR), evaluates
+//! its glare with [`candela::glare`] and prints the indices with their 95 % intervals.
+
+use std::path::PathBuf;
+
+use candela::glare::file::read_glare_image;
+use candela::glare::{
+    evaluate_uncertain, GlareOptions, Interval, Threshold, UncertainGlare, UncertainOptions,
+};
+
+/// Arguments of `candela glare`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct GlareArgs {
+    /// Fisheye image: an EXR written by `candela render` (its `projection` attribute and
+    /// per-pixel standard errors are used) or a Radiance picture with a `VIEW=` line.
+    pub image: PathBuf,
+    /// Glare-pixel threshold as evalglare's `-b`: above 100 a luminance in cd/m², else a
+    /// multiple of the image's mean luminance (default: 2000 cd/m²).
+    #[arg(long)]
+    pub threshold: Option<f64>,
+    /// Search angle in radians (evalglare `-r`): glare pixels within half of it merge.
+    #[arg(long, default_value_t = 0.2)]
+    pub search_angle: f64,
+    /// Do not split sources' peaks above 50 000 cd/m² into sources of their own (evalglare `-x`).
+    #[arg(long)]
+    pub no_peaks: bool,
+    /// Apply DGP's low-light correction below 1000 lx (evalglare `-C l+`).
+    #[arg(long)]
+    pub low_light: bool,
+    /// Perturbed images drawn for the intervals.
+    #[arg(long, default_value_t = 64)]
+    pub draws: usize,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs the command: the text (or JSON) to print.
+pub fn run(args: &GlareArgs) -> anyhow::Result<String> {
+    let mut opt = GlareOptions::default();
+    if let Some(b) = args.threshold {
+        if !(b.is_finite() && b > 0.0) {
+            return Err(super::usage(format!(
+                "--threshold must be a positive number, got {b}"
+            )));
+        }
+        opt.detect.threshold = Threshold::from_evalglare_b(b);
+    }
+    if !(args.search_angle.is_finite() && args.search_angle > 0.0) {
+        return Err(super::usage(format!(
+            "--search-angle must be a positive angle in radians, got {}",
+            args.search_angle
+        )));
+    }
+    if args.draws == 1 || args.draws > 100_000 {
+        return Err(super::usage(format!(
+            "--draws must be 0 (no intervals) or 2 … 100 000, got {}",
+            args.draws
+        )));
+    }
+    opt.detect.search_angle_rad = args.search_angle;
+    if args.no_peaks {
+        opt.detect.peak_limit_cd_m2 = None;
+    }
+    opt.low_light_correction = args.low_light;
+    let img = read_glare_image(&args.image)?;
+    let u = UncertainOptions {
+        draws: args.draws,
+        ..Default::default()
+    };
+    let g = evaluate_uncertain(&img, &opt, &u)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.image.display()))?;
+    Ok(if args.json {
+        json(&g)
+    } else {
+        text(&g, img.stderr_cd_m2.is_some())
+    })
+}
+
+fn interval_json(i: &Interval) -> serde_json::Value {
+    serde_json::json!({
+        "value": i.value,
+        "ci95": [i.low(), i.high()],
+        "quantiles95": [i.quantiles.0, i.quantiles.1],
+    })
+}
+
+fn json(g: &UncertainGlare) -> String {
+    let r = &g.result;
+    let sources: Vec<_> = r
+        .sources
+        .iter()
+        .map(|s| {
+            serde_json::json!({
+                "direction": s.direction,
+                "solid_angle_sr": s.solid_angle_sr,
+                "luminance_cd_m2": s.luminance_cd_m2,
+                "position_index": s.position_index,
+                "angle_from_view_deg": s.angle_from_view_rad.to_degrees(),
+                "illuminance_lx": s.illuminance_lx,
+                "pixels": s.pixel_count,
+            })
+        })
+        .collect();
+    let v = serde_json::json!({
+        "dgp": interval_json(&g.dgp),
+        "dgi": interval_json(&g.dgi),
+        "ugr": interval_json(&g.ugr),
+        "vcp": interval_json(&g.vcp),
+        "cgi": interval_json(&g.cgi),
+        "ev_lx": interval_json(&g.ev_lx),
+        "ev_direct_lx": r.ev_direct_lx,
+        "background_cd_m2": r.background_cd_m2,
+        "mean_luminance_cd_m2": r.mean_luminance_cd_m2,
+        "threshold_cd_m2": r.threshold_cd_m2,
+        "sources": sources,
+        "trustworthy": g.trustworthy,
+        "warnings": g.warnings,
+    });
+    serde_json::to_string_pretty(&v).expect("JSON of numbers and strings")
+}
+
+fn text(g: &UncertainGlare, has_errors: bool) -> String {
+    let r = &g.result;
+    let row = |name: &str, i: &Interval, digits: usize| {
+        if has_errors {
+            format!(
+                "{name:<4} {:.digits$}  (95 % CI {:.digits$} … {:.digits$})\n",
+                i.value,
+                i.low(),
+                i.high()
+            )
+        } else {
+            format!("{name:<4} {:.digits$}\n", i.value)
+        }
+    };
+    let mut s = String::new();
+    s += &row("DGP", &g.dgp, 3);
+    s += &row("UGR", &g.ugr, 1);
+    s += &row("DGI", &g.dgi, 1);
+    s += &row("VCP", &g.vcp, 1);
+    s += &row("CGI", &g.cgi, 1);
+    s += &row("Ev", &g.ev_lx, 1);
+    s += &format!(
+        "threshold {:.0} cd/m², background {:.1} cd/m², {} glare source(s)\n",
+        r.threshold_cd_m2,
+        r.background_cd_m2,
+        r.sources.len()
+    );
+    for (k, src) in r.sources.iter().enumerate() {
+        s += &format!(
+            "  source {}: {:.4} sr, {:.0} cd/m², {:.1}° from the line of sight, position index {:.2}, {:.1} lx\n",
+            k + 1,
+            src.solid_angle_sr,
+            src.luminance_cd_m2,
+            src.angle_from_view_rad.to_degrees(),
+            src.position_index,
+            src.illuminance_lx
+        );
+    }
+    if !has_errors {
+        s += "no per-pixel standard errors in the image: no intervals\n";
+    } else if !g.trustworthy {
+        for w in &g.warnings {
+            s += &format!("warning: {w}\n");
+        }
+    }
+    s
+}
