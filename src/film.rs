@@ -63,14 +63,53 @@ pub fn radiance_to_xyz(l: &SampledSpectrum, wl: &SampledWavelengths) -> [f64; 3]
     [xyz[0] * k, xyz[1] * k, xyz[2] * k]
 }
 
+/// Independent batches of a pixel's camera samples: sample i belongs to batch i mod
+/// `PIXEL_BATCHES`, where it is sample i / `PIXEL_BATCHES` of the batch's own scrambled Sobol
+/// sequence (see [`crate::render::render_pixel`]); as for meters ([`crate::meter::BATCHES`]).
+pub const PIXEL_BATCHES: usize = 16;
+
+/// EXR attribute giving the number of independent sample batches per pixel behind `stderr.Y`
+/// and `stderr.E`: a pixel with n samples has min(n, batches) of them, and its 95 % interval
+/// uses Student's t with one degree of freedom fewer.
+pub const STDERR_BATCHES_ATTRIBUTE: &str = "stderr_batches";
+
+/// Samples of batch `b` among the first `n` samples of a pixel (sample i in batch i mod 16).
+#[inline]
+pub fn batch_count(n: u64, b: usize) -> u64 {
+    n / PIXEL_BATCHES as u64 + ((b as u64) < n % PIXEL_BATCHES as u64) as u64
+}
+
+/// Standard error of Σ Sᵦ / n from the sums Sᵦ of the independent batches of `n` samples
+/// (batch sizes by [`batch_count`]): the ratio estimator's
+/// √(K/(K−1) · Σᵦ (Sᵦ − x̄ nᵦ)²) / n over the K = min(n, 16) non-empty batches, which is the
+/// spread of the batch means over √K when the batches are equal. 0 below 2 batches.
+pub fn batch_standard_error(sums: &[f64; PIXEL_BATCHES], n: u64) -> f64 {
+    let k = n.min(PIXEL_BATCHES as u64) as usize;
+    if k < 2 {
+        return 0.0;
+    }
+    let nf = n as f64;
+    let mean = sums.iter().sum::<f64>() / nf;
+    let ss: f64 = (0..k)
+        .map(|b| (sums[b] - mean * batch_count(n, b) as f64).powi(2))
+        .sum();
+    (ss * k as f64 / (k - 1) as f64).sqrt() / nf
+}
+
 /// Running sums for one pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PixelSums {
     /// Σ of the samples' absolute XYZ (Y in cd/m²).
     pub sum_xyz: [f64; 3],
-    /// Σ Y² ((cd/m²)²), for the sample variance of luminance.
+    /// Σ Y² ((cd/m²)²): the samples' variance, for consistency checks and the iid error
+    /// ([`Self::y_standard_error_iid`]).
     pub sum_y2: f64,
     pub count: u64,
+    /// Σ Y (cd/m²) of each batch's samples ([`PIXEL_BATCHES`], sample i in batch i mod 16):
+    /// the standard error comes from their spread.
+    pub batch_y: [f64; PIXEL_BATCHES],
+    /// Σ E (lx) of each batch's samples, a sample that sees no receiving surface counting 0.
+    pub batch_e: [f64; PIXEL_BATCHES],
     /// Σ E (lx) over the samples whose camera ray found a receiving surface.
     pub sum_e: f64,
     /// Σ E² (lx²) over the same samples.
@@ -94,13 +133,39 @@ pub struct PixelSums {
 }
 
 impl PixelSums {
+    /// Record the next camera sample (index `count`, of batch `count` mod 16): its absolute
+    /// XYZ and the illuminance (lx) of the surface it sees, if it sees a receiving one.
     #[inline]
-    pub fn add(&mut self, xyz: [f64; 3]) {
+    pub fn add(&mut self, xyz: [f64; 3], e: Option<f64>) {
+        let b = (self.count % PIXEL_BATCHES as u64) as usize;
+        if let Some(e) = e {
+            self.sum_e += e;
+            self.sum_e2 += e * e;
+            self.count_e += 1;
+            self.batch_e[b] += e;
+        }
         self.sum_xyz[0] += xyz[0];
         self.sum_xyz[1] += xyz[1];
         self.sum_xyz[2] += xyz[2];
         self.sum_y2 += xyz[1] * xyz[1];
+        self.batch_y[b] += xyz[1];
         self.count += 1;
+    }
+    /// Independent batches behind the camera samples' standard errors (min(samples, 16)); the
+    /// 95 % intervals use Student's t with one degree of freedom fewer
+    /// ([`Self::y_ci95_half_width`]).
+    pub fn batches(&self) -> u32 {
+        self.count.min(PIXEL_BATCHES as u64) as u32
+    }
+    /// Half-width (cd/m²) of the 95 % interval of the mean luminance: t₀.₉₇₅ with
+    /// [`Self::batches`] − 1 degrees of freedom times [`Self::y_standard_error`] (infinite
+    /// below 2 batches).
+    pub fn y_ci95_half_width(&self) -> f64 {
+        crate::meter::t95(self.batches().saturating_sub(1)) * self.y_standard_error()
+    }
+    /// Half-width (lx) of the 95 % interval of [`Self::mean_e`], as for luminance.
+    pub fn e_ci95_half_width(&self) -> f64 {
+        crate::meter::t95(self.batches().saturating_sub(1)) * self.e_standard_error()
     }
     /// Add the splats of `paths` light paths (see [`crate::integrator::light_path`]): their
     /// Σ X, Σ Y, Σ Z, Σ Y², Σ E and Σ E² on this pixel.
@@ -118,13 +183,6 @@ impl PixelSums {
     fn has_e_splats(&self) -> bool {
         self.light_paths > 0 && (self.splat_e != 0.0 || self.splat_e2 != 0.0)
     }
-    /// Record one illuminance sample (lx) of the surface seen by a camera sample.
-    #[inline]
-    pub fn add_illuminance(&mut self, e: f64) {
-        self.sum_e += e;
-        self.sum_e2 += e * e;
-        self.count_e += 1;
-    }
     /// Mean illuminance over the samples that saw a receiving surface.
     ///
     /// With light-traced caustics, the light paths' splats estimate the pixel's mean of E over
@@ -140,8 +198,26 @@ impl PixelSums {
         let all = self.sum_e / self.count as f64 + self.splat_e / self.light_paths as f64;
         Some(all / self.e_coverage())
     }
-    /// Standard error of [`Self::mean_e`] (the coverage taken as exact).
+    /// Standard error of [`Self::mean_e`] (the coverage taken as exact): that of the camera
+    /// samples' mean of E over all samples (0 where no receiver is seen) from the spread of
+    /// the batches, and with light-traced caustics that of the light paths' mean from their
+    /// sample variance (independent estimates, added in quadrature), over the coverage.
     pub fn e_standard_error(&self) -> f64 {
+        if self.count_e == 0 {
+            return 0.0;
+        }
+        let cam = batch_standard_error(&self.batch_e, self.count);
+        let light = if self.has_e_splats() {
+            standard_error(self.splat_e, self.splat_e2, self.light_paths)
+        } else {
+            0.0
+        };
+        (cam * cam + light * light).sqrt() / self.e_coverage()
+    }
+    /// The standard error of [`Self::mean_e`] that treats the camera samples as independent
+    /// (√(s²/n) with the sample variance): an over-estimate for stratified samples, kept for
+    /// comparison.
+    pub fn e_standard_error_iid(&self) -> f64 {
         if !self.has_e_splats() || self.count_e == 0 {
             return standard_error(self.sum_e, self.sum_e2, self.count_e);
         }
@@ -157,7 +233,16 @@ impl PixelSums {
             self.count_e as f64 / self.count as f64
         }
     }
+    /// Add the sums of an independent render of this pixel (another seed). Its batch b joins
+    /// batch (b + count) mod 16, as if its samples continued this pixel's numbering, so the
+    /// batch sizes keep the i mod 16 rule; every batch stream still feeds a single batch, so
+    /// the batches stay independent.
     pub fn merge(&mut self, o: &PixelSums) {
+        let r = (self.count % PIXEL_BATCHES as u64) as usize;
+        for b in 0..PIXEL_BATCHES {
+            self.batch_y[(b + r) % PIXEL_BATCHES] += o.batch_y[b];
+            self.batch_e[(b + r) % PIXEL_BATCHES] += o.batch_e[b];
+        }
         self.sum_e += o.sum_e;
         self.sum_e2 += o.sum_e2;
         self.count_e += o.count_e;
@@ -189,9 +274,18 @@ impl PixelSums {
         );
         [c[0] + l[0], c[1] + l[1], c[2] + l[2]]
     }
-    /// Standard error of the mean luminance, √(s²/n) with the unbiased sample variance s², of
-    /// the camera samples and the light paths (independent) combined.
+    /// Standard error (cd/m²) of the mean luminance: that of the camera samples from the spread
+    /// of their batches ([`batch_standard_error`]) and, with light-traced caustics, that of the
+    /// light paths from their sample variance, added in quadrature (independent estimates).
     pub fn y_standard_error(&self) -> f64 {
+        let cam = batch_standard_error(&self.batch_y, self.count);
+        let light = standard_error(self.splat_xyz[1], self.splat_y2, self.light_paths);
+        (cam * cam + light * light).sqrt()
+    }
+    /// The standard error of the mean luminance that treats the camera samples as independent,
+    /// √(s²/n) with the sample variance: an over-estimate for stratified samples, kept for
+    /// comparison.
+    pub fn y_standard_error_iid(&self) -> f64 {
         let cam = standard_error(self.sum_xyz[1], self.sum_y2, self.count);
         let light = standard_error(self.splat_xyz[1], self.splat_y2, self.light_paths);
         (cam * cam + light * light).sqrt()
@@ -257,6 +351,34 @@ impl PixelSums {
             // squares are all ≥ 0.
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("{name} is {v:e}, but sums of XYZ, illuminance and their squares are finite and ≥ 0"));
+            }
+        }
+        let nonempty = self.count.min(PIXEL_BATCHES as u64) as usize;
+        let rel = 1.0 + 1e-9_f64.max(4.0 * self.count as f64 * f64::EPSILON);
+        let abs = self.count as f64 * 1e-150;
+        for (what, batches, total) in [
+            ("Y", &self.batch_y, self.sum_xyz[1]),
+            ("E", &self.batch_e, self.sum_e),
+        ] {
+            for (b, &v) in batches.iter().enumerate() {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(format!(
+                        "batch {b} of Σ {what} is {v:e}, but sums of luminance and illuminance are finite and ≥ 0"
+                    ));
+                }
+                if b >= nonempty && v != 0.0 {
+                    return Err(format!(
+                        "batch {b} of Σ {what} is {v:e}, but with {} samples that batch holds none",
+                        self.count
+                    ));
+                }
+            }
+            // The same samples summed in another order: equal but for rounding.
+            let sum: f64 = batches.iter().sum();
+            if sum > total * rel + abs || total > sum * rel + abs {
+                return Err(format!(
+                    "its batches of Σ {what} add up to {sum:e}, but Σ {what} is {total:e}"
+                ));
             }
         }
         if self.light_paths != light_paths {
@@ -534,12 +656,99 @@ mod tests {
 
     #[test]
     fn standard_error_of_known_samples() {
+        // Four samples, one per batch: the batch estimate equals the iid one. s² = 5/3,
+        // se = √(5/12).
         let mut p = PixelSums::default();
         for y in [1.0, 2.0, 3.0, 4.0] {
-            p.add([0.0, y, 0.0]);
+            p.add([0.0, y, 0.0], None);
         }
-        // s² = 5/3, se = sqrt(5/12)
         assert!((p.y_standard_error() - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
+        assert!((p.y_standard_error_iid() - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
         assert_eq!(p.mean_xyz()[1], 2.5);
+        assert_eq!(p.batches(), 4);
+    }
+
+    #[test]
+    fn the_standard_error_is_the_spread_of_the_batch_means() {
+        // 64 samples, sample i in batch i mod 16 with value b = i mod 16 (+ i/16 · 0, so
+        // nothing varies within a batch): batch means 0 … 15, sd √(340/15), se = sd/4.
+        let mut p = PixelSums::default();
+        for i in 0..64u64 {
+            p.add([0.0, (i % 16) as f64, 0.0], Some(2.0 * (i % 16) as f64));
+        }
+        let se = (340.0f64 / 15.0).sqrt() / 4.0;
+        assert!(
+            (p.y_standard_error() - se).abs() < 1e-12,
+            "{}",
+            p.y_standard_error()
+        );
+        assert!((p.e_standard_error() - 2.0 * se).abs() < 1e-12);
+        assert!((p.y_ci95_half_width() - 2.131_449_545_6 * se).abs() < 1e-9);
+        // Variation only within batches, equal batch means: no spread at all.
+        let mut q = PixelSums::default();
+        for i in 0..64u64 {
+            q.add([0.0, (i / 16) as f64, 0.0], None);
+        }
+        assert_eq!(q.y_standard_error(), 0.0);
+        assert!(q.y_standard_error_iid() > 0.5);
+    }
+
+    #[test]
+    fn unequal_batches_are_weighted() {
+        // 20 samples of 1: batches 0–3 hold 2, the others 1; every sample equal, no error.
+        let mut p = PixelSums::default();
+        for _ in 0..20 {
+            p.add([0.0, 1.0, 0.0], None);
+        }
+        assert_eq!(p.y_standard_error(), 0.0);
+        assert_eq!((batch_count(20, 3), batch_count(20, 4)), (2, 1));
+    }
+
+    #[test]
+    fn merging_continues_the_batch_numbering() {
+        // 5 + 7 samples merged hold the batches of 12 samples numbered in a row.
+        let (mut a, mut b, mut all) = Default::default();
+        let v = |i: u64| [0.0, (i * i % 7) as f64, 0.0];
+        for i in 0..5 {
+            PixelSums::add(&mut a, v(i), None);
+            PixelSums::add(&mut all, v(i), None);
+        }
+        for i in 5..12 {
+            PixelSums::add(&mut b, v(i), None);
+            PixelSums::add(&mut all, v(i), None);
+        }
+        a.merge(&b);
+        assert_eq!(a.batch_y, all.batch_y);
+        assert_eq!(a.count, 12);
+        assert!(a.check(0, false).is_ok());
+    }
+
+    #[test]
+    fn check_names_inconsistent_batches() {
+        let mut p = PixelSums::default();
+        for i in 0..20 {
+            p.add([0.0, i as f64, 0.0], Some(1.0));
+        }
+        assert!(p.check(0, true).is_ok());
+        let mut q = p;
+        q.batch_y[3] += 1.0;
+        let e = q.check(0, true).unwrap_err();
+        assert!(e.contains("batches of Σ Y add up to"), "{e}");
+        let mut q = p;
+        q.batch_e[2] = -1.0;
+        q.batch_e[5] += 1.0;
+        let e = q.check(0, true).unwrap_err();
+        assert!(e.contains("batch 2 of Σ E"), "{e}");
+        let mut q = PixelSums::default();
+        for _ in 0..3 {
+            q.add([0.0, 1.0, 0.0], None);
+        }
+        q.batch_y[9] = 1.0;
+        q.batch_y[0] = 0.0;
+        let e = q.check(0, false).unwrap_err();
+        assert!(
+            e.contains("batch 9 of Σ Y") && e.contains("holds none"),
+            "{e}"
+        );
     }
 }

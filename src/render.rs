@@ -1,9 +1,9 @@
 //! Rendering an image: tiles in parallel (rayon), every sample regenerated from
 //! (seed, pixel, sample index), so the result does not depend on the number of threads.
 
-use crate::film::{radiance_to_xyz, Film, PixelSums};
+use crate::film::{radiance_to_xyz, Film, PixelSums, PIXEL_BATCHES};
 use crate::integrator::{trace, PathStart, RayStats};
-use crate::sampling::Sampler;
+use crate::sampling::{batch_stream, Sampler};
 use crate::spectrum::SampledWavelengths;
 use crate::world::World;
 use rayon::prelude::*;
@@ -44,7 +44,10 @@ pub fn render_pixel(
     let cam = &world.camera;
     let pixel = (y * cam.width + x) as u64;
     for s in first..first + count {
-        let mut sampler = Sampler::new(seed, pixel, s);
+        // Sample s is sample s / 16 of batch s mod 16, whose independently scrambled sequence
+        // makes the batch means independent (the pixel's standard error is their spread).
+        let (batch, index) = pixel_batch(pixel, s);
+        let mut sampler = Sampler::new(seed, batch, index);
         // Dimensions 0–1: position in the pixel (the best-stratified Sobol pair), 2–3: lens,
         // 4: wavelengths; paths continue from dimension 8.
         let [fx, fy, lx, ly] = sampler.get4();
@@ -64,20 +67,28 @@ pub fn render_pixel(
             &mut sampler,
             stats,
         );
-        if world.settings.illuminance {
-            if let Some(e) = surface_illuminance(world, seed, ray.origin, ray.dir, pixel, s, stats)
-            {
-                sums.add_illuminance(e);
-            }
-        }
+        let e = if world.settings.illuminance {
+            surface_illuminance(world, seed, ray.origin, ray.dir, batch, index, stats)
+        } else {
+            None
+        };
         let xyz = radiance_to_xyz(&l, &wl);
         if xyz.iter().all(|v| v.is_finite()) {
-            sums.add(xyz);
+            sums.add(xyz, e);
         } else {
             stats.non_finite += 1;
-            sums.add([0.0; 3]);
+            sums.add([0.0; 3], e);
         }
     }
+}
+
+/// The stream and index of sample `s` of pixel `pixel`: sample s / 16 of the pixel's batch
+/// s mod 16 ([`PIXEL_BATCHES`]), each batch its own scramble, so each batch is a prefix of its
+/// sequence however the samples are split into passes.
+#[inline]
+pub fn pixel_batch(pixel: u64, s: u64) -> (u64, u64) {
+    let k = PIXEL_BATCHES as u64;
+    (batch_stream(pixel, (s % k) as u32), s / k)
 }
 
 /// Stream id of the illuminance estimates (independent of the radiance samples).
@@ -85,7 +96,8 @@ const ILLUMINANCE_STREAM: u64 = 0x11_1c_e5_7a_u64 << 20;
 
 /// Illuminance (lx) on the surface a camera ray sees, or None if it sees no receiving surface
 /// (nothing, the sky, or an emitter). `seed` is the buffer's stream (the decision buffer of
-/// adaptive mode has its own), so each buffer's illuminance samples are independent.
+/// adaptive mode has its own), so each buffer's illuminance samples are independent; `pixel`
+/// and `sample` are the camera sample's batch stream and index in it ([`pixel_batch`]).
 fn surface_illuminance(
     world: &World,
     seed: u64,
@@ -194,12 +206,11 @@ fn pixel_converged(
     if y < floor {
         return (true, false);
     }
-    let z = 1.959_963_984_540_054;
-    let mut ok = z * d.y_standard_error() <= target.relative * y;
+    let mut ok = d.y_ci95_half_width() <= target.relative * y;
     if illuminance {
         if let Some(e) = d.mean_e() {
             if d.count_e >= MIN_DECISION_SAMPLES && e > 0.0 {
-                ok &= z * d.e_standard_error() <= target.relative * e;
+                ok &= d.e_ci95_half_width() <= target.relative * e;
             }
         }
     }

@@ -19,14 +19,18 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &str = "candela-render-state";
-/// Format version: 4 added the checksum; earlier versions are refused with a message.
-pub const VERSION: u32 = 4;
+/// Format version: 4 added the checksum, 8 the per-pixel batch sums (8 rather than 5 because no
+/// single flipped bit turns 8 into one of the unchecked versions 1–3, see
+/// [`RenderState::decode`]); other versions are refused with a message.
+pub const VERSION: u32 = 8;
 
 /// Bytes of the checksum at the end of the file.
 const CHECKSUM_BYTES: usize = 8;
-/// Encoded size of one [`PixelSums`]: 11 f64 of 8 bytes and 3 u64 varints of 1 to 10 bytes.
-const MIN_PIXEL_BYTES: u64 = 11 * 8 + 3;
-const MAX_PIXEL_BYTES: u64 = 11 * 8 + 3 * 10;
+/// Encoded size of one [`PixelSums`]: 11 f64 and 2 × 16 f64 of batch sums of 8 bytes, and 3
+/// u64 varints of 1 to 10 bytes.
+const PIXEL_FLOATS: u64 = 11 + 2 * crate::film::PIXEL_BATCHES as u64;
+const MIN_PIXEL_BYTES: u64 = PIXEL_FLOATS * 8 + 3;
+const MAX_PIXEL_BYTES: u64 = PIXEL_FLOATS * 8 + 3 * 10;
 /// Longest scene name (the path the state was rendered from) and longest merged-seed list a
 /// state may hold; the seed list is checked against itself when merging.
 pub const MAX_SCENE_NAME_BYTES: u64 = 64 << 10;
@@ -251,13 +255,16 @@ impl RenderState {
             ),
             // Versions before the checksum: their last bytes are no checksum, so the version
             // is read unchecked (a damaged current file cannot read as one of these: its
-            // version byte is 4, and no single flipped bit makes it 1, 2 or 3).
-            Some(h) if (1..VERSION).contains(&h.version) && !intact => anyhow::bail!(
+            // version byte is 8, and no single flipped bit makes it 1, 2 or 3).
+            Some(h) if (1..4).contains(&h.version) && !intact => anyhow::bail!(
                 "{name} is a candela render state of format version {}; this candela reads version {VERSION} only (which carries a checksum): finish or merge it with the candela that wrote it, or render again",
                 h.version
             ),
             Some(_) if !intact => anyhow::bail!(
                 "{name} is corrupt or truncated: its checksum does not match its contents (a changed, missing or added byte)"
+            ),
+            Some(h) if h.version == 4 => anyhow::bail!(
+                "{name} is a candela render state of format version 4, which has no per-pixel batch sums: this candela (format version {VERSION}) estimates pixel standard errors from them and cannot resume or merge it; finish or merge it with the candela that wrote it, or render again"
             ),
             Some(h) if h.version != VERSION => anyhow::bail!(
                 "{name} is a candela render state of format version {}; this candela reads version {VERSION} (read it with the candela that wrote it)",

@@ -348,13 +348,15 @@ fn float_field(p: &mut PixelSums, field: usize) -> &mut f64 {
         6..=8 => &mut p.splat_xyz[field - 6],
         9 => &mut p.splat_y2,
         10 => &mut p.splat_e,
-        _ => &mut p.splat_e2,
+        11 => &mut p.splat_e2,
+        12..=27 => &mut p.batch_y[field - 12],
+        _ => &mut p.batch_e[field - 28],
     }
 }
 
 fn craft() -> impl Strategy<Value = Craft> {
     prop_oneof![
-        4 => (0..2usize, any::<usize>(), 0..12usize, 0..HOSTILE_FLOATS.len())
+        4 => (0..2usize, any::<usize>(), 0..44usize, 0..HOSTILE_FLOATS.len())
             .prop_map(|(buffer, pixel, field, value)| Craft::Float { buffer, pixel, field, value }),
         2 => (0..2usize, any::<usize>(), 0..3usize, 0..4usize)
             .prop_map(|(buffer, pixel, field, value)| Craft::Count { buffer, pixel, field, value }),
@@ -445,7 +447,7 @@ fn apply_craft(s: &mut RenderState, c: &Craft) -> bool {
             8 if s.film.decision.is_none() => s.film.light_paths[1] = 1,
             8 => s.film.light_paths[1] = 0,
             9 => s.version = 3,
-            10 => s.version = 5,
+            10 => s.version = candela::state::VERSION + 1,
             11 => s.magic = "candela-render-statf".into(),
             12 => s.merged_seeds = vec![s.seed],
             13 => s.merged_seeds = vec![7, 7],

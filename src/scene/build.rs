@@ -74,9 +74,9 @@ pub const RENDER_BASE_BYTES: u64 = 150 << 20;
 const PASS_PIXEL_BYTES: u64 =
     8 + PIXEL_SUMS + std::mem::size_of::<Option<crate::film::PixelSums>>() as u64;
 
-/// A film buffer's pixel in a render state file (postcard: 9 f64 and 3 variable-length
-/// counts), with the slack of the growing encoding buffer.
-const STATE_PIXEL_BYTES: u64 = 90;
+/// A film buffer's pixel in a render state file (postcard: 43 f64, 32 of them batch sums, and
+/// 3 variable-length counts), with the slack of the growing encoding buffer.
+const STATE_PIXEL_BYTES: u64 = 350;
 
 /// Peak memory per pixel of a render as `candela render` runs it in `mode` (add
 /// [`RENDER_BASE_BYTES`] once). The larger of
