@@ -524,7 +524,8 @@ impl Film {
     /// `illuminance`), as read from a file: sizes that match, counts that a render produces
     /// (every pixel the same number of samples, or in adaptive mode as many in each buffer; as
     /// many light paths on every pixel as the buffer traced; at most [`MAX_SAMPLES`]), and sums
-    /// that are finite, ≥ 0, and agree with their sums of squares and counts. The message
+    /// that are finite, ≥ 0, and agree with their sums of squares and counts, batch sums
+    /// likewise, 0 in batches that hold no sample and adding up to their total. The message
     /// names the pixel, the buffer and what is wrong.
     pub fn check(&self, illuminance: bool) -> Result<(), String> {
         let n = self

@@ -1,4 +1,4 @@
-//! Render state files (`NAME.state`): per-pixel sums, sums of squares and sample counts (both
+//! Render state files (`NAME.state`): per-pixel sums, sums of squares, batch sums and sample counts (both
 //! buffers in adaptive mode), the scene's hash and the settings that determine the random
 //! sequence, so a render can be resumed exactly or merged with independent renders.
 //!

@@ -657,7 +657,7 @@ fn huge_claimed_sizes_are_refused_without_allocating() {
     seeds_2_60.pop();
     seeds_2_60.extend(varint(1 << 60));
     let cases = [
-        (pixels_2_28, "needs at least 24427626496 bytes"),
+        (pixels_2_28, "needs at least 93147103232 bytes"),
         (pixels_2_60, "claims 1152921504606846976 pixels"),
         (film_2_64, "more than the limit of 268435456"),
         (seeds_2_60, "claims 1152921504606846976 seeds"),
@@ -674,9 +674,9 @@ fn huge_claimed_sizes_are_refused_without_allocating() {
 
 #[test]
 fn a_fifo_or_an_oversized_file_is_refused_without_reading() {
-    // The limit is the state of the largest film (2²⁸ pixels, two buffers of up to 118 bytes
+    // The limit is the state of the largest film (2²⁸ pixels, two buffers of up to 374 bytes
     // each): one byte more, as a sparse file, is refused before a byte is read.
-    assert!((2 * (1u64 << 28) * 118..2 * (1 << 28) * 118 + (32 << 20))
+    assert!((2 * (1u64 << 28) * 374..2 * (1 << 28) * 374 + (32 << 20))
         .contains(&state::MAX_STATE_BYTES));
     let dir = tempfile::tempdir().unwrap();
     let big = dir.path().join("big.state");

@@ -186,7 +186,7 @@ fn integrating_sphere_interreflection() {
     let w = world(&format!(
         r#"(
         camera: (position: (0.2, 0.1, -0.3), look_at: (0, 0, 1), vfov_deg: 100, resolution: (8, 8)),
-        render: (spp: 128, max_depth: 64, illuminance: true),
+        render: (spp: 256, max_depth: 64, illuminance: true),
         materials: {{ "wall": Diffuse(reflectance: Constant({rho})) }},
         objects: [(shape: Sphere(center: (0, 0, 0), radius: {r}), material: "wall")],
         lights: [Point(position: (0, 0, 0), spectrum: Named("FL2"), amount: Flux({phi}))],
@@ -194,6 +194,8 @@ fn integrating_sphere_interreflection() {
         measure: (samples: 131072),
     )"#
     ));
+    // 256 samples: 16 per batch of the pixels' standard errors, which the interreflections'
+    // skewed samples need for near-normal batch means (docs/uncertainty.md, pixels).
     let film = render(&w, 2);
     let n = film.pixels.len() as f64;
     let (mut sum_e, mut var_e, mut sum_l, mut var_l) = (0.0, 0.0, 0.0, 0.0);
