@@ -161,11 +161,11 @@ impl PixelSums {
     /// [`Self::batches`] − 1 degrees of freedom times [`Self::y_standard_error`] (infinite
     /// below 2 batches).
     pub fn y_ci95_half_width(&self) -> f64 {
-        crate::meter::t95(self.batches().saturating_sub(1)) * self.y_standard_error()
+        crate::sampling::t95(self.batches().saturating_sub(1)) * self.y_standard_error()
     }
     /// Half-width (lx) of the 95 % interval of [`Self::mean_e`], as for luminance.
     pub fn e_ci95_half_width(&self) -> f64 {
-        crate::meter::t95(self.batches().saturating_sub(1)) * self.e_standard_error()
+        crate::sampling::t95(self.batches().saturating_sub(1)) * self.e_standard_error()
     }
     /// Add the splats of `paths` light paths (see [`crate::integrator::light_path`]): their
     /// Σ X, Σ Y, Σ Z, Σ Y², Σ E and Σ E² on this pixel.
@@ -691,7 +691,8 @@ mod tests {
             q.add([0.0, (i / 16) as f64, 0.0], None);
         }
         assert_eq!(q.y_standard_error(), 0.0);
-        assert!(q.y_standard_error_iid() > 0.5);
+        // The iid estimate sees the within-batch spread: s² = 80/63.
+        assert!((q.y_standard_error_iid() - (80.0f64 / 63.0 / 64.0).sqrt()).abs() < 1e-12);
     }
 
     #[test]

@@ -215,7 +215,7 @@ pub fn probe(
             } else {
                 d
             };
-            crate::meter::t95(nu.max(d))
+            crate::sampling::t95(nu.max(d))
         }
     };
     let lq = Quantity::Luminance;
