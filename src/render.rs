@@ -1,7 +1,7 @@
 //! Rendering an image: tiles in parallel (rayon), every sample regenerated from
 //! (seed, pixel, sample index), so the result does not depend on the number of threads.
 
-use crate::film::{radiance_to_xyz, Film, PixelSums, PIXEL_BATCHES};
+use crate::film::{radiance_to_xyz, Film, IlluminanceSums, PixelE, PixelSums, PIXEL_BATCHES};
 use crate::integrator::{trace, PathStart, RayStats};
 use crate::sampling::{batch_stream, Sampler};
 use crate::spectrum::SampledWavelengths;
@@ -29,7 +29,8 @@ impl RenderResult {
     }
 }
 
-/// Render one pixel's samples `first..first+count` of the random stream `seed` into `sums`.
+/// Render one pixel's samples `first..first+count` of the random stream `seed` into `sums`,
+/// and their illuminance into `e` (which the film has when the render estimates illuminance).
 #[allow(clippy::too_many_arguments)]
 pub fn render_pixel(
     world: &World,
@@ -39,6 +40,7 @@ pub fn render_pixel(
     first: u64,
     count: u64,
     sums: &mut PixelSums,
+    mut e: Option<&mut IlluminanceSums>,
     stats: &mut RayStats,
 ) {
     let cam = &world.camera;
@@ -67,17 +69,16 @@ pub fn render_pixel(
             &mut sampler,
             stats,
         );
-        let e = if world.settings.illuminance {
-            surface_illuminance(world, seed, ray.origin, ray.dir, batch, index, stats)
-        } else {
-            None
-        };
+        if let Some(e) = e.as_deref_mut() {
+            let v = surface_illuminance(world, seed, ray.origin, ray.dir, batch, index, stats);
+            e.add(sums.count, v);
+        }
         let xyz = radiance_to_xyz(&l, &wl);
         if xyz.iter().all(|v| v.is_finite()) {
-            sums.add(xyz, e);
+            sums.add(xyz);
         } else {
             stats.non_finite += 1;
-            sums.add([0.0; 3], e);
+            sums.add([0.0; 3]);
         }
     }
 }
@@ -195,9 +196,9 @@ pub enum StopReason {
 /// whether it counts toward the fraction (not below the floor).
 fn pixel_converged(
     d: &PixelSums,
+    e: Option<PixelE>,
     target: &TargetError,
     floor: f64,
-    illuminance: bool,
 ) -> (bool, bool) {
     if d.count < MIN_DECISION_SAMPLES {
         return (false, true);
@@ -207,10 +208,10 @@ fn pixel_converged(
         return (true, false);
     }
     let mut ok = d.y_ci95_half_width() <= target.relative * y;
-    if illuminance {
-        if let Some(e) = d.mean_e() {
-            if d.count_e >= MIN_DECISION_SAMPLES && e > 0.0 {
-                ok &= d.e_ci95_half_width() <= target.relative * e;
+    if let Some(pe) = e {
+        if let Some(mean) = pe.mean_e() {
+            if pe.e.count_e >= MIN_DECISION_SAMPLES && mean > 0.0 {
+                ok &= pe.e_ci95_half_width() <= target.relative * mean;
             }
         }
     }
@@ -219,7 +220,7 @@ fn pixel_converged(
 
 /// Per-pixel sample counts to add in the next pass (0 = pixel done), and the fraction of
 /// eligible pixels that meet the target.
-fn plan_pass(world: &World, film: &Film, prog: &Progressive) -> (Vec<u64>, Option<f64>) {
+fn plan_pass(film: &Film, prog: &Progressive) -> (Vec<u64>, Option<f64>) {
     let max = prog.max_spp as u64;
     let n = film.pixels.len();
     let mut plan = vec![0u64; n];
@@ -235,7 +236,11 @@ fn plan_pass(world: &World, film: &Film, prog: &Progressive) -> (Vec<u64>, Optio
         if let (Some(t), Some(d)) = (&prog.target, &film.decision) {
             // A pixel at max_spp that misses the target still counts against the fraction:
             // running out of samples is not reaching the target.
-            let (ok, counts) = pixel_converged(&d[i], t, floor, world.settings.illuminance);
+            let e = film.decision_e.as_ref().map(|e| PixelE {
+                sums: &d[i],
+                e: &e[i],
+            });
+            let (ok, counts) = pixel_converged(&d[i], e, t, floor);
             if counts {
                 eligible += 1;
                 converged += ok as u64;
@@ -284,6 +289,19 @@ pub fn render_progressive(
         film.width,
         film.height
     );
+    if world.settings.illuminance && film.total_samples() == 0 {
+        film.estimate_illuminance();
+    }
+    anyhow::ensure!(
+        film.e.is_some() == world.settings.illuminance,
+        "the film {} illuminance sums but the render {} illuminance",
+        if film.e.is_some() { "holds" } else { "lacks" },
+        if world.settings.illuminance {
+            "estimates"
+        } else {
+            "does not estimate"
+        }
+    );
     let tiles_x = w.div_ceil(TILE);
     let n_tiles = tiles_x * h.div_ceil(TILE);
     let start = Instant::now();
@@ -294,7 +312,7 @@ pub fn render_progressive(
         ..Default::default()
     };
     let reason = 'passes: loop {
-        let (plan, frac) = plan_pass(world, film, prog);
+        let (plan, frac) = plan_pass(film, prog);
         status.converged_fraction = frac;
         status.samples = (0..w * h).map(|i| film.samples_taken(i)).sum();
         if let (Some(t), Some(f)) = (&prog.target, frac) {
@@ -327,6 +345,8 @@ pub fn render_progressive(
                             let i = y * w + x;
                             let mut est = film_ref.pixels[i];
                             let mut dec = film_ref.decision.as_ref().map(|d| d[i]);
+                            let mut est_e = film_ref.e.as_ref().map(|e| e[i]);
+                            let mut dec_e = film_ref.decision_e.as_ref().map(|e| e[i]);
                             let seed = world.settings.seed;
                             match dec.as_mut() {
                                 // Independent streams: the image's samples continue its own
@@ -342,6 +362,7 @@ pub fn render_progressive(
                                         first,
                                         half,
                                         &mut est,
+                                        est_e.as_mut(),
                                         &mut r.stats,
                                     );
                                     let first = d.count;
@@ -353,6 +374,7 @@ pub fn render_progressive(
                                         first,
                                         half,
                                         d,
+                                        dec_e.as_mut(),
                                         &mut r.stats,
                                     );
                                 }
@@ -366,11 +388,15 @@ pub fn render_progressive(
                                         first,
                                         plan[i],
                                         &mut est,
+                                        est_e.as_mut(),
                                         &mut r.stats,
                                     );
                                 }
                             }
-                            r.pixels.push((i, est, dec));
+                            r.pixels.push((i, est));
+                            r.decision.extend(dec);
+                            r.e.extend(est_e);
+                            r.decision_e.extend(dec_e);
                         }
                     }
                     Some(r)
@@ -414,22 +440,34 @@ pub fn render_progressive(
         }
         for r in results.into_iter().flatten() {
             stats.merge(&r.stats);
-            for (i, est, dec) in r.pixels {
+            for (k, (i, est)) in r.pixels.into_iter().enumerate() {
                 film.pixels[i] = est;
-                if let (Some(d), Some(v)) = (film.decision.as_mut(), dec) {
-                    d[i] = v;
+                if let Some(d) = film.decision.as_mut() {
+                    d[i] = r.decision[k];
+                }
+                if let Some(e) = film.e.as_mut() {
+                    e[i] = r.e[k];
+                }
+                if let Some(e) = film.decision_e.as_mut() {
+                    e[i] = r.decision_e[k];
                 }
             }
         }
         for (b, sums, paths) in light {
             film.light_paths[b] += paths;
-            let buf = if b == 0 {
-                &mut film.pixels
+            let (buf, e) = if b == 0 {
+                (&mut film.pixels, &mut film.e)
             } else {
-                film.decision.as_mut().expect("adaptive film")
+                let d = film.decision.as_mut().expect("adaptive film");
+                (d, &mut film.decision_e)
             };
             for (p, s) in buf.iter_mut().zip(&sums) {
-                p.add_light_paths(s, paths);
+                p.add_light_paths(&[s[0], s[1], s[2], s[3]], paths);
+            }
+            if let Some(e) = e.as_mut() {
+                for (p, s) in e.iter_mut().zip(&sums) {
+                    p.add_light_paths(s[4], s[5]);
+                }
             }
         }
         debug_assert_eq!(adaptive, film.decision.is_some());
@@ -458,7 +496,13 @@ pub fn render_progressive(
 
 #[derive(Default)]
 struct TileResult {
-    pixels: Vec<(usize, PixelSums, Option<PixelSums>)>,
+    /// The pixels' indices and image sums; their decision buffer's and illuminance sums (image,
+    /// decision), when the film has them, in the same order: apart, so that a render without
+    /// them carries none.
+    pixels: Vec<(usize, PixelSums)>,
+    decision: Vec<PixelSums>,
+    e: Vec<IlluminanceSums>,
+    decision_e: Vec<IlluminanceSums>,
     stats: RayStats,
 }
 

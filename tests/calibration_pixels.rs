@@ -274,9 +274,9 @@ fn study(cases: Vec<Case>, seeds: u64, mode: Mode) -> Vec<String> {
                     })
                     .collect::<Vec<_>>(),
             );
+            assert!(film.e.is_some(), "the film has illuminance sums");
             es.push(
-                film.pixels
-                    .iter()
+                film.pixels_e()
                     .map(|p| {
                         assert_eq!(
                             p.e_coverage(),

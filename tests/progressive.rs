@@ -267,9 +267,9 @@ fn adaptive_buffers_have_independent_illuminance_samples() {
         ..Default::default()
     };
     run(&w, &mut film, &prog, None);
-    let d = film.decision.as_ref().unwrap();
+    let (e, d) = (film.e.as_ref().unwrap(), film.decision_e.as_ref().unwrap());
     let (mut both, mut differ) = (0, 0);
-    for (a, b) in film.pixels.iter().zip(d) {
+    for (a, b) in e.iter().zip(d) {
         assert_eq!(a.count_e, b.count_e);
         if a.count_e > 0 {
             both += 1;
