@@ -283,6 +283,11 @@ fn memory_guard_covers_caustics_and_checkpoints() {
         ("cornell-glass", 2048, plain, false, true, 2_797_668),
         ("cornell-glass", 2048, plain, true, true, 4_900_532),
         ("cornell-glass", 2048, adaptive_fc, true, true, 9_205_472),
+        ("cornell-glass", 2048, adaptive, false, true, 5_229_996),
+        ("bench-cornell", 2048, plain, false, true, 2_929_684),
+        ("cornell-box", 1024, plain, false, false, 660_116),
+        ("cornell-glass", 1024, plain, false, true, 662_772),
+        ("cornell-box", 1024, adaptive, false, false, 1_349_844),
     ];
     for (scene, side, mode, illuminance, caustics, kb) in measured {
         let px = side as u64 * side as u64;
