@@ -10,6 +10,9 @@ use crate::photometry::K_M;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, DENSE_LEN, LAMBDA_MIN, N_LAMBDA};
 use std::sync::LazyLock;
 
+mod illuminance;
+pub use illuminance::{IlluminanceSums, PixelE};
+
 /// The CIE 1931 2° colour-matching functions as f32 tables for the hot path (from the colour
 /// library's 1 nm data).
 pub struct FilmCmfs {
@@ -63,19 +66,52 @@ pub fn radiance_to_xyz(l: &SampledSpectrum, wl: &SampledWavelengths) -> [f64; 3]
     [xyz[0] * k, xyz[1] * k, xyz[2] * k]
 }
 
-/// Running sums for one pixel.
+/// Independent batches of a pixel's camera samples: sample i belongs to batch i mod
+/// `PIXEL_BATCHES`, where it is sample i / `PIXEL_BATCHES` of the batch's own scrambled Sobol
+/// sequence (see [`crate::render::render_pixel`]); as for meters ([`crate::meter::BATCHES`]).
+pub const PIXEL_BATCHES: usize = 16;
+
+/// EXR attribute giving the number of independent sample batches per pixel behind `stderr.Y`
+/// and `stderr.E`: a pixel with n samples has min(n, batches) of them, and its 95 % interval
+/// uses Student's t with one degree of freedom fewer.
+pub const STDERR_BATCHES_ATTRIBUTE: &str = "stderr_batches";
+
+/// Samples of batch `b` among the first `n` samples of a pixel (sample i in batch i mod 16).
+#[inline]
+pub fn batch_count(n: u64, b: usize) -> u64 {
+    n / PIXEL_BATCHES as u64 + ((b as u64) < n % PIXEL_BATCHES as u64) as u64
+}
+
+/// Standard error of Σ Sᵦ / n from the sums Sᵦ of the independent batches of `n` samples
+/// (batch sizes by [`batch_count`]): the ratio estimator's
+/// √(K/(K−1) · Σᵦ (Sᵦ − x̄ nᵦ)²) / n over the K = min(n, 16) non-empty batches, which is the
+/// spread of the batch means over √K when the batches are equal. 0 below 2 batches.
+pub fn batch_standard_error(sums: &[f64; PIXEL_BATCHES], n: u64) -> f64 {
+    let k = n.min(PIXEL_BATCHES as u64) as usize;
+    if k < 2 {
+        return 0.0;
+    }
+    let nf = n as f64;
+    let mean = sums.iter().sum::<f64>() / nf;
+    let ss: f64 = (0..k)
+        .map(|b| (sums[b] - mean * batch_count(n, b) as f64).powi(2))
+        .sum();
+    (ss * k as f64 / (k - 1) as f64).sqrt() / nf
+}
+
+/// Running sums for one pixel (its illuminance, when estimated, is kept apart in
+/// [`IlluminanceSums`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PixelSums {
     /// Σ of the samples' absolute XYZ (Y in cd/m²).
     pub sum_xyz: [f64; 3],
-    /// Σ Y² ((cd/m²)²), for the sample variance of luminance.
+    /// Σ Y² ((cd/m²)²): the samples' variance, for consistency checks and the iid error
+    /// ([`Self::y_standard_error_iid`]).
     pub sum_y2: f64,
     pub count: u64,
-    /// Σ E (lx) over the samples whose camera ray found a receiving surface.
-    pub sum_e: f64,
-    /// Σ E² (lx²) over the same samples.
-    pub sum_e2: f64,
-    pub count_e: u64,
+    /// Σ Y (cd/m²) of each batch's samples ([`PIXEL_BATCHES`], sample i in batch i mod 16):
+    /// the standard error comes from their spread.
+    pub batch_y: [f64; PIXEL_BATCHES],
     /// Σ of the caustic light paths' splats on this pixel (XYZ, Y²) and the number of light
     /// paths traced for the buffer (see [`crate::integrator::light_path`]): they add
     /// `splat_xyz / light_paths` to the camera samples' mean.
@@ -86,81 +122,53 @@ pub struct PixelSums {
     pub splat_y2: f64,
     #[serde(default)]
     pub light_paths: u64,
-    /// Σ and Σ² of the light paths' illuminance splats (lx) on the surface this pixel sees.
-    #[serde(default)]
-    pub splat_e: f64,
-    #[serde(default)]
-    pub splat_e2: f64,
 }
 
 impl PixelSums {
+    /// Record the next camera sample's absolute XYZ (index `count`, of batch `count` mod 16;
+    /// its illuminance goes to [`IlluminanceSums::add`] first).
     #[inline]
     pub fn add(&mut self, xyz: [f64; 3]) {
+        let b = (self.count % PIXEL_BATCHES as u64) as usize;
         self.sum_xyz[0] += xyz[0];
         self.sum_xyz[1] += xyz[1];
         self.sum_xyz[2] += xyz[2];
         self.sum_y2 += xyz[1] * xyz[1];
+        self.batch_y[b] += xyz[1];
         self.count += 1;
     }
+    /// Independent batches behind the camera samples' standard errors (min(samples, 16)); the
+    /// 95 % intervals use Student's t with one degree of freedom fewer
+    /// ([`Self::y_ci95_half_width`]).
+    pub fn batches(&self) -> u32 {
+        self.count.min(PIXEL_BATCHES as u64) as u32
+    }
+    /// Half-width (cd/m²) of the 95 % interval of the mean luminance: t₀.₉₇₅ with
+    /// [`Self::batches`] − 1 degrees of freedom times [`Self::y_standard_error`] (infinite
+    /// below 2 batches).
+    pub fn y_ci95_half_width(&self) -> f64 {
+        crate::sampling::t95(self.batches().saturating_sub(1)) * self.y_standard_error()
+    }
     /// Add the splats of `paths` light paths (see [`crate::integrator::light_path`]): their
-    /// Σ X, Σ Y, Σ Z, Σ Y², Σ E and Σ E² on this pixel.
+    /// Σ X, Σ Y, Σ Z and Σ Y² on this pixel (Σ E and Σ E² go to
+    /// [`IlluminanceSums::add_light_paths`]).
     #[inline]
-    pub fn add_light_paths(&mut self, sums: &[f64; 6], paths: u64) {
+    pub fn add_light_paths(&mut self, sums: &[f64; 4], paths: u64) {
         for (s, v) in self.splat_xyz.iter_mut().zip(sums) {
             *s += v;
         }
         self.splat_y2 += sums[3];
-        self.splat_e += sums[4];
-        self.splat_e2 += sums[5];
         self.light_paths += paths;
     }
-    /// Whether light paths added illuminance to this pixel.
-    fn has_e_splats(&self) -> bool {
-        self.light_paths > 0 && (self.splat_e != 0.0 || self.splat_e2 != 0.0)
-    }
-    /// Record one illuminance sample (lx) of the surface seen by a camera sample.
-    #[inline]
-    pub fn add_illuminance(&mut self, e: f64) {
-        self.sum_e += e;
-        self.sum_e2 += e * e;
-        self.count_e += 1;
-    }
-    /// Mean illuminance over the samples that saw a receiving surface.
-    ///
-    /// With light-traced caustics, the light paths' splats estimate the pixel's mean of E over
-    /// *all* its footprint (0 where no receiver is seen), so they are added to the camera
-    /// samples' mean over all samples and the sum divided by the coverage.
-    pub fn mean_e(&self) -> Option<f64> {
-        if self.count_e == 0 {
-            return None;
-        }
-        if !self.has_e_splats() {
-            return Some(self.sum_e / self.count_e as f64);
-        }
-        let all = self.sum_e / self.count as f64 + self.splat_e / self.light_paths as f64;
-        Some(all / self.e_coverage())
-    }
-    /// Standard error of [`Self::mean_e`] (the coverage taken as exact).
-    pub fn e_standard_error(&self) -> f64 {
-        if !self.has_e_splats() || self.count_e == 0 {
-            return standard_error(self.sum_e, self.sum_e2, self.count_e);
-        }
-        let cam = standard_error(self.sum_e, self.sum_e2, self.count);
-        let light = standard_error(self.splat_e, self.splat_e2, self.light_paths);
-        (cam * cam + light * light).sqrt() / self.e_coverage()
-    }
-    /// Fraction of the pixel's samples whose illuminance is defined.
-    pub fn e_coverage(&self) -> f64 {
-        if self.count == 0 {
-            0.0
-        } else {
-            self.count_e as f64 / self.count as f64
-        }
-    }
+    /// Add the sums of an independent render of this pixel (another seed). Its batch b joins
+    /// batch (b + count) mod 16, as if its samples continued this pixel's numbering, so the
+    /// batch sizes keep the i mod 16 rule; every batch stream still feeds a single batch, so
+    /// the batches stay independent.
     pub fn merge(&mut self, o: &PixelSums) {
-        self.sum_e += o.sum_e;
-        self.sum_e2 += o.sum_e2;
-        self.count_e += o.count_e;
+        let r = (self.count % PIXEL_BATCHES as u64) as usize;
+        for b in 0..PIXEL_BATCHES {
+            self.batch_y[(b + r) % PIXEL_BATCHES] += o.batch_y[b];
+        }
         for k in 0..3 {
             self.sum_xyz[k] += o.sum_xyz[k];
         }
@@ -170,8 +178,6 @@ impl PixelSums {
             self.splat_xyz[k] += o.splat_xyz[k];
         }
         self.splat_y2 += o.splat_y2;
-        self.splat_e += o.splat_e;
-        self.splat_e2 += o.splat_e2;
         self.light_paths += o.light_paths;
     }
     /// Mean absolute XYZ: the camera samples' mean plus, with light tracing, the light paths'.
@@ -189,9 +195,18 @@ impl PixelSums {
         );
         [c[0] + l[0], c[1] + l[1], c[2] + l[2]]
     }
-    /// Standard error of the mean luminance, √(s²/n) with the unbiased sample variance s², of
-    /// the camera samples and the light paths (independent) combined.
+    /// Standard error (cd/m²) of the mean luminance: that of the camera samples from the spread
+    /// of their batches ([`batch_standard_error`]) and, with light-traced caustics, that of the
+    /// light paths from their sample variance, added in quadrature (independent estimates).
     pub fn y_standard_error(&self) -> f64 {
+        let cam = batch_standard_error(&self.batch_y, self.count);
+        let light = standard_error(self.splat_xyz[1], self.splat_y2, self.light_paths);
+        (cam * cam + light * light).sqrt()
+    }
+    /// The standard error of the mean luminance that treats the camera samples as independent,
+    /// √(s²/n) with the sample variance: an over-estimate for stratified samples, kept for
+    /// comparison.
+    pub fn y_standard_error_iid(&self) -> f64 {
         let cam = standard_error(self.sum_xyz[1], self.sum_y2, self.count);
         let light = standard_error(self.splat_xyz[1], self.splat_y2, self.light_paths);
         (cam * cam + light * light).sqrt()
@@ -234,45 +249,68 @@ fn sums_agree(sum: f64, sum2: f64, n: u64) -> bool {
     sum2.sqrt() <= sum * rel + abs && sum <= (nf * sum2).sqrt() * rel + abs
 }
 
+/// Whether the batch sums `batches` of Σ `what` over `count` samples (sample i in batch
+/// i mod 16) are finite, ≥ 0, 0 in the batches that hold no sample, and add up to `total`.
+fn check_batches(
+    what: &str,
+    batches: &[f64; PIXEL_BATCHES],
+    total: f64,
+    count: u64,
+) -> Result<(), String> {
+    let nonempty = count.min(PIXEL_BATCHES as u64) as usize;
+    for (b, &v) in batches.iter().enumerate() {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(format!(
+                "batch {b} of Σ {what} is {v:e}, but sums of luminance and illuminance are finite and ≥ 0"
+            ));
+        }
+        if b >= nonempty && v != 0.0 {
+            return Err(format!(
+                "batch {b} of Σ {what} is {v:e}, but with {count} samples that batch holds none"
+            ));
+        }
+    }
+    // The same samples summed in another order: equal but for rounding.
+    let rel = 1.0 + 1e-9_f64.max(4.0 * count as f64 * f64::EPSILON);
+    let abs = count as f64 * 1e-150;
+    let sum: f64 = batches.iter().sum();
+    if sum > total * rel + abs || total > sum * rel + abs {
+        return Err(format!(
+            "its batches of Σ {what} add up to {sum:e}, but Σ {what} is {total:e}"
+        ));
+    }
+    Ok(())
+}
+
 impl PixelSums {
-    /// Whether these sums can come from a render whose buffer traced `light_paths` light paths
-    /// (with per-pixel illuminance if `illuminance`); the message names the field at fault.
-    fn check(&self, light_paths: u64, illuminance: bool) -> Result<(), String> {
+    /// Whether these sums can come from a render whose buffer traced `light_paths` light
+    /// paths; the message names the field at fault.
+    fn check(&self, light_paths: u64) -> Result<(), String> {
         let fields = [
             ("Σ X", self.sum_xyz[0]),
             ("Σ Y", self.sum_xyz[1]),
             ("Σ Z", self.sum_xyz[2]),
             ("Σ Y²", self.sum_y2),
-            ("Σ E", self.sum_e),
-            ("Σ E²", self.sum_e2),
             ("light-path Σ X", self.splat_xyz[0]),
             ("light-path Σ Y", self.splat_xyz[1]),
             ("light-path Σ Z", self.splat_xyz[2]),
             ("light-path Σ Y²", self.splat_y2),
-            ("light-path Σ E", self.splat_e),
-            ("light-path Σ E²", self.splat_e2),
         ];
         for (name, v) in fields {
-            // XYZ of spectra ≥ 0 under the (non-negative) CIE 1931 functions, illuminance and
-            // squares are all ≥ 0.
+            // XYZ of spectra ≥ 0 under the (non-negative) CIE 1931 functions and squares are
+            // all ≥ 0.
             if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("{name} is {v:e}, but sums of XYZ, illuminance and their squares are finite and ≥ 0"));
+                return Err(format!(
+                    "{name} is {v:e}, but sums of XYZ and their squares are finite and ≥ 0"
+                ));
             }
         }
+        check_batches("Y", &self.batch_y, self.sum_xyz[1], self.count)?;
         if self.light_paths != light_paths {
             return Err(format!(
                 "it counts {} light paths, but the film traced {light_paths} for this buffer",
                 self.light_paths
             ));
-        }
-        if self.count_e > self.count {
-            return Err(format!(
-                "{} illuminance samples but only {} samples",
-                self.count_e, self.count
-            ));
-        }
-        if !illuminance && (self.count_e > 0 || self.sum_e > 0.0 || self.splat_e > 0.0) {
-            return Err("it holds illuminance, but the render did not estimate illuminance".into());
         }
         let ratio = *XYZ_OVER_Y;
         let tol = 1.0 + 1e-5;
@@ -304,23 +342,9 @@ impl PixelSums {
                 "samples",
             ),
             (
-                "Σ E and Σ E²",
-                self.sum_e,
-                self.sum_e2,
-                self.count_e,
-                "illuminance samples",
-            ),
-            (
                 "light-path Σ Y and Σ Y²",
                 self.splat_xyz[1],
                 self.splat_y2,
-                self.light_paths,
-                "light paths",
-            ),
-            (
-                "light-path Σ E and Σ E²",
-                self.splat_e,
-                self.splat_e2,
                 self.light_paths,
                 "light paths",
             ),
@@ -362,6 +386,12 @@ pub struct Film {
     /// indices of their streams).
     #[serde(default)]
     pub light_paths: [u64; 2],
+    /// Illuminance sums of `pixels` and of `decision`, present only when the render estimates
+    /// illuminance (see [`Self::estimate_illuminance`]).
+    #[serde(default)]
+    pub e: Option<Vec<IlluminanceSums>>,
+    #[serde(default)]
+    pub decision_e: Option<Vec<IlluminanceSums>>,
 }
 
 impl Film {
@@ -372,7 +402,35 @@ impl Film {
             pixels: vec![PixelSums::default(); width * height],
             decision: None,
             light_paths: [0; 2],
+            e: None,
+            decision_e: None,
         }
+    }
+    /// Allocate the illuminance sums of every buffer that lacks them (zero: for a film that
+    /// holds no samples yet).
+    pub fn estimate_illuminance(&mut self) {
+        let n = self.pixels.len();
+        self.e
+            .get_or_insert_with(|| vec![IlluminanceSums::default(); n]);
+        if self.decision.is_some() {
+            self.decision_e
+                .get_or_insert_with(|| vec![IlluminanceSums::default(); n]);
+        }
+    }
+    /// Pixel `i` of the image with its illuminance sums, if the film has them.
+    pub fn pixel_e(&self, i: usize) -> Option<PixelE<'_>> {
+        let e = self.e.as_ref()?;
+        Some(PixelE {
+            sums: &self.pixels[i],
+            e: &e[i],
+        })
+    }
+    /// The image's pixels with their illuminance sums (none if the film has none).
+    pub fn pixels_e(&self) -> impl Iterator<Item = PixelE<'_>> {
+        self.pixels
+            .iter()
+            .zip(self.e.iter().flatten())
+            .map(|(sums, e)| PixelE { sums, e })
     }
     pub fn new_adaptive(width: usize, height: usize) -> Self {
         Self {
@@ -389,6 +447,18 @@ impl Film {
     pub fn merge(&mut self, o: &Film) {
         self.light_paths[0] += o.light_paths[0];
         self.light_paths[1] += o.light_paths[1];
+        // Illuminance first: its batches continue the pixel's numbering before the merge.
+        let decision = self.decision.as_deref().unwrap_or(&[]);
+        for (e, oe, pixels) in [
+            (&mut self.e, &o.e, &self.pixels[..]),
+            (&mut self.decision_e, &o.decision_e, decision),
+        ] {
+            if let (Some(a), Some(b)) = (e.as_mut(), oe.as_ref()) {
+                for ((x, y), p) in a.iter_mut().zip(b).zip(pixels) {
+                    x.merge(y, p.count);
+                }
+            }
+        }
         for (a, b) in self.pixels.iter_mut().zip(&o.pixels) {
             a.merge(b);
         }
@@ -402,7 +472,8 @@ impl Film {
     /// `illuminance`), as read from a file: sizes that match, counts that a render produces
     /// (every pixel the same number of samples, or in adaptive mode as many in each buffer; as
     /// many light paths on every pixel as the buffer traced; at most [`MAX_SAMPLES`]), and sums
-    /// that are finite, ≥ 0, and agree with their sums of squares and counts. The message
+    /// that are finite, ≥ 0, and agree with their sums of squares and counts, batch sums
+    /// likewise, 0 in batches that hold no sample and adding up to their total. The message
     /// names the pixel, the buffer and what is wrong.
     pub fn check(&self, illuminance: bool) -> Result<(), String> {
         let n = self
@@ -415,11 +486,28 @@ impl Film {
                     self.width, self.height
                 )
             })?;
+        if self.e.is_some() != illuminance
+            || self.decision_e.is_some() != (illuminance && self.decision.is_some())
+        {
+            return Err(if illuminance {
+                "it lacks illuminance sums, but the render estimated illuminance".into()
+            } else {
+                "it holds illuminance sums, but the render did not estimate illuminance".into()
+            });
+        }
         let lengths = [
             Some(self.pixels.len()),
             self.decision.as_ref().map(Vec::len),
+            self.e.as_ref().map(Vec::len),
+            self.decision_e.as_ref().map(Vec::len),
         ];
-        for (buffer, len) in ["image", "decision"].iter().zip(lengths) {
+        let names = [
+            "image",
+            "decision",
+            "image illuminance",
+            "decision illuminance",
+        ];
+        for (buffer, len) in names.iter().zip(lengths) {
             if len.is_some_and(|len| len != n) {
                 return Err(format!(
                     "its {buffer} buffer has {} pixels, but the film is {}×{}",
@@ -464,17 +552,19 @@ impl Film {
                 });
             }
         }
-        let buffers = std::iter::once(("image", &self.pixels, self.light_paths[0])).chain(
+        let buffers = std::iter::once(("image", &self.pixels, &self.e, self.light_paths[0])).chain(
             self.decision
                 .iter()
-                .map(|d| ("decision", d, self.light_paths[1])),
+                .map(|d| ("decision", d, &self.decision_e, self.light_paths[1])),
         );
-        for (buffer, pixels, light_paths) in buffers {
+        for (buffer, pixels, e, light_paths) in buffers {
             for (i, p) in pixels.iter().enumerate() {
-                p.check(light_paths, illuminance).map_err(|e| {
-                    let (x, y) = at(i);
-                    format!("pixel ({x}, {y}) of the {buffer} buffer: {e}")
-                })?;
+                p.check(light_paths)
+                    .and_then(|()| e.as_ref().map_or(Ok(()), |e| e[i].check(p)))
+                    .map_err(|e| {
+                        let (x, y) = at(i);
+                        format!("pixel ({x}, {y}) of the {buffer} buffer: {e}")
+                    })?;
             }
         }
         Ok(())
@@ -496,21 +586,21 @@ impl Film {
             .collect()
     }
     /// Illuminance channels: (E with the sentinel where undefined, its standard error, coverage).
+    /// (All undefined if the film has no illuminance sums.)
     pub fn illuminance_images(&self) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
-        let e = self
-            .pixels
-            .iter()
-            .map(|p| {
-                p.mean_e()
-                    .map_or(crate::output::ILLUMINANCE_SENTINEL, |v| v as f32)
-            })
-            .collect();
-        let se = self
-            .pixels
-            .iter()
-            .map(|p| p.e_standard_error() as f32)
-            .collect();
-        let cov = self.pixels.iter().map(|p| p.e_coverage() as f32).collect();
+        let n = self.pixels.len();
+        let (mut e, mut se, mut cov) = (
+            vec![crate::output::ILLUMINANCE_SENTINEL; n],
+            vec![0.0; n],
+            vec![0.0; n],
+        );
+        for (i, p) in self.pixels_e().enumerate() {
+            if let Some(v) = p.mean_e() {
+                e[i] = v as f32;
+            }
+            se[i] = p.e_standard_error() as f32;
+            cov[i] = p.e_coverage() as f32;
+        }
         (e, se, cov)
     }
     pub fn total_samples(&self) -> u64 {
@@ -534,12 +624,113 @@ mod tests {
 
     #[test]
     fn standard_error_of_known_samples() {
+        // Four samples, one per batch: the batch estimate equals the iid one. s² = 5/3,
+        // se = √(5/12).
         let mut p = PixelSums::default();
         for y in [1.0, 2.0, 3.0, 4.0] {
             p.add([0.0, y, 0.0]);
         }
-        // s² = 5/3, se = sqrt(5/12)
         assert!((p.y_standard_error() - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
+        assert!((p.y_standard_error_iid() - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
         assert_eq!(p.mean_xyz()[1], 2.5);
+        assert_eq!(p.batches(), 4);
+    }
+
+    #[test]
+    fn the_standard_error_is_the_spread_of_the_batch_means() {
+        // 64 samples, sample i in batch i mod 16 with value b = i mod 16 (+ i/16 · 0, so
+        // nothing varies within a batch): batch means 0 … 15, sd √(340/15), se = sd/4.
+        let (mut p, mut e) = (PixelSums::default(), IlluminanceSums::default());
+        for i in 0..64u64 {
+            e.add(p.count, Some(2.0 * (i % 16) as f64));
+            p.add([0.0, (i % 16) as f64, 0.0]);
+        }
+        let pe = PixelE { sums: &p, e: &e };
+        let se = (340.0f64 / 15.0).sqrt() / 4.0;
+        assert!(
+            (p.y_standard_error() - se).abs() < 1e-12,
+            "{}",
+            p.y_standard_error()
+        );
+        assert!((pe.e_standard_error() - 2.0 * se).abs() < 1e-12);
+        assert!((pe.e_ci95_half_width() - 2.131_449_545_6 * 2.0 * se).abs() < 1e-9);
+        assert!((p.y_ci95_half_width() - 2.131_449_545_6 * se).abs() < 1e-9);
+        // Variation only within batches, equal batch means: no spread at all.
+        let mut q = PixelSums::default();
+        for i in 0..64u64 {
+            q.add([0.0, (i / 16) as f64, 0.0]);
+        }
+        assert_eq!(q.y_standard_error(), 0.0);
+        // The iid estimate sees the within-batch spread: s² = 80/63.
+        assert!((q.y_standard_error_iid() - (80.0f64 / 63.0 / 64.0).sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn unequal_batches_are_weighted() {
+        // 20 samples of 1: batches 0–3 hold 2, the others 1; every sample equal, no error.
+        let mut p = PixelSums::default();
+        for _ in 0..20 {
+            p.add([0.0, 1.0, 0.0]);
+        }
+        assert_eq!(p.y_standard_error(), 0.0);
+        assert_eq!((batch_count(20, 3), batch_count(20, 4)), (2, 1));
+    }
+
+    #[test]
+    fn merging_continues_the_batch_numbering() {
+        // 5 + 7 samples merged hold the batches of 12 samples numbered in a row.
+        let (mut a, mut b, mut all) = Default::default();
+        let v = |i: u64| [0.0, (i * i % 7) as f64, 0.0];
+        for i in 0..5 {
+            PixelSums::add(&mut a, v(i));
+            PixelSums::add(&mut all, v(i));
+        }
+        for i in 5..12 {
+            PixelSums::add(&mut b, v(i));
+            PixelSums::add(&mut all, v(i));
+        }
+        a.merge(&b);
+        assert_eq!(a.batch_y, all.batch_y);
+        assert_eq!(a.count, 12);
+        assert!(a.check(0).is_ok());
+    }
+
+    #[test]
+    fn check_names_inconsistent_batches() {
+        let (mut p, mut pe) = (PixelSums::default(), IlluminanceSums::default());
+        for i in 0..20 {
+            pe.add(p.count, Some(1.0));
+            p.add([0.0, i as f64, 0.0]);
+        }
+        assert!(p.check(0).is_ok() && pe.check(&p).is_ok());
+        let mut q = p;
+        q.batch_y[3] += 1.0;
+        let e = q.check(0).unwrap_err();
+        assert!(e.contains("batches of Σ Y add up to"), "{e}");
+        let mut qe = pe;
+        qe.batch_e[2] = -1.0;
+        qe.batch_e[5] += 1.0;
+        let e = qe.check(&p).unwrap_err();
+        assert!(e.contains("batch 2 of Σ E"), "{e}");
+        // Illuminance of more samples than the pixel holds.
+        let mut r = p;
+        r.count = 10;
+        r.batch_y = [0.0; PIXEL_BATCHES];
+        let e = pe.check(&r).unwrap_err();
+        assert!(
+            e.contains("holds none") || e.contains("only 10 samples"),
+            "{e}"
+        );
+        let mut q = PixelSums::default();
+        for _ in 0..3 {
+            q.add([0.0, 1.0, 0.0]);
+        }
+        q.batch_y[9] = 1.0;
+        q.batch_y[0] = 0.0;
+        let e = q.check(0).unwrap_err();
+        assert!(
+            e.contains("batch 9 of Σ Y") && e.contains("holds none"),
+            "{e}"
+        );
     }
 }

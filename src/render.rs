@@ -1,9 +1,9 @@
 //! Rendering an image: tiles in parallel (rayon), every sample regenerated from
 //! (seed, pixel, sample index), so the result does not depend on the number of threads.
 
-use crate::film::{radiance_to_xyz, Film, PixelSums};
+use crate::film::{radiance_to_xyz, Film, IlluminanceSums, PixelE, PixelSums, PIXEL_BATCHES};
 use crate::integrator::{trace, PathStart, RayStats};
-use crate::sampling::Sampler;
+use crate::sampling::{batch_stream, Sampler};
 use crate::spectrum::SampledWavelengths;
 use crate::world::World;
 use rayon::prelude::*;
@@ -29,7 +29,8 @@ impl RenderResult {
     }
 }
 
-/// Render one pixel's samples `first..first+count` of the random stream `seed` into `sums`.
+/// Render one pixel's samples `first..first+count` of the random stream `seed` into `sums`,
+/// and their illuminance into `e` (which the film has when the render estimates illuminance).
 #[allow(clippy::too_many_arguments)]
 pub fn render_pixel(
     world: &World,
@@ -39,12 +40,16 @@ pub fn render_pixel(
     first: u64,
     count: u64,
     sums: &mut PixelSums,
+    mut e: Option<&mut IlluminanceSums>,
     stats: &mut RayStats,
 ) {
     let cam = &world.camera;
     let pixel = (y * cam.width + x) as u64;
     for s in first..first + count {
-        let mut sampler = Sampler::new(seed, pixel, s);
+        // Sample s is sample s / 16 of batch s mod 16, whose independently scrambled sequence
+        // makes the batch means independent (the pixel's standard error is their spread).
+        let (batch, index) = pixel_batch(pixel, s);
+        let mut sampler = Sampler::new(seed, batch, index);
         // Dimensions 0–1: position in the pixel (the best-stratified Sobol pair), 2–3: lens,
         // 4: wavelengths; paths continue from dimension 8.
         let [fx, fy, lx, ly] = sampler.get4();
@@ -68,11 +73,9 @@ pub fn render_pixel(
             &mut sampler,
             stats,
         );
-        if world.settings.illuminance {
-            if let Some(e) = surface_illuminance(world, seed, ray.origin, ray.dir, pixel, s, stats)
-            {
-                sums.add_illuminance(e);
-            }
+        if let Some(e) = e.as_deref_mut() {
+            let v = surface_illuminance(world, seed, ray.origin, ray.dir, batch, index, stats);
+            e.add(sums.count, v);
         }
         let xyz = radiance_to_xyz(&l, &wl);
         if xyz.iter().all(|v| v.is_finite()) {
@@ -84,12 +87,22 @@ pub fn render_pixel(
     }
 }
 
+/// The stream and index of sample `s` of pixel `pixel`: sample s / 16 of the pixel's batch
+/// s mod 16 ([`PIXEL_BATCHES`]), each batch its own scramble, so each batch is a prefix of its
+/// sequence however the samples are split into passes.
+#[inline]
+pub fn pixel_batch(pixel: u64, s: u64) -> (u64, u64) {
+    let k = PIXEL_BATCHES as u64;
+    (batch_stream(pixel, (s % k) as u32), s / k)
+}
+
 /// Stream id of the illuminance estimates (independent of the radiance samples).
 const ILLUMINANCE_STREAM: u64 = 0x11_1c_e5_7a_u64 << 20;
 
 /// Illuminance (lx) on the surface a camera ray sees, or None if it sees no receiving surface
 /// (nothing, the sky, or an emitter). `seed` is the buffer's stream (the decision buffer of
-/// adaptive mode has its own), so each buffer's illuminance samples are independent.
+/// adaptive mode has its own), so each buffer's illuminance samples are independent; `pixel`
+/// and `sample` are the camera sample's batch stream and index in it ([`pixel_batch`]).
 fn surface_illuminance(
     world: &World,
     seed: u64,
@@ -187,9 +200,9 @@ pub enum StopReason {
 /// whether it counts toward the fraction (not below the floor).
 fn pixel_converged(
     d: &PixelSums,
+    e: Option<PixelE>,
     target: &TargetError,
     floor: f64,
-    illuminance: bool,
 ) -> (bool, bool) {
     if d.count < MIN_DECISION_SAMPLES {
         return (false, true);
@@ -198,12 +211,11 @@ fn pixel_converged(
     if y < floor {
         return (true, false);
     }
-    let z = 1.959_963_984_540_054;
-    let mut ok = z * d.y_standard_error() <= target.relative * y;
-    if illuminance {
-        if let Some(e) = d.mean_e() {
-            if d.count_e >= MIN_DECISION_SAMPLES && e > 0.0 {
-                ok &= z * d.e_standard_error() <= target.relative * e;
+    let mut ok = d.y_ci95_half_width() <= target.relative * y;
+    if let Some(pe) = e {
+        if let Some(mean) = pe.mean_e() {
+            if pe.e.count_e >= MIN_DECISION_SAMPLES && mean > 0.0 {
+                ok &= pe.e_ci95_half_width() <= target.relative * mean;
             }
         }
     }
@@ -212,7 +224,7 @@ fn pixel_converged(
 
 /// Per-pixel sample counts to add in the next pass (0 = pixel done), and the fraction of
 /// eligible pixels that meet the target.
-fn plan_pass(world: &World, film: &Film, prog: &Progressive) -> (Vec<u64>, Option<f64>) {
+fn plan_pass(film: &Film, prog: &Progressive) -> (Vec<u64>, Option<f64>) {
     let max = prog.max_spp as u64;
     let n = film.pixels.len();
     let mut plan = vec![0u64; n];
@@ -231,7 +243,11 @@ fn plan_pass(world: &World, film: &Film, prog: &Progressive) -> (Vec<u64>, Optio
         if let (Some(t), Some(d)) = (&prog.target, &film.decision) {
             // A pixel at max_spp that misses the target still counts against the fraction:
             // running out of samples is not reaching the target.
-            let (ok, counts) = pixel_converged(&d[i], t, floor, world.settings.illuminance);
+            let e = film.decision_e.as_ref().map(|e| PixelE {
+                sums: &d[i],
+                e: &e[i],
+            });
+            let (ok, counts) = pixel_converged(&d[i], e, t, floor);
             if counts {
                 eligible += 1;
                 converged += ok as u64;
@@ -280,6 +296,19 @@ pub fn render_progressive(
         film.width,
         film.height
     );
+    if world.settings.illuminance && film.total_samples() == 0 {
+        film.estimate_illuminance();
+    }
+    anyhow::ensure!(
+        film.e.is_some() == world.settings.illuminance,
+        "the film {} illuminance sums but the render {} illuminance",
+        if film.e.is_some() { "holds" } else { "lacks" },
+        if world.settings.illuminance {
+            "estimates"
+        } else {
+            "does not estimate"
+        }
+    );
     let tiles_x = w.div_ceil(TILE);
     let n_tiles = tiles_x * h.div_ceil(TILE);
     let start = Instant::now();
@@ -290,7 +319,7 @@ pub fn render_progressive(
         ..Default::default()
     };
     let reason = 'passes: loop {
-        let (plan, frac) = plan_pass(world, film, prog);
+        let (plan, frac) = plan_pass(film, prog);
         status.converged_fraction = frac;
         status.samples = (0..w * h).map(|i| film.samples_taken(i)).sum();
         if let (Some(t), Some(f)) = (&prog.target, frac) {
@@ -323,6 +352,8 @@ pub fn render_progressive(
                             let i = y * w + x;
                             let mut est = film_ref.pixels[i];
                             let mut dec = film_ref.decision.as_ref().map(|d| d[i]);
+                            let mut est_e = film_ref.e.as_ref().map(|e| e[i]);
+                            let mut dec_e = film_ref.decision_e.as_ref().map(|e| e[i]);
                             let seed = world.settings.seed;
                             match dec.as_mut() {
                                 // Independent streams: the image's samples continue its own
@@ -338,6 +369,7 @@ pub fn render_progressive(
                                         first,
                                         half,
                                         &mut est,
+                                        est_e.as_mut(),
                                         &mut r.stats,
                                     );
                                     let first = d.count;
@@ -349,6 +381,7 @@ pub fn render_progressive(
                                         first,
                                         half,
                                         d,
+                                        dec_e.as_mut(),
                                         &mut r.stats,
                                     );
                                 }
@@ -362,11 +395,15 @@ pub fn render_progressive(
                                         first,
                                         plan[i],
                                         &mut est,
+                                        est_e.as_mut(),
                                         &mut r.stats,
                                     );
                                 }
                             }
-                            r.pixels.push((i, est, dec));
+                            r.pixels.push((i, est));
+                            r.decision.extend(dec);
+                            r.e.extend(est_e);
+                            r.decision_e.extend(dec_e);
                         }
                     }
                     Some(r)
@@ -410,22 +447,34 @@ pub fn render_progressive(
         }
         for r in results.into_iter().flatten() {
             stats.merge(&r.stats);
-            for (i, est, dec) in r.pixels {
+            for (k, (i, est)) in r.pixels.into_iter().enumerate() {
                 film.pixels[i] = est;
-                if let (Some(d), Some(v)) = (film.decision.as_mut(), dec) {
-                    d[i] = v;
+                if let Some(d) = film.decision.as_mut() {
+                    d[i] = r.decision[k];
+                }
+                if let Some(e) = film.e.as_mut() {
+                    e[i] = r.e[k];
+                }
+                if let Some(e) = film.decision_e.as_mut() {
+                    e[i] = r.decision_e[k];
                 }
             }
         }
         for (b, sums, paths) in light {
             film.light_paths[b] += paths;
-            let buf = if b == 0 {
-                &mut film.pixels
+            let (buf, e) = if b == 0 {
+                (&mut film.pixels, &mut film.e)
             } else {
-                film.decision.as_mut().expect("adaptive film")
+                let d = film.decision.as_mut().expect("adaptive film");
+                (d, &mut film.decision_e)
             };
             for (p, s) in buf.iter_mut().zip(&sums) {
-                p.add_light_paths(s, paths);
+                p.add_light_paths(&[s[0], s[1], s[2], s[3]], paths);
+            }
+            if let Some(e) = e.as_mut() {
+                for (p, s) in e.iter_mut().zip(&sums) {
+                    p.add_light_paths(s[4], s[5]);
+                }
             }
         }
         debug_assert_eq!(adaptive, film.decision.is_some());
@@ -454,7 +503,13 @@ pub fn render_progressive(
 
 #[derive(Default)]
 struct TileResult {
-    pixels: Vec<(usize, PixelSums, Option<PixelSums>)>,
+    /// The pixels' indices and image sums; their decision buffer's and illuminance sums (image,
+    /// decision), when the film has them, in the same order: apart, so that a render without
+    /// them carries none.
+    pixels: Vec<(usize, PixelSums)>,
+    decision: Vec<PixelSums>,
+    e: Vec<IlluminanceSums>,
+    decision_e: Vec<IlluminanceSums>,
     stats: RayStats,
 }
 

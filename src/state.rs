@@ -1,5 +1,5 @@
-//! Render state files (`NAME.state`): per-pixel sums, sums of squares and sample counts (both
-//! buffers in adaptive mode), the scene's hash and the settings that determine the random
+//! Render state files (`NAME.state`): per-pixel sums, sums of squares, batch sums and sample
+//! counts (both buffers in adaptive mode; illuminance sums when the render estimates it), the scene's hash and the settings that determine the random
 //! sequence, so a render can be resumed exactly or merged with independent renders.
 //!
 //! A file is the little-endian [postcard](https://docs.rs/postcard) encoding of [`RenderState`]
@@ -10,7 +10,7 @@
 //! list) against the limits, the bytes present and the memory available, before anything is
 //! allocated for them; then the values ([`Film::check`]).
 
-use crate::film::{Film, PixelSums};
+use crate::film::{Film, IlluminanceSums, PixelSums};
 use crate::output::write_atomic;
 use crate::sampling::mix64;
 use crate::scene::build::MAX_PIXELS;
@@ -19,14 +19,22 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &str = "candela-render-state";
-/// Format version: 4 added the checksum; earlier versions are refused with a message.
-pub const VERSION: u32 = 4;
+/// Format version: 4 added the checksum, 12 the per-pixel batch sums with the illuminance sums
+/// in buffers of their own (12 because no single flipped bit turns it into one of the
+/// unchecked versions 1–3, see [`RenderState::decode`]); other versions are refused with a
+/// message.
+pub const VERSION: u32 = 12;
 
 /// Bytes of the checksum at the end of the file.
 const CHECKSUM_BYTES: usize = 8;
-/// Encoded size of one [`PixelSums`]: 11 f64 of 8 bytes and 3 u64 varints of 1 to 10 bytes.
-const MIN_PIXEL_BYTES: u64 = 11 * 8 + 3;
-const MAX_PIXEL_BYTES: u64 = 11 * 8 + 3 * 10;
+/// Encoded size of one [`PixelSums`]: 8 f64 and 16 f64 of batch sums of 8 bytes, and 2 u64
+/// varints of 1 to 10 bytes; of one [`IlluminanceSums`]: 4 f64, 16 batch sums and 1 varint.
+const PIXEL_FLOATS: u64 = 8 + crate::film::PIXEL_BATCHES as u64;
+const E_FLOATS: u64 = 4 + crate::film::PIXEL_BATCHES as u64;
+const MIN_PIXEL_BYTES: u64 = PIXEL_FLOATS * 8 + 2;
+const MIN_E_BYTES: u64 = E_FLOATS * 8 + 1;
+/// Most bytes of a pixel of one buffer with its illuminance sums.
+const MAX_PIXEL_BYTES: u64 = (PIXEL_FLOATS + E_FLOATS) * 8 + 3 * 10;
 /// Longest scene name (the path the state was rendered from) and longest merged-seed list a
 /// state may hold; the seed list is checked against itself when merging.
 pub const MAX_SCENE_NAME_BYTES: u64 = 64 << 10;
@@ -53,6 +61,32 @@ pub struct RenderState {
     /// The other seeds a merged state contains (`candela merge`; empty for one render), so a
     /// later merge can refuse a seed that is already in it.
     pub merged_seeds: Vec<u64>,
+}
+
+/// The fields of a [`RenderState`] with everything borrowed: what is written, so that saving a
+/// render's film needs no copy of it.
+#[derive(Serialize)]
+struct StateRef<'a> {
+    magic: &'a str,
+    version: u32,
+    scene_hash: u64,
+    scene: &'a str,
+    seed: u64,
+    max_depth: u32,
+    illuminance: bool,
+    film: &'a Film,
+    merged_seeds: &'a [u64],
+}
+
+impl StateRef<'_> {
+    /// Writes the state with its checksum, atomically.
+    fn save(&self, path: &Path) -> anyhow::Result<()> {
+        let mut bytes = postcard::to_stdvec(self)?;
+        let sum = checksum(&bytes);
+        bytes.extend_from_slice(&sum.to_le_bytes());
+        write_atomic(path, |w| w.write_all(&bytes))?;
+        Ok(())
+    }
 }
 
 /// [`RenderState::max_depth`] of a render without a depth limit (finite limits are at most
@@ -126,23 +160,29 @@ fn take<'a, T: Deserialize<'a>>(bytes: &mut &'a [u8], what: &str) -> Result<T, S
     Ok(v)
 }
 
-/// Reads a buffer of `n` pixels after checking the length the file gives it against `n`, the
-/// bytes left and the memory available, so a false length allocates nothing.
-fn take_pixels(bytes: &mut &[u8], n: u64, buffer: &str) -> Result<Vec<PixelSums>, String> {
+/// Reads a buffer of `n` pixels of at least `min_bytes` each after checking the length the file
+/// gives it against `n`, the bytes left and the memory available, so a false length allocates
+/// nothing.
+fn take_pixels<T: serde::de::DeserializeOwned>(
+    bytes: &mut &[u8],
+    n: u64,
+    min_bytes: u64,
+    buffer: &str,
+) -> Result<Vec<T>, String> {
     let len: u64 = take(bytes, &format!("the length of the {buffer} buffer"))?;
     if len != n {
         return Err(format!(
             "its {buffer} buffer claims {len} pixels, but its film has {n}"
         ));
     }
-    if (bytes.len() as u64) < n * MIN_PIXEL_BYTES {
+    if (bytes.len() as u64) < n * min_bytes {
         return Err(format!(
             "its {buffer} buffer of {n} pixels needs at least {} bytes, but only {} remain (truncated?)",
-            n * MIN_PIXEL_BYTES,
+            n * min_bytes,
             bytes.len()
         ));
     }
-    let size = n * std::mem::size_of::<PixelSums>() as u64;
+    let size = n * std::mem::size_of::<T>() as u64;
     crate::limits::check_memory(size, &format!("the {buffer} buffer of {n} pixels"))?;
     let mut pixels = Vec::with_capacity(n as usize);
     for i in 0..n {
@@ -211,11 +251,40 @@ impl RenderState {
 
     /// Writes the state with its checksum, atomically.
     pub fn save(&self, path: &Path) -> anyhow::Result<()> {
-        let mut bytes = postcard::to_stdvec(self)?;
-        let sum = checksum(&bytes);
-        bytes.extend_from_slice(&sum.to_le_bytes());
-        write_atomic(path, |w| w.write_all(&bytes))?;
-        Ok(())
+        StateRef {
+            magic: &self.magic,
+            version: self.version,
+            scene_hash: self.scene_hash,
+            scene: &self.scene,
+            seed: self.seed,
+            max_depth: self.max_depth,
+            illuminance: self.illuminance,
+            film: &self.film,
+            merged_seeds: &self.merged_seeds,
+        }
+        .save(path)
+    }
+
+    /// Writes the state [`Self::new`] would make of `film`, without copying the film.
+    pub fn save_film(
+        scene: &Path,
+        scene_hash: u64,
+        world: &World,
+        film: &Film,
+        path: &Path,
+    ) -> anyhow::Result<()> {
+        StateRef {
+            magic: MAGIC,
+            version: VERSION,
+            scene_hash,
+            scene: &scene.display().to_string(),
+            seed: world.settings.seed,
+            max_depth: depth_code(world.settings.max_depth),
+            illuminance: world.settings.illuminance,
+            film,
+            merged_seeds: &[],
+        }
+        .save(path)
     }
 
     /// Reads and checks a state file (see the module's description); errors name the file and
@@ -251,13 +320,16 @@ impl RenderState {
             ),
             // Versions before the checksum: their last bytes are no checksum, so the version
             // is read unchecked (a damaged current file cannot read as one of these: its
-            // version byte is 4, and no single flipped bit makes it 1, 2 or 3).
-            Some(h) if (1..VERSION).contains(&h.version) && !intact => anyhow::bail!(
+            // version byte is 8, and no single flipped bit makes it 1, 2 or 3).
+            Some(h) if (1..4).contains(&h.version) && !intact => anyhow::bail!(
                 "{name} is a candela render state of format version {}; this candela reads version {VERSION} only (which carries a checksum): finish or merge it with the candela that wrote it, or render again",
                 h.version
             ),
             Some(_) if !intact => anyhow::bail!(
                 "{name} is corrupt or truncated: its checksum does not match its contents (a changed, missing or added byte)"
+            ),
+            Some(h) if h.version == 4 => anyhow::bail!(
+                "{name} is a candela render state of format version 4, which has no per-pixel batch sums: this candela (format version {VERSION}) estimates pixel standard errors from them and cannot resume or merge it; finish or merge it with the candela that wrote it, or render again"
             ),
             Some(h) if h.version != VERSION => anyhow::bail!(
                 "{name} is a candela render state of format version {}; this candela reads version {VERSION} (read it with the candela that wrote it)",
@@ -293,13 +365,30 @@ impl RenderState {
             ));
         }
         let n = n as u64;
-        let pixels = take_pixels(&mut bytes, n, "image")?;
+        let pixels = take_pixels::<PixelSums>(&mut bytes, n, MIN_PIXEL_BYTES, "image")?;
         let decision = match take::<u8>(&mut bytes, "whether it has a decision buffer")? {
             0 => None,
-            1 => Some(take_pixels(&mut bytes, n, "decision")?),
+            1 => Some(take_pixels(&mut bytes, n, MIN_PIXEL_BYTES, "decision")?),
             t => return Err(format!("its decision-buffer tag is {t}, not 0 or 1")),
         };
         let light_paths: [u64; 2] = take(&mut bytes, "its light-path counts")?;
+        // Illuminance sums, for the image and the decision buffer: present exactly when the
+        // render estimated illuminance (checked with the film).
+        let mut e_buffers = [None, None];
+        for (e, buffer) in e_buffers.iter_mut().zip(["image", "decision"]) {
+            let what = format!("whether it has {buffer} illuminance sums");
+            *e = match take::<u8>(&mut bytes, &what)? {
+                0 => None,
+                1 => Some(take_pixels::<IlluminanceSums>(
+                    &mut bytes,
+                    n,
+                    MIN_E_BYTES,
+                    &format!("{buffer} illuminance"),
+                )?),
+                t => return Err(format!("its {buffer} illuminance tag is {t}, not 0 or 1")),
+            };
+        }
+        let [e, decision_e] = e_buffers;
         let seeds: u64 = take(&mut bytes, "the length of its merged-seed list")?;
         if seeds > MAX_MERGED_SEEDS || seeds > bytes.len() as u64 {
             return Err(format!(
@@ -324,6 +413,8 @@ impl RenderState {
             pixels,
             decision,
             light_paths,
+            e,
+            decision_e,
         };
         film.check(p.illuminance)?;
         Ok(Self {

@@ -201,18 +201,18 @@ fn illuminance_channel_includes_the_light_traced_caustic() {
     let w = world_with(&text, Caustics::LightTracing);
     assert!(w.settings.illuminance && w.caustics.is_some());
     let film = render(&w, 2);
-    let illuminance = |p: &candela::film::PixelSums| {
+    let illuminance = |p: candela::film::PixelE| {
         (
             p.mean_e().expect("every pixel sees the floor"),
             p.e_standard_error(),
         )
     };
-    check_pixels(&film, "E", illuminance, |x, y| {
+    check_pixels_e(&film, "E", illuminance, |x, y| {
         expected(&w, x, y, true) * PI / RHO
     });
     // The luminance and the illuminance see the same light.
-    for p in &film.pixels {
-        let ((l, sl), (e, se)) = (luminance(p), illuminance(p));
+    for p in film.pixels_e() {
+        let ((l, sl), (e, se)) = (luminance(&p), illuminance(p));
         assert!(
             (l - RHO / PI * e).abs() <= 5.0 * (sl + RHO / PI * se),
             "L = {l}, ρE/π = {}",
@@ -230,7 +230,7 @@ fn illuminance_on_a_black_floor_includes_the_light_traced_caustic() {
         .replace(r#"material: "floor")"#, r#"material: "black")"#);
     let w = world_with(&text, Caustics::LightTracing);
     let film = render(&w, 2);
-    check_pixels(
+    check_pixels_e(
         &film,
         "E on black",
         |p| {

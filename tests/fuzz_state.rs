@@ -14,7 +14,7 @@
 
 mod fuzz_common;
 
-use candela::film::PixelSums;
+use candela::film::{IlluminanceSums, PixelSums};
 use candela::job::{self, RenderJob, Silent};
 use candela::render::TargetError;
 use candela::state::{self, RenderState};
@@ -140,12 +140,14 @@ fn fixture() -> &'static Fixture {
         let s = decode(&f.plain).unwrap();
         assert!(s.film.pixels.iter().all(|p| p.count == 4));
         assert!(s.film.pixels.iter().any(|p| p.sum_xyz[1] > 0.0));
-        assert!(s.film.pixels.iter().any(|p| p.count_e > 0 && p.sum_e > 0.0));
+        let e = s.film.e.as_ref().expect("illuminance sums");
+        assert!(e.iter().any(|p| p.count_e > 0 && p.sum_e > 0.0));
         assert!(s
             .film
             .pixels
             .iter()
-            .any(|p| p.splat_xyz[1] > 0.0 && p.splat_e > 0.0));
+            .zip(e)
+            .any(|(p, e)| p.splat_xyz[1] > 0.0 && e.splat_e > 0.0));
         assert!(decode(&f.adaptive).unwrap().film.decision.is_some());
         f
     })
@@ -339,28 +341,37 @@ const HOSTILE_FLOATS: &[f64] = &[
     f64::MIN,
 ];
 
-fn float_field(p: &mut PixelSums, field: usize) -> &mut f64 {
-    match field {
-        0..=2 => &mut p.sum_xyz[field],
-        3 => &mut p.sum_y2,
-        4 => &mut p.sum_e,
-        5 => &mut p.sum_e2,
-        6..=8 => &mut p.splat_xyz[field - 6],
-        9 => &mut p.splat_y2,
-        10 => &mut p.splat_e,
-        _ => &mut p.splat_e2,
+/// Float `field` of a pixel: 0–23 of its [`PixelSums`], 24–43 of its [`IlluminanceSums`].
+fn float_field(s: &mut RenderState, buffer: usize, pixel: usize, field: usize) -> Option<&mut f64> {
+    if field < 24 {
+        let p = &mut buffer_mut(s, buffer)?[pixel];
+        return Some(match field {
+            0..=2 => &mut p.sum_xyz[field],
+            3 => &mut p.sum_y2,
+            4..=6 => &mut p.splat_xyz[field - 4],
+            7 => &mut p.splat_y2,
+            _ => &mut p.batch_y[field - 8],
+        });
     }
+    let p = &mut e_buffer_mut(s, buffer)?[pixel];
+    Some(match field {
+        24 => &mut p.sum_e,
+        25 => &mut p.sum_e2,
+        26 => &mut p.splat_e,
+        27 => &mut p.splat_e2,
+        _ => &mut p.batch_e[field - 28],
+    })
 }
 
 fn craft() -> impl Strategy<Value = Craft> {
     prop_oneof![
-        4 => (0..2usize, any::<usize>(), 0..12usize, 0..HOSTILE_FLOATS.len())
+        4 => (0..2usize, any::<usize>(), 0..44usize, 0..HOSTILE_FLOATS.len())
             .prop_map(|(buffer, pixel, field, value)| Craft::Float { buffer, pixel, field, value }),
         2 => (0..2usize, any::<usize>(), 0..3usize, 0..4usize)
             .prop_map(|(buffer, pixel, field, value)| Craft::Count { buffer, pixel, field, value }),
         2 => (0..2usize, any::<usize>(), 0..6usize)
             .prop_map(|(buffer, pixel, kind)| Craft::Inconsistent { buffer, pixel, kind }),
-        2 => (0..16usize).prop_map(|kind| Craft::Film { kind }),
+        2 => (0..FILM_CRAFTS).prop_map(|kind| Craft::Film { kind }),
     ]
 }
 
@@ -371,6 +382,17 @@ fn buffer_mut(s: &mut RenderState, b: usize) -> Option<&mut Vec<PixelSums>> {
         s.film.decision.as_mut()
     }
 }
+
+fn e_buffer_mut(s: &mut RenderState, b: usize) -> Option<&mut Vec<IlluminanceSums>> {
+    if b == 0 {
+        s.film.e.as_mut()
+    } else {
+        s.film.decision_e.as_mut()
+    }
+}
+
+/// Kinds of [`Craft::Film`].
+const FILM_CRAFTS: usize = 19;
 
 /// Applies `c` to `s` with a value no render writes there; false if it does not apply (a
 /// decision buffer of a plain state, a ratio of a black pixel).
@@ -383,10 +405,10 @@ fn apply_craft(s: &mut RenderState, c: &Craft) -> bool {
             field,
             value,
         } => {
-            let Some(buf) = buffer_mut(s, buffer) else {
+            let Some(v) = float_field(s, buffer, pixel % n, field) else {
                 return false;
             };
-            *float_field(&mut buf[pixel % n], field) = HOSTILE_FLOATS[value];
+            *v = HOSTILE_FLOATS[value];
         }
         Craft::Count {
             buffer,
@@ -394,20 +416,30 @@ fn apply_craft(s: &mut RenderState, c: &Craft) -> bool {
             field,
             value,
         } => {
+            let huge = [u64::MAX, 1 << 62];
+            if field == 1 {
+                // More illuminance samples than samples.
+                let count = buffer_mut(s, buffer).map_or(0, |b| b[pixel % n].count);
+                let Some(e) = e_buffer_mut(s, buffer) else {
+                    return false;
+                };
+                let e = &mut e[pixel % n];
+                match value {
+                    0 => e.count_e = count + 1,
+                    1 => e.count_e = count + 100,
+                    v => e.count_e = huge[v - 2],
+                }
+                return true;
+            }
             let Some(buf) = buffer_mut(s, buffer) else {
                 return false;
             };
             let p = &mut buf[pixel % n];
-            let huge = [u64::MAX, 1 << 62];
             match (field, value) {
                 // One pixel's samples differ from the others' (or its decision buffer's).
                 (0, 0) => p.count += 1,
                 (0, 1) => p.count = p.count.wrapping_sub(1),
                 (0, v) => p.count = huge[v - 2],
-                // More illuminance samples than samples.
-                (1, 0) => p.count_e = p.count + 1,
-                (1, 1) => p.count_e = p.count + 100,
-                (1, v) => p.count_e = huge[v - 2],
                 // Other light paths than the film traced.
                 (_, 0) => p.light_paths += 1,
                 (_, 1) => p.light_paths = p.light_paths.wrapping_sub(1),
@@ -419,6 +451,15 @@ fn apply_craft(s: &mut RenderState, c: &Craft) -> bool {
             pixel,
             kind,
         } => {
+            if let (2 | 3, Some(e)) = (kind, e_buffer_mut(s, buffer)) {
+                let p = &mut e[pixel % n];
+                match kind {
+                    2 if p.sum_e > 0.0 => p.sum_e2 = 0.0,
+                    3 if p.sum_e2 > 0.0 => p.sum_e2 *= 1e6,
+                    _ => return false,
+                }
+                return true;
+            }
             let Some(buf) = buffer_mut(s, buffer) else {
                 return false;
             };
@@ -426,8 +467,6 @@ fn apply_craft(s: &mut RenderState, c: &Craft) -> bool {
             match kind {
                 0 if p.sum_xyz[1] > 0.0 => p.sum_y2 = 0.0,
                 1 if p.sum_y2 > 0.0 => p.sum_y2 *= 1e6,
-                2 if p.sum_e > 0.0 => p.sum_e2 = 0.0,
-                3 if p.sum_e2 > 0.0 => p.sum_e2 *= 1e6,
                 4 if p.sum_xyz[1] > 0.0 => p.sum_xyz[0] = 100.0 * p.sum_xyz[1],
                 5 if p.sum_xyz[1] > 0.0 => p.sum_xyz[2] = 200.0 * p.sum_xyz[1],
                 _ => return false,
@@ -445,11 +484,16 @@ fn apply_craft(s: &mut RenderState, c: &Craft) -> bool {
             8 if s.film.decision.is_none() => s.film.light_paths[1] = 1,
             8 => s.film.light_paths[1] = 0,
             9 => s.version = 3,
-            10 => s.version = 5,
+            10 => s.version = candela::state::VERSION + 1,
             11 => s.magic = "candela-render-statf".into(),
             12 => s.merged_seeds = vec![s.seed],
             13 => s.merged_seeds = vec![7, 7],
             14 => s.illuminance = false,
+            // Illuminance sums missing, or one pixel short.
+            15 => s.film.e = None,
+            16 if s.film.decision_e.is_some() => s.film.decision_e = None,
+            16 => s.film.decision_e = s.film.e.clone(),
+            17 => drop(s.film.e.as_mut().map(Vec::pop)),
             _ => s.film.pixels[n - 1].count += 2,
         },
     }
@@ -494,7 +538,7 @@ proptest! {
 #[test]
 fn every_crafted_film_change_is_refused() {
     for adaptive in [false, true] {
-        for kind in 0..16 {
+        for kind in 0..FILM_CRAFTS {
             check_crafted(adaptive, &Craft::Film { kind });
         }
     }
@@ -655,7 +699,7 @@ fn huge_claimed_sizes_are_refused_without_allocating() {
     seeds_2_60.pop();
     seeds_2_60.extend(varint(1 << 60));
     let cases = [
-        (pixels_2_28, "needs at least 24427626496 bytes"),
+        (pixels_2_28, "needs at least 52076478464 bytes"),
         (pixels_2_60, "claims 1152921504606846976 pixels"),
         (film_2_64, "more than the limit of 268435456"),
         (seeds_2_60, "claims 1152921504606846976 seeds"),
@@ -672,9 +716,10 @@ fn huge_claimed_sizes_are_refused_without_allocating() {
 
 #[test]
 fn a_fifo_or_an_oversized_file_is_refused_without_reading() {
-    // The limit is the state of the largest film (2²⁸ pixels, two buffers of up to 118 bytes
-    // each): one byte more, as a sparse file, is refused before a byte is read.
-    assert!((2 * (1u64 << 28) * 118..2 * (1 << 28) * 118 + (32 << 20))
+    // The limit is the state of the largest film (2²⁸ pixels, two buffers of up to 382 bytes
+    // each: sums and illuminance sums): one byte more, as a sparse file, is refused before a
+    // byte is read.
+    assert!((2 * (1u64 << 28) * 382..2 * (1 << 28) * 382 + (32 << 20))
         .contains(&state::MAX_STATE_BYTES));
     let dir = tempfile::tempdir().unwrap();
     let big = dir.path().join("big.state");

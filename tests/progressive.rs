@@ -219,6 +219,29 @@ fn state_of_an_older_format_version_is_refused_by_name() {
 }
 
 #[test]
+fn state_without_batch_sums_is_refused_by_name() {
+    // Version 4 (intact, with its checksum) has no per-pixel batch sums to estimate the pixels'
+    // standard errors from.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("v4.state");
+    let mut st = candela::state::RenderState::new(
+        std::path::Path::new("s.ron"),
+        7,
+        &world(FURNACE),
+        Film::new(2, 2),
+    );
+    st.version = 4;
+    st.save(&path).unwrap();
+    let e = candela::state::RenderState::load(&path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("v4.state") && e.contains("format version 4") && e.contains("batch sums"),
+        "{e}"
+    );
+}
+
+#[test]
 fn adaptive_buffers_have_independent_illuminance_samples() {
     // The decision buffer decides when a pixel stops; if its illuminance samples repeated the
     // image's, the stopping time would depend on the image's own estimate (biased). A floor
@@ -244,9 +267,9 @@ fn adaptive_buffers_have_independent_illuminance_samples() {
         ..Default::default()
     };
     run(&w, &mut film, &prog, None);
-    let d = film.decision.as_ref().unwrap();
+    let (e, d) = (film.e.as_ref().unwrap(), film.decision_e.as_ref().unwrap());
     let (mut both, mut differ) = (0, 0);
-    for (a, b) in film.pixels.iter().zip(d) {
+    for (a, b) in e.iter().zip(d) {
         assert_eq!(a.count_e, b.count_e);
         if a.count_e > 0 {
             both += 1;

@@ -19,10 +19,12 @@ fn mean_and_se(values: &[f64]) -> (f64, f64) {
 }
 
 fn check(spectrum: &str, luminance: f64) {
+    // 256 samples (16 per batch of independently scrambled wavelengths): a narrow band needs
+    // them for the 1 % standard error asked below.
     let w = world(&format!(
         r#"(
         camera: (position: (0, 0, 0), look_at: (0, 0, 1), vfov_deg: 20, resolution: (16, 16)),
-        render: (spp: 64),
+        render: (spp: 256),
         objects: [(
             shape: Quad(origin: (-5, -5, 1), edge_u: (0, 10, 0), edge_v: (10, 0, 0)),
             material: "black",

@@ -186,10 +186,12 @@ fn lambertian_disc_source_on_axis() {
 }
 
 fn furnace(rho: f64, max_depth: u32) -> candela::film::Film {
+    // 256 samples: 16 per batch of the pixels' standard errors, which the interreflections'
+    // skewed samples need for near-normal batch means (docs/uncertainty.md, pixels).
     let w = world(&format!(
         r#"(
         camera: (position: (0.1, -0.2, 0.05), look_at: (0, 0, 1), vfov_deg: 120, resolution: (12, 12)),
-        render: (spp: 128, max_depth: {max_depth}),
+        render: (spp: 256, max_depth: {max_depth}),
         materials: {{ "wall": Diffuse(reflectance: Constant({rho})) }},
         objects: [(
             shape: Sphere(center: (0, 0, 0), radius: 1),

@@ -269,7 +269,7 @@ fn caustics_and_direct_light_seen_through_a_pane() {
     // the pane's top. Only the metal's image of the lamp lights it from above (through the
     // pane once); the lamp itself and its image in the pane are below. None of the light on
     // the floor behind the pane may leak into it through the light-traced connections.
-    check_pixels(
+    check_pixels_e(
         &film,
         "illuminance on the pane",
         |p| (p.mean_e().unwrap(), p.e_standard_error()),

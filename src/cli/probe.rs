@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::anyhow;
 use candela::photometry::Quantity;
-use candela::report::probe::{probe_file, Estimate, IlluminanceProbe, ProbeResult, Z95};
+use candela::report::probe::{probe_file, Estimate, IlluminanceProbe, ProbeResult};
 use candela::report::units::{format_sig, UnitSystem};
 use serde_json::json;
 
@@ -71,7 +71,7 @@ fn estimate_text(e: &Estimate, unit: &str) -> String {
         (Some(se), Some((lo, hi))) => format!(
             "{} ± {} {unit}   (95 % CI {} … {}; standard error {})",
             format_sig(e.mean, 5),
-            format_sig(Z95 * se, 3),
+            format_sig(e.t95 * se, 3),
             format_sig(lo, 5),
             format_sig(hi, 5),
             format_sig(se, 3)

@@ -264,7 +264,11 @@ pub fn film_layers(scene: &str, film: &Film, illuminance: bool) -> Layers {
         ("scene".to_string(), scene.to_string()),
         (
             "channel_units".to_string(),
-            "X,Y,Z: absolute CIE 1931 2° tristimulus values, Y = luminance in cd/m^2; stderr.Y: standard error of Y in cd/m^2".to_string(),
+            "X,Y,Z: absolute CIE 1931 2° tristimulus values, Y = luminance in cd/m^2; stderr.Y: standard error of Y in cd/m^2, from the spread of the pixel's independently scrambled sample batches (see stderr_batches)".to_string(),
+        ),
+        (
+            crate::film::STDERR_BATCHES_ATTRIBUTE.to_string(),
+            crate::film::PIXEL_BATCHES.to_string(),
         ),
         (
             "spp".to_string(),

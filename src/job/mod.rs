@@ -441,7 +441,7 @@ pub fn run(
     };
     let write_state = |film: &Film, writes: &mut Writes| {
         writes.attempt(&state_path, || {
-            RenderState::new(scene_path, hash, &world, film.clone()).save(&state_path)
+            RenderState::save_film(scene_path, hash, &world, film, &state_path)
         });
     };
     progress.start(prog.max_spp as u64 * world.camera.inside_pixels() as u64)?;

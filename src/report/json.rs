@@ -118,12 +118,7 @@ pub fn report_json(r: &ReportInput) -> Value {
     let film = &r.render.film;
     let luminance = stats(film.pixels.iter().map(|p| p.mean_xyz()[1] * kl));
     let illuminance = if w.settings.illuminance {
-        stats(
-            film.pixels
-                .iter()
-                .filter_map(|p| p.mean_e())
-                .map(|e| e * ke),
-        )
+        stats(film.pixels_e().filter_map(|p| p.mean_e()).map(|e| e * ke))
     } else {
         Value::Null
     };

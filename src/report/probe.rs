@@ -27,13 +27,17 @@ pub struct Estimate {
     pub mean: f64,
     /// Standard error of the mean; `None` if the image has no error channel.
     pub stderr: Option<f64>,
+    /// The multiple of `stderr` that is the 95 % interval's half-width: Student's t₀.₉₇₅ with
+    /// the degrees of freedom of the pixels' batch standard errors (Welch–Satterthwaite over
+    /// several pixels), or [`Z95`] for an image that does not state its batches.
+    pub t95: f64,
 }
 
 impl Estimate {
-    /// The 95 % confidence interval mean ± 1.96·SE.
+    /// The 95 % confidence interval mean ± t95·SE.
     pub fn ci95(&self) -> Option<(f64, f64)> {
         self.stderr
-            .map(|se| (self.mean - Z95 * se, self.mean + Z95 * se))
+            .map(|se| (self.mean - self.t95 * se, self.mean + self.t95 * se))
     }
 
     fn to_json(self) -> Value {
@@ -190,13 +194,38 @@ pub fn probe(
         .attribute("spp")
         .and_then(|v| v.trim().parse::<f64>().ok());
     let too_few_samples = spp.is_some_and(|spp| spp < 2.0);
+    // A pixel's standard error comes from min(n, batches) independent batches of its n
+    // samples (the mean spp stands for n); images that do not state their batches get the
+    // normal quantile.
+    let batches = layers
+        .attribute(crate::film::STDERR_BATCHES_ATTRIBUTE)
+        .and_then(|v| v.trim().parse::<u32>().ok());
+    let dof = batches.map(|k| (spp.unwrap_or(k as f64).floor().clamp(1.0, k as f64) as u32) - 1);
+    let t95_of = |c: &[f32], ids: &[usize]| match dof {
+        None => Z95,
+        Some(0) => f64::INFINITY,
+        Some(d) => {
+            // Welch–Satterthwaite: ν = (Σ seᵢ²)² / Σ (seᵢ⁴ / dᵢ), at least one pixel's dof.
+            let (s2, s4) = ids.iter().fold((0.0, 0.0), |(a, b), &i| {
+                let v = (c[i] as f64).powi(2);
+                (a + v, b + v * v)
+            });
+            let nu = if s4 > 0.0 {
+                (s2 * s2 / s4 * d as f64).min(u32::MAX as f64 / 2.0) as u32
+            } else {
+                d
+            };
+            crate::sampling::t95(nu.max(d))
+        }
+    };
     let lq = Quantity::Luminance;
+    let y_se = layers.channel(CHANNEL_Y_STDERR);
     let luminance = Estimate {
         mean: units.from_si(lq, mean_of(lum, &idx)),
-        stderr: layers
-            .channel(CHANNEL_Y_STDERR)
+        stderr: y_se
             .filter(|_| !too_few_samples)
             .map(|c| units.from_si(lq, se_of(c, &idx))),
+        t95: y_se.map_or(Z95, |c| t95_of(c, &idx)),
     };
 
     let eq = Quantity::Illuminance;
@@ -237,6 +266,7 @@ pub fn probe(
                         stderr: e_se
                             .filter(|_| !too_few_samples && !too_few_e)
                             .map(|c| units.from_si(eq, se_of(c, &defined))),
+                        t95: e_se.map_or(Z95, |c| t95_of(c, &defined)),
                     },
                     pixels: defined.len(),
                     mask_mean,

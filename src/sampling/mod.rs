@@ -6,9 +6,11 @@
 pub mod discrete;
 pub mod piecewise;
 pub mod sobol;
+pub mod student;
 pub mod warp;
 
 pub use discrete::{cdf_from_weights, choose_by_weight, pick_from_cdf};
 pub use piecewise::{Piecewise1D, Piecewise2D};
 pub use sobol::{batch_stream, mix64, Sampler, ONE_MINUS_EPSILON};
+pub use student::t95;
 pub use warp::*;

@@ -39,25 +39,29 @@ pub struct RunMode {
 }
 
 const PIXEL_SUMS: u64 = std::mem::size_of::<crate::film::PixelSums>() as u64;
+const E_SUMS: u64 = std::mem::size_of::<crate::film::IlluminanceSums>() as u64;
 
-/// Peak memory of a plain render's own buffers per pixel: the tiles' pixel sums and the film
-/// (both alive while the film is assembled), a pass's light-path sums (48 B for each of up to
-/// two buffers), plus the image, EXR and PNG buffers (48 B). Measured peak RSS at 2048² of a
-/// render that writes no state: 1.58 GB (this: 1.61 GB).
-const BYTES_PER_PIXEL: u64 = 2 * PIXEL_SUMS + 2 * 48 + 48;
+/// Bytes of one pixel of one film buffer: its sums, and its illuminance sums if the render
+/// estimates illuminance (208 B, 376 B).
+fn sums_bytes(illuminance: bool) -> u64 {
+    PIXEL_SUMS + if illuminance { E_SUMS } else { 0 }
+}
 
-/// Peak memory of a render's own buffers per pixel in `mode`, without the render state
-/// (see [`peak_bytes_per_pixel`] for the whole job). Adaptive sampling adds the decision buffer (one
-/// [`crate::film::PixelSums`] per pixel) and its per-pass statistics (16 B); its peak is then
-/// while the outputs are written, so the illuminance channels and false-colour maps add 32 B.
-/// Measured peak RSS at 2048² (GB): adaptive 2.20 (this: 2.18), adaptive with --illuminance
-/// and/or --falsecolour 2.23–2.31 (this: 2.32). Without adaptive sampling the output buffers
-/// are smaller than the film and do not raise the peak.
+/// Peak memory of a render's own buffers per pixel in `mode`, without the render state (see
+/// [`peak_bytes_per_pixel`] for the whole job). The film, the pass's results (pixel index and
+/// sums) and, at the end, the finished render's copy of the film, plus the image, EXR and PNG
+/// buffers (48 B) and the pass plan (8 B). How much of a pass's results the allocator still
+/// holds when the copy is made is measured, not derived: at 2048² the peak held two copies of
+/// the pixel sums and three of the illuminance sums of a plain render, and six copies of both
+/// with adaptive sampling (two buffers, each in the film, the pass's results and the copy),
+/// whose per-pass statistics, illuminance channels and false-colour maps are within that
+/// but for 32 B. Measured peak RSS: see tests/scene_errors.rs.
 pub fn bytes_per_pixel(mode: &RunMode, illuminance: bool) -> u64 {
+    let e = if illuminance { E_SUMS } else { 0 };
     if !mode.adaptive {
-        return BYTES_PER_PIXEL;
+        return 2 * PIXEL_SUMS + 3 * e + 56;
     }
-    let adaptive = BYTES_PER_PIXEL + PIXEL_SUMS + 16;
+    let adaptive = 6 * sums_bytes(illuminance);
     if illuminance || mode.falsecolour {
         adaptive + 32
     } else {
@@ -69,38 +73,35 @@ pub fn bytes_per_pixel(mode: &RunMode, illuminance: bool) -> u64 {
 /// light tracing's batches of splats (measured: 50 to 130 MB).
 pub const RENDER_BASE_BYTES: u64 = 150 << 20;
 
-/// Bytes of a pixel in a pass's results (pixel index, its sums and those of its decision
-/// buffer), the largest per-pixel buffer of a pass.
-const PASS_PIXEL_BYTES: u64 =
-    8 + PIXEL_SUMS + std::mem::size_of::<Option<crate::film::PixelSums>>() as u64;
-
-/// A film buffer's pixel in a render state file (postcard: 9 f64 and 3 variable-length
-/// counts), with the slack of the growing encoding buffer.
-const STATE_PIXEL_BYTES: u64 = 90;
+/// A film buffer's pixel in a render state file (postcard: 24 f64, 16 of them batch sums, and
+/// 2 variable-length counts; with illuminance 20 f64 more and a count), with the slack of the
+/// growing encoding buffer.
+fn state_pixel_bytes(illuminance: bool) -> u64 {
+    200 + if illuminance { 166 } else { 0 }
+}
 
 /// Peak memory per pixel of a render as `candela render` runs it in `mode` (add
 /// [`RENDER_BASE_BYTES`] once). The larger of
 /// * the render's own buffers, [`bytes_per_pixel`], and
-/// * writing the render state, which the job does at every checkpoint (every 60 s by default)
-///   and at the end once a state exists: the film, the finished render's copy of it, the
-///   state's copy and its encoding, per film buffer (two with adaptive sampling);
+/// * writing the render state at the end (`--save-state`, `--resume`): the film, the finished
+///   render's copy of it and the state's encoding, per film buffer (two with adaptive
+///   sampling); a checkpoint during the render holds one copy fewer;
 ///
-/// and, with light-traced caustics, a pass's results (256 B): the allocator keeps their memory
-/// once they are freed, because light tracing's splat batches are allocated after them.
-/// Measured peak RSS with a checkpoint after every pass, minus [`RENDER_BASE_BYTES`] (B/pixel
-/// at 1024² / 2048², Cornell box without and Cornell boxes with glass; this estimate in
-/// brackets): plain 411 / 428 (450), plain with caustics 490–545 / 622–643 (706), adaptive
-/// 806 / 887 (900), adaptive with caustics 938–940 / 1082–1104 (1156). A render that writes
-/// no state peaks lower: 1.26 to 1.8 times below this at 2048².
+/// and, with light-traced caustics, 96 B per film buffer: a pass's light-path sums (48 B) and
+/// as much again for what the allocator keeps of light tracing's splat batches (measured:
+/// 35 to 65 B in all). Measured peak RSS
+/// with a checkpoint after every pass and the state written at the end: see
+/// tests/hostile_memory.rs.
 pub fn peak_bytes_per_pixel(mode: &RunMode, illuminance: bool, caustics: bool) -> u64 {
     let buffers = if mode.adaptive { 2 } else { 1 };
-    let mut state = buffers * (3 * PIXEL_SUMS + STATE_PIXEL_BYTES);
+    let sums = sums_bytes(illuminance);
+    let mut state = buffers * (2 * sums + state_pixel_bytes(illuminance));
     if mode.adaptive && (illuminance || mode.falsecolour) {
         state += 32;
     }
     let peak = bytes_per_pixel(mode, illuminance).max(state);
     if caustics {
-        peak + PASS_PIXEL_BYTES
+        peak + buffers * 96
     } else {
         peak
     }
@@ -113,7 +114,7 @@ fn check_film_size(ctx: &Context, w: u32, h: u32) -> Result<(), SceneError> {
             "camera.resolution",
             format!(
                 "{w}×{h} pixels exceeds the limit of {MAX_PIXELS} pixels (the film would need {:.0} GiB)",
-                w as f64 * h as f64 * BYTES_PER_PIXEL as f64 / crate::limits::GIB
+                w as f64 * h as f64 * bytes_per_pixel(&RunMode::default(), false) as f64 / crate::limits::GIB
             ),
         ));
     }

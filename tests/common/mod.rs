@@ -116,10 +116,30 @@ pub fn check_pixels(
     value: impl Fn(&candela::film::PixelSums) -> (f64, f64),
     expected: impl Fn(usize, usize) -> f64,
 ) {
+    check_values(film, label, |i| value(&film.pixels[i]), expected);
+}
+
+/// [`check_pixels`] of a value that needs the pixels' illuminance sums.
+pub fn check_pixels_e(
+    film: &Film,
+    label: &str,
+    value: impl Fn(candela::film::PixelE) -> (f64, f64),
+    expected: impl Fn(usize, usize) -> f64,
+) {
+    let pixel = |i| film.pixel_e(i).expect("the film has illuminance sums");
+    check_values(film, label, |i| value(pixel(i)), expected);
+}
+
+fn check_values(
+    film: &Film,
+    label: &str,
+    value: impl Fn(usize) -> (f64, f64),
+    expected: impl Fn(usize, usize) -> f64,
+) {
     let (mut sum, mut sum_exp, mut var) = (0.0, 0.0, 0.0);
     for y in 0..film.height {
         for x in 0..film.width {
-            let (v, se) = value(&film.pixels[y * film.width + x]);
+            let (v, se) = value(y * film.width + x);
             let e = expected(x, y);
             assert!(
                 (v - e).abs() <= 5.0 * se,
