@@ -224,7 +224,7 @@ fn pixel_converged(
 
 /// Per-pixel sample counts to add in the next pass (0 = pixel done), and the fraction of
 /// eligible pixels that meet the target.
-fn plan_pass(film: &Film, prog: &Progressive) -> (Vec<u64>, Option<f64>) {
+fn plan_pass(world: &World, film: &Film, prog: &Progressive) -> (Vec<u64>, Option<f64>) {
     let max = prog.max_spp as u64;
     let n = film.pixels.len();
     let mut plan = vec![0u64; n];
@@ -319,7 +319,7 @@ pub fn render_progressive(
         ..Default::default()
     };
     let reason = 'passes: loop {
-        let (plan, frac) = plan_pass(film, prog);
+        let (plan, frac) = plan_pass(world, film, prog);
         status.converged_fraction = frac;
         status.samples = (0..w * h).map(|i| film.samples_taken(i)).sum();
         if let (Some(t), Some(f)) = (&prog.target, frac) {
