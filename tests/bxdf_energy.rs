@@ -17,8 +17,8 @@
 mod bxdf_util;
 use bxdf_util::*;
 use candela::bxdf::fresnel::{fr_conductor, fr_dielectric};
-use candela::bxdf::microfacet::erf_inv;
 use candela::bxdf::{ior, Distribution::*, Masking::*, Material};
+use candela::sampling::special::erf_inv;
 use glam::Vec3;
 
 /// Two-sided normal quantile for significance `alpha`.

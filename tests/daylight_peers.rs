@@ -8,25 +8,18 @@
 //! brightness Δ that gendaylit prints must match candela's to its four decimals.
 
 mod common;
-use common::python;
+use common::{python, python_json};
 
 use candela::daylight::{angle_to_sun, CieSky, PerezSky, SkyCondition};
 use serde_json::{json, Value};
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 fn radiance(cases: &Value) -> Vec<Value> {
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/daylight/radiance_sky.py");
-    let mut child = Command::new(python())
-        .arg(script)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("run python");
-    serde_json::to_writer(child.stdin.take().unwrap(), cases).unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(out.status.success(), "radiance_sky.py failed");
-    serde_json::from_slice::<Vec<Value>>(&out.stdout).unwrap()
+    match python_json("daylight/radiance_sky.py", &[], Some(cases)) {
+        Value::Array(v) => v,
+        other => panic!("radiance_sky.py printed {other}"),
+    }
 }
 
 /// Directions (Radiance frame: x east, y north, z up) at cos Z ≥ 0.45, around the sky and
@@ -332,19 +325,9 @@ fn sky_vectors_against_gendaymtx() {
         (7, 10, 19.0, 150.0, 45.0),
     ];
     for mf in [1u32, 2] {
-        let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/daylight/gendaymtx.py");
-        let mut child = Command::new(python())
-            .arg(script)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .spawn()
-            .expect("run python");
         let case = json!({"site": [45.76, -4.84, -15.0], "mf": mf,
             "steps": steps.iter().map(|s| json!([s.0, s.1, s.2, s.3, s.4])).collect::<Vec<_>>()});
-        serde_json::to_writer(child.stdin.take().unwrap(), &case).unwrap();
-        let out = child.wait_with_output().unwrap();
-        assert!(out.status.success(), "gendaymtx.py failed");
-        let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+        let r = python_json("daylight/gendaymtx.py", &[], Some(&case));
         let patches = SkyPatches::new(mf).unwrap();
         let suns = r["suns"].as_array().unwrap();
         assert_eq!(suns.len(), steps.len());

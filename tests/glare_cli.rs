@@ -8,7 +8,7 @@
 //!   within 0.5, and the same number of sources.
 
 mod common;
-use common::python;
+use common::python_json;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -115,18 +115,8 @@ fn glare_of_candela_fisheye_renders() {
     }
 
     // evalglare on the same picture.
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/glare/evalglare_file.py");
-    let out = Command::new(python())
-        .arg(script)
-        .arg(dir.join("room.hdr"))
-        .output()
-        .expect("run python");
-    assert!(
-        out.status.success(),
-        "evalglare_file.py: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let eg: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let hdr_path = dir.join("room.hdr");
+    let eg = python_json("glare/evalglare_file.py", &[hdr_path.as_os_str()], None);
     println!("evalglare: {eg}");
     let near = |k: &str, ours: &Value, tol: f64| {
         let (a, b) = (ours["value"].as_f64().unwrap(), eg[k].as_f64().unwrap());

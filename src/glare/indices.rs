@@ -4,6 +4,7 @@
 
 use super::image::{cross, dot, normalize, GlareImage, ImageError};
 use super::sources::{detect, DetectOptions, Detection};
+use crate::sampling::special::erf;
 
 /// How the background luminance L_b of DGI and UGR is taken (evalglare `-q`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -244,29 +245,6 @@ pub fn vcp(dgr: f64) -> f64 {
         0.0
     } else {
         50.0 * erf((6.374 - 1.3227 * dgr.ln()) / std::f64::consts::SQRT_2) + 50.0
-    }
-}
-
-/// The error function, as 1 − erfc(x) with Numerical Recipes' Chebyshev fit of erfc
-/// (|error| < 1.2·10⁻⁷, far below what VCP's two-decimal use needs).
-pub fn erf(x: f64) -> f64 {
-    let z = x.abs();
-    let t = 1.0 / (1.0 + 0.5 * z);
-    let r = t
-        * (-z * z - 1.265_512_23
-            + t * (1.000_023_68
-                + t * (0.374_091_96
-                    + t * (0.096_784_18
-                        + t * (-0.186_288_06
-                            + t * (0.278_868_07
-                                + t * (-1.135_203_98
-                                    + t * (1.488_515_87
-                                        + t * (-0.822_152_23 + t * 0.170_872_77)))))))))
-            .exp();
-    if x >= 0.0 {
-        1.0 - r
-    } else {
-        r - 1.0
     }
 }
 

@@ -6,6 +6,7 @@
 pub mod discrete;
 pub mod piecewise;
 pub mod sobol;
+pub mod special;
 pub mod student;
 pub mod warp;
 

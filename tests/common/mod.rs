@@ -270,3 +270,37 @@ pub fn python() -> std::path::PathBuf {
     );
     p
 }
+
+/// Runs the reference script `tests/<script>` under [`python`] with `args`, writing `input`
+/// (JSON) to its standard input when given, and returns the JSON it prints.
+pub fn python_json(
+    script: &str,
+    args: &[&std::ffi::OsStr],
+    input: Option<&serde_json::Value>,
+) -> serde_json::Value {
+    use std::process::{Command, Stdio};
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests")
+        .join(script);
+    let mut child = Command::new(python())
+        .arg(&path)
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run python");
+    let stdin = child.stdin.take().unwrap();
+    if let Some(v) = input {
+        serde_json::to_writer(stdin, v).unwrap();
+    } else {
+        drop(stdin);
+    }
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{script} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
