@@ -1,11 +1,14 @@
-//! `candela glare` on candela's own fisheye renders: a room with a window under an overcast sky
-//! and a bright ceiling luminaire in view, seen through a 180° angular fisheye.
+//! `candela glare` on candela's own fisheye renders (180° angular fisheye): a room with a window
+//! under an overcast sky and a bright ceiling luminaire in view; the same window under a clear
+//! sky with a low sun in view; a windowless office lit by four luminaires, with a `Ugr` meter.
 //! - E_v of the image (Σ L ∫cos θ dω) equals an illuminance meter at the eye facing the line
 //!   of sight, within their combined standard errors;
 //! - the EXR (with its per-pixel standard errors) and the Radiance picture give the same
 //!   indices to RGBE precision, and the EXR's indices carry intervals;
 //! - evalglare (Radiance 6) on candela's `.hdr` finds the same DGP within 0.01 and UGR/DGI
-//!   within 0.5, and the same number of sources.
+//!   within 0.5, and the same number of sources;
+//! - in the office, the image's UGR agrees with the `Ugr` meter's (CIE 117 from the luminaires)
+//!   within 0.5 plus their intervals.
 
 mod common;
 use common::python_json;
@@ -13,7 +16,8 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const SCENE: &str = r#"(
+/// The room; `LIGHTS` and `LAMP` are filled in per case.
+const ROOM: &str = r#"(
     camera: (position: (0, 1.2, 0.5), look_at: (0, 1.2, 2), resolution: (160, 160),
              projection: Fisheye(mapping: Equidistant, fov_deg: 180.0)),
     render: (spp: 64, seed: 3),
@@ -31,14 +35,58 @@ const SCENE: &str = r#"(
         (material: "wall", shape: Quad(origin: (-2, 2.1, 2), edge_u: (0, 0.9, 0), edge_v: (4, 0, 0))),
         (material: "wall", shape: Quad(origin: (-2, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (1, 0, 0))),
         (material: "wall", shape: Quad(origin: (1, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (1, 0, 0))),
-        (material: "lamp", shape: Quad(origin: (-0.3, 2.98, 1.0), edge_u: (0.6, 0, 0), edge_v: (0, 0, 0.6)),
-         emission: (spectrum: Named("D65"), amount: Luminance(20000.0))),
+        LAMP
+        CLOSED
     ],
-    lights: [Sky(model: CieOvercast, amount: HorizontalIlluminance(10000.0),
-                 portals: [(origin: (-1, 0.9, 2), edge_u: (2, 0, 0), edge_v: (0, 1.2, 0))])],
-    meters: [Illuminance(name: "eye", position: (0, 1.2, 0.5), normal: (0, 0, 1))],
+    lights: [LIGHTS],
+    meters: [Illuminance(name: "eye", position: (0, 1.2, 0.5), normal: (0, 0, 1)),
+             Ugr(name: "ugr", position: (0, 1.2, 0.5), direction: (0, 0, 1))],
     measure: (samples: 65536),
 )"#;
+
+const PORTAL: &str = "portals: [(origin: (-1, 0.9, 2), edge_u: (2, 0, 0), edge_v: (0, 1.2, 0))]";
+
+fn lamp(x: f64, z: f64, luminance: f64) -> String {
+    format!(
+        "(material: \"lamp\", shape: Quad(origin: ({}, 2.98, {}), edge_u: (0.6, 0, 0), \
+         edge_v: (0, 0, 0.6)), emission: (spectrum: Named(\"D65\"), amount: \
+         Luminance({luminance}))),",
+        x - 0.3,
+        z - 0.3
+    )
+}
+
+/// The three cases: (name, lights, lamps, whether the window is walled up).
+fn cases() -> Vec<(&'static str, String, String, bool)> {
+    vec![
+        (
+            "overcast",
+            format!("Sky(model: CieOvercast, amount: HorizontalIlluminance(10000.0), {PORTAL})"),
+            lamp(0.0, 1.3, 20000.0),
+            false,
+        ),
+        (
+            "sun",
+            format!(
+                "Sky(model: CieGeneral(12), sun: (altitude_deg: 20.0, azimuth_deg: 180.0), \
+                 amount: HorizontalIlluminance(15000.0), {PORTAL}), \
+                 Sun(sun: (altitude_deg: 20.0, azimuth_deg: 180.0), \
+                 amount: NormalIlluminance(70000.0))"
+            ),
+            String::new(),
+            false,
+        ),
+        (
+            "office",
+            String::new(),
+            [(-0.9, 1.2), (0.9, 1.2), (-0.9, -0.8), (0.9, -0.8)]
+                .iter()
+                .map(|&(x, z)| lamp(x, z, 5000.0))
+                .collect(),
+            true,
+        ),
+    ]
+}
 
 fn glare(image: &Path) -> Value {
     let out = Command::new(env!("CARGO_BIN_EXE_candela"))
@@ -58,20 +106,40 @@ fn glare(image: &Path) -> Value {
 
 #[test]
 fn glare_of_candela_fisheye_renders() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("glare_cli");
+    for (name, lights, lamps, closed) in cases() {
+        let closed = if closed {
+            "(material: \"wall\", shape: Quad(origin: (-1, 0.9, 2), edge_u: (0, 1.2, 0), \
+             edge_v: (2, 0, 0))),"
+        } else {
+            ""
+        };
+        let scene = ROOM
+            .replace("LIGHTS", &lights)
+            .replace("LAMP", &lamps)
+            .replace("CLOSED", closed);
+        case(name, &scene);
+    }
+}
+
+fn case(name: &str, scene_text: &str) {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("glare_cli_{name}"));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("room.ron");
-    std::fs::write(&scene, SCENE).unwrap();
+    std::fs::write(&scene, scene_text).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_candela"))
         .current_dir(&dir)
-        .args(["render", "room.ron"])
+        .args(["render", "room.ron", "--glare"])
         .output()
         .unwrap();
     assert!(
         out.status.success(),
-        "render: {}",
+        "{name}: render: {}",
         String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("DGP"),
+        "{name}: render --glare prints the indices"
     );
     let report: Value =
         serde_json::from_slice(&std::fs::read(dir.join("room.report.json")).unwrap()).unwrap();
@@ -89,7 +157,7 @@ fn glare_of_candela_fisheye_renders() {
     // The interval's half-width is t·sd of the draws; as a standard error, about half of it.
     let se_ev = half / 2.0;
     println!(
-        "E_v: image {ev:.2} (95 % CI ± {half:.2}) lx, meter {e_meter:.2} ± {se_meter:.2} lx; \
+        "{name}: E_v: image {ev:.2} (95 % CI ± {half:.2}) lx, meter {e_meter:.2} ± {se_meter:.2} lx; \
          DGP {:.4} (EXR) {:.4} (HDR); UGR {:.2} / {:.2}; sources {} / {}",
         exr["dgp"]["value"],
         hdr["dgp"]["value"],
@@ -100,7 +168,7 @@ fn glare_of_candela_fisheye_renders() {
     );
     assert!(
         (ev - e_meter).abs() <= 5.0 * (se_ev * se_ev + se_meter * se_meter).sqrt(),
-        "E_v {ev} vs meter {e_meter}"
+        "{name}: E_v {ev} vs meter {e_meter}"
     );
     assert!(half > 0.0, "the EXR's indices carry intervals");
     for k in ["dgp", "ev_lx"] {
@@ -117,10 +185,13 @@ fn glare_of_candela_fisheye_renders() {
     // evalglare on the same picture.
     let hdr_path = dir.join("room.hdr");
     let eg = python_json("glare/evalglare_file.py", &[hdr_path.as_os_str()], None);
-    println!("evalglare: {eg}");
+    println!("{name}: evalglare: {eg}");
     let near = |k: &str, ours: &Value, tol: f64| {
         let (a, b) = (ours["value"].as_f64().unwrap(), eg[k].as_f64().unwrap());
-        assert!((a - b).abs() <= tol, "{k}: candela {a}, evalglare {b}");
+        assert!(
+            (a - b).abs() <= tol,
+            "{name}: {k}: candela {a}, evalglare {b}"
+        );
     };
     near("dgp", &hdr["dgp"], 0.01);
     near("ugr", &hdr["ugr"], 0.5);
@@ -135,6 +206,23 @@ fn glare_of_candela_fisheye_renders() {
         (ev_eg / ev_hdr - 1.0).abs() < 0.01,
         "E_v: evalglare {ev_eg}, candela {ev_hdr}"
     );
+    // The Ugr meter (CIE 117 from the luminaires) against the image's UGR.
+    if name == "office" {
+        let m = &report["meters"][1]["ugr"];
+        let ugr_meter = m["ugr"].as_f64().unwrap();
+        let mi = m["ugr_interval"].as_array().unwrap();
+        let meter_half = (mi[1].as_f64().unwrap() - mi[0].as_f64().unwrap()) / 2.0;
+        let ui = exr["ugr"]["ci95"].as_array().unwrap();
+        let image_half = (ui[1].as_f64().unwrap() - ui[0].as_f64().unwrap()) / 2.0;
+        let ugr_image = exr["ugr"]["value"].as_f64().unwrap();
+        println!(
+            "office: UGR meter {ugr_meter:.2} ± {meter_half:.2}, image {ugr_image:.2} ± {image_half:.2}"
+        );
+        assert!(
+            (ugr_meter - ugr_image).abs() <= 0.5 + meter_half + image_half,
+            "UGR: meter {ugr_meter}, image {ugr_image}"
+        );
+    }
 }
 
 /// Images without a projection, and bad options, are refused with their reason.

@@ -35,6 +35,21 @@ pub struct GlareArgs {
     pub json: bool,
 }
 
+impl GlareArgs {
+    /// The command's defaults for `image` (text output).
+    pub fn defaults_for(image: PathBuf) -> Self {
+        GlareArgs {
+            image,
+            threshold: None,
+            search_angle: 0.2,
+            no_peaks: false,
+            low_light: false,
+            draws: 64,
+            json: false,
+        }
+    }
+}
+
 /// Runs the command: the text (or JSON) to print.
 pub fn run(args: &GlareArgs) -> anyhow::Result<String> {
     let mut opt = GlareOptions::default();

@@ -74,6 +74,9 @@ pub struct RenderOpts {
     /// Also write false-colour maps NAME.luminance.png (and NAME.illuminance.png with --illuminance), automatic range; `candela falsecolour` offers every option.
     #[arg(long)]
     falsecolour: bool,
+    /// After the render, evaluate the glare of the image as `candela glare NAME.exr` does with its defaults (DGP, UGR, DGI, VCP, CGI, E_v with 95 % intervals; meant for a fisheye camera) and print it.
+    #[arg(long)]
+    glare: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -336,6 +339,11 @@ pub fn render(a: &RenderOpts) -> Result<()> {
     }
     if let Some(w) = &out.truncation {
         eprintln!("warning: {w}");
+    }
+    if a.glare {
+        let report =
+            super::glare::run(&super::glare::GlareArgs::defaults_for(out.exr_path.clone()))?;
+        say!("glare of {}:\n{}", shown(&out.exr_path), report.trim_end());
     }
     Ok(())
 }
