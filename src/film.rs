@@ -607,14 +607,21 @@ impl Film {
         self.pixels.iter().map(|p| p.count).sum()
     }
 
-    /// Mean luminance of the image, cd/m²: the pixels' mean Y averaged over the pixels.
-    pub fn mean_luminance_cd_m2(&self) -> f64 {
-        self.pixels.iter().map(|p| p.mean_xyz()[1]).sum::<f64>() / (self.width * self.height) as f64
+    /// Pixels that have samples: all of them but a fisheye's pixels wholly outside its circle,
+    /// which see nothing and are never sampled (at least 1, for an empty film).
+    fn sampled_pixels(&self) -> usize {
+        self.pixels.iter().filter(|p| p.count > 0).count().max(1)
     }
 
-    /// Image samples per pixel: all samples over the number of pixels.
+    /// Mean luminance of the image, cd/m²: the pixels' mean Y averaged over the pixels that
+    /// have samples.
+    pub fn mean_luminance_cd_m2(&self) -> f64 {
+        self.pixels.iter().map(|p| p.mean_xyz()[1]).sum::<f64>() / self.sampled_pixels() as f64
+    }
+
+    /// Image samples per pixel: all samples over the number of pixels that have samples.
     pub fn samples_per_pixel(&self) -> f64 {
-        self.total_samples() as f64 / (self.width * self.height) as f64
+        self.total_samples() as f64 / self.sampled_pixels() as f64
     }
 }
 

@@ -319,6 +319,8 @@ fn fisheyes_in_a_uniform_sky_integrate_to_the_illuminance_at_the_eye() {
             );
             let world = common::world(&text);
             let film = common::render(&world, 1);
+            // The pixels outside the circle take no samples and do not count as pixels.
+            assert_eq!(film.samples_per_pixel(), 8.0, "{mapping}");
             let c = &world.camera;
             let lum: Vec<f32> = film.pixels.iter().map(|p| p.mean_xyz()[1] as f32).collect();
             let e = vertical_illuminance_lx(c, &lum);

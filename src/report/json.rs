@@ -116,7 +116,13 @@ pub fn report_json(r: &ReportInput) -> Value {
     let kl = r.units.from_si(Quantity::Luminance, 1.0);
     let w = r.world;
     let film = &r.render.film;
-    let luminance = stats(film.pixels.iter().map(|p| p.mean_xyz()[1] * kl));
+    // A fisheye's pixels outside its circle see nothing and take no samples: left out.
+    let luminance = stats(
+        film.pixels
+            .iter()
+            .filter(|p| p.count > 0)
+            .map(|p| p.mean_xyz()[1] * kl),
+    );
     let illuminance = if w.settings.illuminance {
         stats(film.pixels_e().filter_map(|p| p.mean_e()).map(|e| e * ke))
     } else {
