@@ -14,7 +14,6 @@ mod common;
 use common::python_json;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// The room; `LIGHTS` and `LAMP` are filled in per case.
 const ROOM: &str = r#"(
@@ -89,19 +88,12 @@ fn cases() -> Vec<(&'static str, String, String, bool)> {
 }
 
 fn glare(image: &Path) -> Value {
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .arg("glare")
-        .arg(image)
-        .arg("--json")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "candela glare {}: {}",
-        image.display(),
-        String::from_utf8_lossy(&out.stderr)
+    let (code, stdout, stderr) = common::cli(
+        &["glare", image.to_str().unwrap(), "--json"],
+        image.parent().unwrap(),
     );
-    serde_json::from_slice(&out.stdout).unwrap()
+    assert_eq!(code, 0, "candela glare {}: {stderr}", image.display());
+    serde_json::from_str(&stdout).unwrap()
 }
 
 #[test]
@@ -127,18 +119,10 @@ fn case(name: &str, scene_text: &str) {
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("room.ron");
     std::fs::write(&scene, scene_text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .current_dir(&dir)
-        .args(["render", "room.ron", "--glare"])
-        .output()
-        .unwrap();
+    let (code, stdout, stderr) = common::cli(&["render", "room.ron", "--glare"], &dir);
+    assert_eq!(code, 0, "{name}: render: {stderr}");
     assert!(
-        out.status.success(),
-        "{name}: render: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        String::from_utf8_lossy(&out.stdout).contains("DGP"),
+        stdout.contains("DGP"),
         "{name}: render --glare prints the indices"
     );
     let report: Value =
@@ -231,32 +215,22 @@ fn glare_refuses_what_it_cannot_evaluate() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("glare_cli_errors");
     std::fs::create_dir_all(&dir).unwrap();
     let missing = dir.join("missing.exr");
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args(["glare", missing.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("missing.exr"));
+    let (code, _, stderr) = common::cli(&["glare", missing.to_str().unwrap()], &dir);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("missing.exr"));
     // A Radiance picture without a VIEW line.
     let pic = dir.join("noview.hdr");
     let mut bytes = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 2\n".to_vec();
     bytes.extend_from_slice(&[128, 128, 128, 129].repeat(4));
     std::fs::write(&pic, bytes).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args(["glare", pic.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    let (code, _, err) = common::cli(&["glare", pic.to_str().unwrap()], &dir);
+    assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("noview.hdr") && err.contains("projection"),
         "{err}"
     );
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args(["glare", pic.to_str().unwrap(), "--threshold", "-3"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
+    let (code, _, _) = common::cli(&["glare", pic.to_str().unwrap(), "--threshold", "-3"], &dir);
+    assert_eq!(code, 2);
 }
 
 /// The DGP interval of a noisy render (64 × 64 fisheye, 8 spp) covers the DGP of a converged
@@ -280,17 +254,12 @@ fn dgp_interval_covers_the_converged_dgp_over_seeds() {
     std::fs::write(dir.join("room.ron"), scene_text).unwrap();
     let render = |spp: u32, seed: u64| -> Value {
         let name = format!("s{seed}.exr");
-        let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-            .current_dir(&dir)
-            .args(["render", "room.ron", "--quiet", "--out", &name])
-            .args(["--spp", &spp.to_string(), "--seed", &seed.to_string()])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let (spp, seed_text) = (spp.to_string(), seed.to_string());
+        let args = [
+            "render", "room.ron", "--quiet", "--out", &name, "--spp", &spp, "--seed", &seed_text,
+        ];
+        let (code, _, stderr) = common::cli(&args, &dir);
+        assert_eq!(code, 0, "{stderr}");
         glare(&dir.join(&name))["dgp"].clone()
     };
     let truth = render(2048, 1_000_000);

@@ -109,13 +109,14 @@ pub fn sky_coefficients(
         .map(|(r, &(p, normal))| {
             let mut sums = vec![0.0f64; BATCHES as usize * n];
             let mut stats = RayStats::default();
+            // One buffer for every sample's tallied parts (a path credits a few patches).
+            let mut parts: Vec<(Vec3, crate::spectrum::SampledSpectrum)> = Vec::new();
             for b in 0..BATCHES {
                 let stream = batch_stream(r as u64, b);
                 let row = &mut sums[b as usize * n..(b as usize + 1) * n];
                 for s in 0..per_batch {
                     let mut sampler = Sampler::new(world.settings.seed, stream, s);
                     let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
-                    let mut parts: Vec<(Vec3, crate::spectrum::SampledSpectrum)> = Vec::new();
                     irradiance_tallied(
                         world,
                         &RayStart::free(p),
@@ -126,7 +127,7 @@ pub fn sky_coefficients(
                         &mut stats,
                         &mut |d, c| parts.push((d, c)),
                     );
-                    for (d, c) in parts {
+                    for (d, c) in parts.drain(..) {
                         let y = radiance_to_xyz(&c, &wl)[1];
                         if y.is_finite() {
                             let local = frame.to_local(d.as_dvec3());
