@@ -4,3 +4,7 @@
 
 pub mod coefficients;
 pub mod metrics;
+pub mod results;
+pub mod run;
+pub mod sun;
+pub mod year;

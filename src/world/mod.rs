@@ -95,3 +95,36 @@ pub struct World {
     /// was built; a render state's scene hash covers their contents.
     pub sources: Vec<std::path::PathBuf>,
 }
+
+impl World {
+    /// The same world lit by `lights` instead (lights at infinity: skies, suns, environments;
+    /// objects emit nothing afterwards). Daylight coefficients use it to light one geometry by
+    /// a unit sky, then by each hour's sun, without building it again. Light-traced caustics
+    /// are dropped: the irradiance estimators these worlds serve do not use them.
+    pub fn relit(mut self, lights: Vec<Light>) -> World {
+        for o in &mut self.objects {
+            o.light = None;
+        }
+        self.infinite_lights = lights
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.flags().contains(crate::light::LightFlags::INFINITE))
+            .map(|(i, _)| i as u32)
+            .collect();
+        let (lo, hi) = self.geometry.bounds();
+        let scene_radius = if lo.is_finite() && hi.is_finite() && hi.cmpge(lo).all() {
+            (0.5 * (hi - lo).length()).max(1e-6)
+        } else {
+            1.0
+        };
+        self.light_sampler = LightSampler::new(
+            self.settings.light_sampler,
+            &lights,
+            &self.geometry,
+            scene_radius,
+        );
+        self.lights = lights;
+        self.caustics = None;
+        self
+    }
+}

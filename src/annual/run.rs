@@ -1,0 +1,356 @@
+//! The annual calculation of a scene, as one library call: `candela annual` parses its options
+//! into [`AnnualSettings`], calls [`run`] and writes what it returns ([`super::output`]).
+//!
+//! The scene's geometry and materials are kept; its lights are not. Daylight comes from the
+//! weather file, through the scene's sky (`Sky` or `Weather`) for its spectrum, ground
+//! reflectance and portals (its own amounts are ignored); electric lights are left out and
+//! counted in the notes. The receivers are the points of the scene's grids.
+
+use super::coefficients::{sky_coefficients, Coefficients};
+use super::metrics::{Schedule, Thresholds};
+use super::results::{hourly, hourly_bytes, metrics, GridResult, Hourly};
+use super::sun::{sun_coefficient_bytes, sun_coefficients, SunCoefficients};
+use super::year::{hourly_skies, HourSky};
+use crate::daylight::epw::{Site, Weather};
+use crate::daylight::patches::SkyPatches;
+use crate::description::schema::{
+    Amount, LightDesc, SceneFile, SkyModelDesc, SpectrumDesc, SunDesc,
+};
+use crate::light::Light;
+use crate::scene::build::Overrides;
+use anyhow::{anyhow, bail, Result};
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+
+/// What [`run`] computes and how finely.
+#[derive(Clone, Debug)]
+pub struct AnnualSettings {
+    /// The weather file (EPW); `None`: the file of the scene's `Weather` light.
+    pub weather: Option<PathBuf>,
+    /// Reinhart sky subdivision (1 = Tregenza's 145 patches; 2 = 577).
+    pub mf: u32,
+    /// Paths per receiver for the sky coefficients.
+    pub sky_samples: u64,
+    /// Paths per receiver and sunny hour for the sun (total light).
+    pub sun_samples: u64,
+    /// Shadow rays per receiver and sunny hour for the direct sun.
+    pub direct_samples: u64,
+    /// Occupied hours each day, local standard time: from `occupied.0`:00 to `occupied.1`:00.
+    pub occupied: (usize, usize),
+    pub thresholds: Thresholds,
+    /// Replicate years drawn for the metrics' intervals (0: no intervals).
+    pub draws: usize,
+    /// Overrides the scene's seed.
+    pub seed: Option<u64>,
+}
+
+impl Default for AnnualSettings {
+    fn default() -> Self {
+        Self {
+            weather: None,
+            mf: 2,
+            sky_samples: 4096,
+            sun_samples: 256,
+            direct_samples: 64,
+            occupied: (8, 18),
+            thresholds: Thresholds::default(),
+            draws: 200,
+            seed: None,
+        }
+    }
+}
+
+/// Which part of the calculation a progress report is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Sky coefficients: one pass (reported as 0 of 1, then 1 of 1).
+    Sky,
+    /// The sun, hour by hour (sunny hours done, of all).
+    Sun,
+    /// Hourly illuminances and the metrics with their replicate years.
+    Metrics,
+}
+
+/// A grid's layout, as the scene gives it.
+#[derive(Clone, Debug)]
+pub struct GridLayout {
+    pub name: String,
+    pub nx: u32,
+    pub ny: u32,
+    /// Cell centres (m), `j * nx + i`.
+    pub points: Vec<Vec3>,
+    pub normal: Vec3,
+}
+
+/// Everything an annual calculation found.
+#[derive(Clone, Debug)]
+pub struct AnnualRun {
+    pub scene: PathBuf,
+    pub weather: PathBuf,
+    pub site: Site,
+    pub settings: AnnualSettings,
+    /// Sky patches used.
+    pub patches: usize,
+    pub grids: Vec<GridLayout>,
+    pub results: Vec<GridResult>,
+    pub hourly: Hourly,
+    pub year: Vec<HourSky>,
+    /// Occupied hours counted, daylight hours (sun above the horizon) counted by EN 17037.
+    pub occupied_hours: usize,
+    pub daylight_hours: usize,
+    pub sunny_hours: usize,
+    /// Sky and sun passes, seconds.
+    pub seconds: (f64, f64, f64),
+    pub notes: Vec<String>,
+}
+
+/// The sky of a scene as the annual calculation uses it: its spectrum, ground reflectance,
+/// portals, and the weather file of a `Weather` light.
+struct SceneSky {
+    spectrum: Option<SpectrumDesc>,
+    ground_reflectance: f64,
+    portals: Vec<crate::description::schema::PortalDesc>,
+    weather: Option<String>,
+}
+
+fn scene_sky(scene: &SceneFile) -> (SceneSky, usize) {
+    let mut sky = SceneSky {
+        spectrum: None,
+        ground_reflectance: 0.2,
+        portals: Vec::new(),
+        weather: None,
+    };
+    let mut electric = 0;
+    for l in &scene.lights {
+        match l {
+            LightDesc::Sky {
+                spectrum,
+                ground_reflectance,
+                portals,
+                ..
+            } => {
+                sky.spectrum = spectrum.clone();
+                sky.ground_reflectance = ground_reflectance.unwrap_or(0.2);
+                sky.portals = portals.clone();
+            }
+            LightDesc::Weather {
+                file,
+                spectrum,
+                ground_reflectance,
+                portals,
+                ..
+            } => {
+                sky.spectrum = spectrum.clone();
+                sky.ground_reflectance = ground_reflectance.unwrap_or(0.2);
+                sky.portals = portals.clone();
+                sky.weather = Some(file.clone());
+            }
+            LightDesc::Sun { .. } => {}
+            _ => electric += 1,
+        }
+    }
+    (sky, electric)
+}
+
+/// Runs the annual calculation of the scene at `scene_path`.
+pub fn run(
+    scene_path: &Path,
+    settings: &AnnualSettings,
+    progress: &mut dyn FnMut(Stage, usize, usize),
+) -> Result<AnnualRun> {
+    let mut scene = crate::scene::load(scene_path)?;
+    let (sky, electric) = scene_sky(&scene);
+    let dir = scene_path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let weather_path = match (&settings.weather, &sky.weather) {
+        (Some(w), _) => w.clone(),
+        (None, Some(w)) => dir.join(w),
+        (None, None) => bail!(
+            "{}: no weather file: give --weather FILE.epw, or a Weather light in the scene",
+            scene_path.display()
+        ),
+    };
+    let weather = Weather::read(&weather_path).map_err(|e| anyhow!(e))?;
+    if scene.grids.is_empty() {
+        bail!(
+            "{}: annual daylight is computed on the scene's grids, and it has none",
+            scene_path.display()
+        );
+    }
+    if !(1..=8).contains(&settings.mf) {
+        return Err(crate::job::invalid_option(format!(
+            "--mf {} must be 1 to 8",
+            settings.mf
+        )));
+    }
+    if settings.occupied.0 >= settings.occupied.1 || settings.occupied.1 > 24 {
+        return Err(crate::job::invalid_option(format!(
+            "occupied hours {}–{} must be a range within 0–24",
+            settings.occupied.0, settings.occupied.1
+        )));
+    }
+    let patches = SkyPatches::new(settings.mf).map_err(|e| anyhow!(e))?;
+    let (year, year_notes) = hourly_skies(&weather, &patches, sky.ground_reflectance)
+        .map_err(|e| anyhow!("{}: {e}", weather_path.display()))?;
+
+    // The geometry lit by the unit sky.
+    scene.lights = vec![LightDesc::Sky {
+        model: SkyModelDesc::Uniform,
+        sun: None,
+        amount: Some(Amount::ZenithLuminance(1.0)),
+        spectrum: sky.spectrum.clone(),
+        ground_reflectance: Some(1.0),
+        portals: sky.portals.clone(),
+        sun_disk: None,
+    }];
+    scene.meters.clear();
+    let overrides = Overrides {
+        seed: settings.seed,
+        ..Default::default()
+    };
+    let world = crate::scene::build::build(&scene, scene_path, &overrides)?;
+    let frame = match world.lights.as_slice() {
+        [Light::Sky(s)] => s.frame,
+        _ => bail!("internal error: the unit-sky world has no sky"),
+    };
+    let mut grids = Vec::new();
+    let mut receivers = Vec::new();
+    let mut ranges = Vec::new();
+    for g in &world.grids {
+        let start = receivers.len();
+        let mut points = Vec::with_capacity(g.nx as usize * g.ny as usize);
+        for j in 0..g.ny {
+            for i in 0..g.nx {
+                points.push(g.point(i, j));
+                receivers.push((g.point(i, j), g.normal));
+            }
+        }
+        ranges.push(start..receivers.len());
+        grids.push(GridLayout {
+            name: g.name.clone(),
+            nx: g.nx,
+            ny: g.ny,
+            points,
+            normal: g.normal,
+        });
+    }
+    let sunny: Vec<usize> = (0..year.len()).filter(|&h| year[h].has_sun()).collect();
+    let daylight_n = year.iter().filter(|h| h.is_daylight()).count();
+    let n_p = patches.len() as u64;
+    let need = receivers.len() as u64 * n_p * (crate::meter::BATCHES as u64 + 1) * 8
+        + sun_coefficient_bytes(sunny.len(), receivers.len())
+        + hourly_bytes(year.len(), daylight_n, receivers.len());
+    crate::limits::check_memory(
+        need,
+        "the annual calculation's coefficients and hourly illuminances",
+    )
+    .map_err(|m| anyhow!("{}: {m}", scene_path.display()))?;
+
+    let t0 = std::time::Instant::now();
+    progress(Stage::Sky, 0, 1);
+    let sky_c: Coefficients = sky_coefficients(&world, &receivers, &patches, settings.sky_samples)?;
+    progress(Stage::Sky, 1, 1);
+    let t1 = std::time::Instant::now();
+
+    let sun_light = {
+        let ctx = crate::description::context::Context {
+            path: scene_path,
+            dir: dir.clone(),
+            sources: Default::default(),
+        };
+        let desc = SunDesc {
+            altitude_deg: Some(45.0),
+            azimuth_deg: Some(180.0),
+            ..Default::default()
+        };
+        let (s, _) = crate::light::SunLight::build(
+            &ctx,
+            "annual sun",
+            &desc,
+            Amount::NormalIlluminance(1.0),
+            None,
+            &frame,
+        )?;
+        s
+    };
+    let mut sun_world = world.relit(vec![Light::Sun(sun_light)]);
+    let to_sun: Vec<Vec3> = sunny
+        .iter()
+        .map(|&h| {
+            frame
+                .to_world(glam::DVec3::from_array(year[h].to_sun_enu))
+                .normalize()
+                .as_vec3()
+        })
+        .collect();
+    let n_sunny = to_sun.len();
+    progress(Stage::Sun, 0, n_sunny);
+    let sun_c: SunCoefficients = sun_coefficients(
+        &mut sun_world,
+        &receivers,
+        &to_sun,
+        settings.sun_samples,
+        settings.direct_samples,
+        &mut |d| progress(Stage::Sun, d, n_sunny),
+    )?;
+    let t2 = std::time::Instant::now();
+
+    progress(Stage::Metrics, 0, 1);
+    let days = year.len() / 24;
+    let occupied = Schedule::daily(days, settings.occupied.0, settings.occupied.1);
+    let daylight = Schedule {
+        hours: (0..year.len())
+            .filter(|&h| year[h].sun_altitude_deg > 0.0)
+            .collect(),
+    };
+    let hourly = hourly(&sky_c, &sun_c, &year);
+    let seed = settings.seed.unwrap_or(sun_world.settings.seed);
+    let results = metrics(
+        &hourly,
+        &ranges,
+        &occupied,
+        &daylight,
+        &settings.thresholds,
+        settings.draws,
+        seed,
+    );
+    progress(Stage::Metrics, 1, 1);
+    let t3 = std::time::Instant::now();
+
+    let mut notes = Vec::new();
+    if electric > 0 {
+        notes.push(format!(
+            "{electric} electric light(s) of the scene are left out: annual results are daylight alone"
+        ));
+    }
+    if year_notes.missing_records > 0 {
+        notes.push(format!(
+            "{} record(s) of the weather file lack irradiances and count as dark",
+            year_notes.missing_records
+        ));
+    }
+    Ok(AnnualRun {
+        scene: scene_path.to_path_buf(),
+        weather: weather_path,
+        site: weather.site.clone(),
+        settings: AnnualSettings {
+            sky_samples: sky_c.samples,
+            sun_samples: sun_c.samples,
+            direct_samples: sun_c.direct_samples,
+            ..settings.clone()
+        },
+        patches: patches.len(),
+        grids,
+        results,
+        hourly,
+        occupied_hours: occupied.hours.len(),
+        daylight_hours: daylight.hours.len(),
+        sunny_hours: n_sunny,
+        year,
+        seconds: (
+            (t1 - t0).as_secs_f64(),
+            (t2 - t1).as_secs_f64(),
+            (t3 - t2).as_secs_f64(),
+        ),
+        notes,
+    })
+}
