@@ -95,6 +95,8 @@ enum Command {
     Falsecolour(cli::falsecolour::FalsecolourArgs),
     /// Glare of a fisheye luminance image (DGP, UGR, DGI, VCP, CGI, E_v with 95 % intervals, the glare sources), as evalglare computes them; see docs/glare.md.
     Glare(cli::glare::GlareArgs),
+    /// A year of daylight on the scene's grids from an EPW weather file: DA, cDA, UDI, sDA, ASE, EN 17037 with 95 % intervals, hourly illuminance (NAME.annual.json, NAME.annual.csv); see docs/annual.md.
+    Annual(cli::annual::AnnualArgs),
 }
 
 fn main() -> ExitCode {
@@ -140,6 +142,7 @@ fn main() -> ExitCode {
             }
         }),
         Command::Falsecolour(args) => cli::falsecolour::run(&args).map(|s| say_raw!("{s}")),
+        Command::Annual(args) => cli::annual::run(&args).map(|s| say_raw!("{s}")),
         Command::Glare(args) => cli::glare::run(&args).map(|s| {
             if args.json {
                 say_json!("{s}")

@@ -4,6 +4,7 @@
 
 pub mod coefficients;
 pub mod metrics;
+pub mod output;
 pub mod results;
 pub mod run;
 pub mod sun;

@@ -31,7 +31,7 @@ pub struct AnnualSettings {
     pub mf: u32,
     /// Paths per receiver for the sky coefficients.
     pub sky_samples: u64,
-    /// Paths per receiver and sunny hour for the sun (total light).
+    /// Paths per receiver and sun-grid node for the sun's inter-reflected light.
     pub sun_samples: u64,
     /// Shadow rays per receiver and sunny hour for the direct sun.
     pub direct_samples: u64,
@@ -50,7 +50,7 @@ impl Default for AnnualSettings {
             weather: None,
             mf: 2,
             sky_samples: 4096,
-            sun_samples: 256,
+            sun_samples: 4096,
             direct_samples: 64,
             occupied: (8, 18),
             thresholds: Thresholds::default(),
@@ -65,7 +65,7 @@ impl Default for AnnualSettings {
 pub enum Stage {
     /// Sky coefficients: one pass (reported as 0 of 1, then 1 of 1).
     Sky,
-    /// The sun, hour by hour (sunny hours done, of all).
+    /// The sun: its grid's nodes, then hour by hour (steps done, of all).
     Sun,
     /// Hourly illuminances and the metrics with their replicate years.
     Metrics,
@@ -273,24 +273,18 @@ pub fn run(
         s
     };
     let mut sun_world = world.relit(vec![Light::Sun(sun_light)]);
-    let to_sun: Vec<Vec3> = sunny
-        .iter()
-        .map(|&h| {
-            frame
-                .to_world(glam::DVec3::from_array(year[h].to_sun_enu))
-                .normalize()
-                .as_vec3()
-        })
-        .collect();
+    let to_sun: Vec<[f64; 3]> = sunny.iter().map(|&h| year[h].to_sun_enu).collect();
     let n_sunny = to_sun.len();
-    progress(Stage::Sun, 0, n_sunny);
+    progress(Stage::Sun, 0, 1);
     let sun_c: SunCoefficients = sun_coefficients(
         &mut sun_world,
         &receivers,
         &to_sun,
+        &frame,
+        weather.site.latitude_deg,
         settings.sun_samples,
         settings.direct_samples,
-        &mut |d| progress(Stage::Sun, d, n_sunny),
+        &mut |d, n| progress(Stage::Sun, d, n),
     )?;
     let t2 = std::time::Instant::now();
 

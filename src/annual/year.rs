@@ -55,9 +55,8 @@ pub fn hourly_skies(
         ));
     }
     let site = &weather.site;
-    let mut notes = YearNotes::default();
-    let mut hours = Vec::with_capacity(n);
-    for (i, r) in weather.records.iter().enumerate() {
+    let missing = std::sync::atomic::AtomicUsize::new(0);
+    let hour = |(i, r): (usize, &crate::daylight::epw::Record)| -> Result<HourSky, String> {
         let t = CivilTime {
             year: r.year.clamp(1, 9999),
             month: r.month,
@@ -87,7 +86,7 @@ pub fn hourly_skies(
         let (dn, dh) = match (r.direct_normal_w_m2, r.diffuse_horizontal_w_m2) {
             (Some(dn), Some(dh)) => (dn, dh),
             _ => {
-                notes.missing_records += 1;
+                missing.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 (0.0, 0.0)
             }
         };
@@ -109,14 +108,24 @@ pub fn hourly_skies(
                 r.hour
             )
         })?;
-        hours.push(HourSky {
+        Ok(HourSky {
             month: r.month,
             day: r.day,
             hour: r.hour,
             sun_altitude_deg: pos.altitude_deg,
             to_sun_enu: to_sun,
             sky,
-        });
-    }
+        })
+    };
+    use rayon::prelude::*;
+    let hours = weather
+        .records
+        .par_iter()
+        .enumerate()
+        .map(hour)
+        .collect::<Result<Vec<_>, _>>()?;
+    let notes = YearNotes {
+        missing_records: missing.into_inner(),
+    };
     Ok((hours, notes))
 }

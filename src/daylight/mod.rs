@@ -27,24 +27,37 @@ pub fn angle_to_sun(cos_z: f64, dphi: f64, sun_zenith: f64) -> f64 {
 }
 
 /// ∫ f(cos Z, γ) cos Z dω over the upper hemisphere, the sun at zenith angle `sun_zenith`:
-/// the horizontal illuminance of a sky whose luminance is f (in f's units × sr). Midpoint rule
-/// in cos Z (512 rings) and azimuth (1024 sectors, the sun's half mirrored): the relative
-/// error is below 1e-6 for the smooth CIE and Perez distributions.
+/// the horizontal illuminance of a sky whose luminance is f (in f's units × sr), by
+/// [`horizontal_integral_with`] on 512 rings and 1024 sectors.
 pub fn horizontal_integral(sun_zenith: f64, f: impl Fn(f64, f64) -> f64) -> f64 {
-    const RINGS: usize = 512;
-    const SECTORS: usize = 1024;
-    let (du, dphi) = (1.0 / RINGS as f64, std::f64::consts::PI / SECTORS as f64);
+    horizontal_integral_with(sun_zenith, 512, 1024, f)
+}
+
+/// [`horizontal_integral`] on `rings` rings of equal zenith angle, each weighted by its exact
+/// ∫ cos Z sin Z dZ, and `sectors` sectors over the sun's half of the circle (the
+/// distribution is symmetric about the sun's vertical plane), f at each cell's midpoint. For
+/// the CIE and Perez skies, 128 × 256 agrees with 512 × 1024 to 4·10⁻⁵ and better than
+/// 10⁻⁵ unless the sun is within a few degrees of the zenith.
+pub fn horizontal_integral_with(
+    sun_zenith: f64,
+    rings: usize,
+    sectors: usize,
+    f: impl Fn(f64, f64) -> f64,
+) -> f64 {
+    let (dz, dphi) = (
+        std::f64::consts::FRAC_PI_2 / rings as f64,
+        std::f64::consts::PI / sectors as f64,
+    );
     let mut total = 0.0f64;
-    for i in 0..RINGS {
-        let u = (i as f64 + 0.5) * du;
+    for i in 0..rings {
+        let (z0, z1) = (i as f64 * dz, (i as f64 + 1.0) * dz);
+        let u = ((i as f64 + 0.5) * dz).cos();
         let mut ring = 0.0f64;
-        for j in 0..SECTORS {
+        for j in 0..sectors {
             let phi = (j as f64 + 0.5) * dphi;
             ring += f(u, angle_to_sun(u, phi, sun_zenith));
         }
-        total += ring * u;
+        total += ring * 0.5 * (z0.cos().powi(2) - z1.cos().powi(2));
     }
-    // The sectors cover half the circle; the distribution is symmetric about the sun's
-    // vertical plane.
-    2.0 * total * du * dphi
+    2.0 * total * dphi
 }

@@ -45,6 +45,9 @@ pub struct PathStart {
     /// scattering before a light that [`crate::world::CausticLights`] handles specular)
     /// are left to light tracing.
     pub caustics_by_light_tracing: bool,
+    /// Lights at infinity reached before the path scatters again count (false: only light
+    /// that has scattered at least once more, as [`indirect_irradiance`] needs).
+    pub unscattered_escapes: bool,
 }
 
 impl PathStart {
@@ -57,6 +60,7 @@ impl PathStart {
             n: None,
             depth: 0,
             caustics_by_light_tracing: false,
+            unscattered_escapes: true,
         }
     }
 
@@ -133,6 +137,9 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
     loop {
         let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
         let Some(hit) = hit else {
+            if depth == start.depth && !start.unscattered_escapes {
+                break;
+            }
             for &li in &world.infinite_lights {
                 let light = &world.lights[li as usize];
                 let le = light.escaped(ray_d, wl);
@@ -443,6 +450,7 @@ pub fn irradiance_tallied<T: FnMut(Vec3, SampledSpectrum)>(
                 n: Some(n),
                 depth: 1,
                 caustics_by_light_tracing,
+                unscattered_escapes: true,
             };
             // cos θ / pdf = π.
             let mut scaled = |d: Vec3, c: SampledSpectrum| tally(d, c * PI);
@@ -450,4 +458,37 @@ pub fn irradiance_tallied<T: FnMut(Vec3, SampledSpectrum)>(
         }
     }
     e
+}
+
+/// The irradiance at `at` on the side of unit normal `n` from light that has scattered at
+/// least once on its way (the lights' direct light, straight or through window panes, left
+/// out): a cosine-sampled path from the receiver that counts what it finds after its first
+/// scattering. Annual daylight adds each hour's direct sun, traced on its own, to it.
+pub fn indirect_irradiance(
+    world: &World,
+    at: &RayStart,
+    n: Vec3,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+) -> SampledSpectrum {
+    let local = crate::sampling::cosine_hemisphere(sampler.get2d());
+    if local.z <= 0.0 || world.settings.max_depth == Some(0) {
+        return SampledSpectrum::ZERO;
+    }
+    let wi = Frame::from_normal(n).to_world(local);
+    let origin = offset_ray_origin(at.p, at.error, at.ng, wi);
+    stats.bounce_rays += 1;
+    let start = PathStart {
+        specular: false,
+        pdf: crate::sampling::cosine_hemisphere_pdf(local.z),
+        p: at.p,
+        n: Some(n),
+        depth: 1,
+        caustics_by_light_tracing: false,
+        unscattered_escapes: false,
+    };
+    // cos θ / pdf = π.
+    trace_tallied(world, origin, wi, start, wl, sampler, stats, &mut |_, _| {})
+        * std::f32::consts::PI
 }

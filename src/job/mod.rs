@@ -4,7 +4,7 @@
 //! The command line, tests and other front ends call [`run`] and [`merge()`]; what they show
 //! while it runs comes through [`Progress`].
 
-mod files;
+pub(crate) mod files;
 mod merge;
 
 use crate::output::with_suffix;

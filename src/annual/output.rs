@@ -1,0 +1,235 @@
+//! What `candela annual` writes: NAME.annual.json (the metrics with their intervals; schema in
+//! docs/annual.md), NAME.annual.csv (every daylight hour's illuminance and standard error at
+//! every grid point) and the summary printed on the terminal. Files are written atomically.
+
+use super::results::{Estimate, GridResult};
+use super::run::AnnualRun;
+use crate::output::OutputError;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+
+fn est(e: &Estimate) -> Value {
+    match e.ci95 {
+        Some((lo, hi)) => json!({"value": e.value, "ci95": [lo, hi]}),
+        None => json!({"value": e.value, "ci95": null}),
+    }
+}
+
+/// The JSON report.
+pub fn json_report(run: &AnnualRun) -> Value {
+    let s = &run.settings;
+    let t = &s.thresholds;
+    let grids: Vec<Value> = run
+        .grids
+        .iter()
+        .zip(&run.results)
+        .map(|(g, r): (_, &GridResult)| {
+            let points: Vec<Value> = g
+                .points
+                .iter()
+                .zip(&r.points)
+                .enumerate()
+                .map(|(k, (p, m))| {
+                    json!({
+                        "i": k % g.nx as usize,
+                        "j": k / g.nx as usize,
+                        "position_m": [p.x, p.y, p.z],
+                        "da": est(&m.da),
+                        "cda": est(&m.cda),
+                        "udi_below": est(&m.udi_below),
+                        "udi_useful": est(&m.udi_useful),
+                        "udi_above": est(&m.udi_above),
+                        "sun_hours": est(&m.sun_hours),
+                    })
+                })
+                .collect();
+            json!({
+                "name": g.name,
+                "nx": g.nx,
+                "ny": g.ny,
+                "normal": [g.normal.x, g.normal.y, g.normal.z],
+                "sda": est(&r.sda),
+                "ase": est(&r.ase),
+                "en17037_target": est(&r.en17037_target),
+                "en17037_minimum": est(&r.en17037_minimum),
+                "points": points,
+            })
+        })
+        .collect();
+    json!({
+        "candela": env!("CARGO_PKG_VERSION"),
+        "scene": run.scene.display().to_string(),
+        "weather": {
+            "file": run.weather.display().to_string(),
+            "city": run.site.city,
+            "country": run.site.country,
+            "latitude_deg": run.site.latitude_deg,
+            "longitude_deg": run.site.longitude_deg,
+            "time_zone_h": run.site.time_zone_h,
+            "elevation_m": run.site.elevation_m,
+        },
+        "method": {
+            "sky_patches": run.patches,
+            "reinhart_mf": s.mf,
+            "sky_samples": s.sky_samples,
+            "sun_samples": s.sun_samples,
+            "direct_sun_samples": s.direct_samples,
+            "replicate_years": s.draws,
+            "sunny_hours_traced": run.sunny_hours,
+        },
+        "thresholds": {
+            "da_lx": t.da_lx,
+            "sda_fraction": t.sda_fraction,
+            "udi_lx": [t.udi_lx.0, t.udi_lx.1],
+            "ase_lx": t.ase_lx,
+            "ase_hours": t.ase_hours,
+            "en17037_target": {"lx": super::results::EN17037_TARGET.0, "plane_fraction": super::results::EN17037_TARGET.1},
+            "en17037_minimum": {"lx": super::results::EN17037_MINIMUM.0, "plane_fraction": super::results::EN17037_MINIMUM.1},
+        },
+        "occupied": {"from_h": s.occupied.0, "to_h": s.occupied.1, "hours": run.occupied_hours},
+        "daylight_hours": run.daylight_hours,
+        "seconds": {"sky": run.seconds.0, "sun": run.seconds.1, "metrics": run.seconds.2},
+        "notes": run.notes,
+        "grids": grids,
+    })
+}
+
+/// Writes the JSON report.
+pub fn write_json(path: &Path, run: &AnnualRun) -> Result<(), OutputError> {
+    let text = serde_json::to_string_pretty(&json_report(run)).expect("JSON of plain values");
+    crate::report::json::write_text(path, &(text + "\n"))
+}
+
+/// Writes the hourly CSV: one row per hour with daylight, the columns `month,day,hour` (the
+/// EPW record hour, 1–24), then per grid point its illuminance and standard error (lx).
+pub fn write_csv(path: &Path, run: &AnnualRun) -> Result<(), OutputError> {
+    let h = &run.hourly;
+    crate::output::write_atomic(path, |w| {
+        write!(w, "month,day,hour")?;
+        for g in &run.grids {
+            let name = g.name.replace([',', '"', '\n', '\r'], "_");
+            for k in 0..g.points.len() {
+                let (i, j) = (k % g.nx as usize, k / g.nx as usize);
+                write!(w, ",{name}[{i};{j}]_lx,{name}[{i};{j}]_stderr_lx")?;
+            }
+        }
+        writeln!(w)?;
+        for (t, hs) in run.year.iter().enumerate() {
+            if !hs.is_daylight() {
+                continue;
+            }
+            write!(w, "{},{},{}", hs.month, hs.day, hs.hour)?;
+            for r in 0..h.receivers {
+                let i = t * h.receivers + r;
+                write!(w, ",{:.6},{:.6}", h.mean[i], h.stderr[i])?;
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    })
+}
+
+fn pct(e: &Estimate) -> String {
+    match e.ci95 {
+        Some((lo, hi)) => format!(
+            "{:5.1} %  [{:.1}, {:.1}]",
+            100.0 * e.value,
+            100.0 * lo,
+            100.0 * hi
+        ),
+        None => format!("{:5.1} %", 100.0 * e.value),
+    }
+}
+
+/// The summary table: per grid its LEED/LM-83 and EN 17037 figures with 95 % intervals.
+pub fn summary(run: &AnnualRun) -> String {
+    let t = &run.settings.thresholds;
+    let mut s = format!(
+        "annual daylight of {} under {} ({}, {:.2}°, {:.2}°): {} occupied hours ({}:00–{}:00), {} sunny hours traced\n",
+        run.scene.display(),
+        run.weather.display(),
+        run.site.city,
+        run.site.latitude_deg,
+        run.site.longitude_deg,
+        run.occupied_hours,
+        run.settings.occupied.0,
+        run.settings.occupied.1,
+        run.sunny_hours
+    );
+    for (g, r) in run.grids.iter().zip(&run.results) {
+        let pass = |e: &Estimate, ok: &dyn Fn(f64) -> bool| match e.ci95 {
+            Some((lo, hi)) if ok(lo) && ok(hi) => "yes",
+            Some((lo, hi)) if !ok(lo) && !ok(hi) => "no",
+            Some(_) => "undecided (the interval straddles the limit)",
+            None if ok(e.value) => "yes",
+            None => "no",
+        };
+        let mean_da =
+            r.points.iter().map(|p| p.da.value).sum::<f64>() / r.points.len().max(1) as f64;
+        s += &format!(
+            "grid \"{}\" ({} × {} points), 95 % intervals in brackets:\n",
+            g.name, g.nx, g.ny
+        );
+        s += &format!(
+            "  sDA {:.0} lx / {:.0} %        {}   (LEED v4, 2 points at ≥ 55 %: {})\n",
+            t.da_lx,
+            100.0 * t.sda_fraction,
+            pct(&r.sda),
+            pass(&r.sda, &|v| v >= 0.55)
+        );
+        s += &format!(
+            "  ASE {:.0} lx, {:.0} h         {}   (LEED v4, at most 10 %: {})\n",
+            t.ase_lx,
+            t.ase_hours,
+            pct(&r.ase),
+            pass(&r.ase, &|v| v <= 0.10)
+        );
+        s += &format!(
+            "  EN 17037 target (300 lx over 50 %)   {} of daylight hours (met at ≥ 50 %: {})\n",
+            pct(&r.en17037_target),
+            pass(&r.en17037_target, &|v| v >= 0.5)
+        );
+        s += &format!(
+            "  EN 17037 minimum (100 lx over 95 %)  {} of daylight hours (met at ≥ 50 %: {})\n",
+            pct(&r.en17037_minimum),
+            pass(&r.en17037_minimum, &|v| v >= 0.5)
+        );
+        s += &format!(
+            "  mean DA {:.0} lx           {:5.1} %\n",
+            t.da_lx,
+            100.0 * mean_da
+        );
+    }
+    for n in &run.notes {
+        s += &format!("note: {n}\n");
+    }
+    s
+}
+
+/// NAME.annual.json and NAME.annual.csv for `out` (an output name, a directory or `None`: the
+/// scene's name in the current directory); refused when the directory does not exist or an
+/// output would replace an input.
+pub fn output_paths(
+    out: Option<&Path>,
+    scene: &Path,
+    weather: Option<&Path>,
+) -> anyhow::Result<(PathBuf, PathBuf)> {
+    use crate::job::files;
+    let name = scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    let stem = files::output_stem(out, &name, &["json", "csv"]);
+    files::check_output_dir(&stem)?;
+    let json = PathBuf::from(format!("{}.annual.json", stem.display()));
+    let csv = PathBuf::from(format!("{}.annual.csv", stem.display()));
+    for p in [&json, &csv] {
+        if files::would_replace(p, scene) || weather.is_some_and(|w| files::would_replace(p, w)) {
+            return Err(crate::job::invalid_option(format!(
+                "{} would replace an input",
+                p.display()
+            )));
+        }
+    }
+    Ok((json, csv))
+}
