@@ -279,7 +279,15 @@ fn a_year_of_uniform_skies_gives_daylight_autonomy_from_the_configuration_factor
     let hy = hourly(&c, &no_sun, &year);
     let occupied = Schedule::daily(365, 8, 18);
     let t = Thresholds::default();
-    let g = metrics(&hy, std::slice::from_ref(&(0..receivers.len())), &occupied, &occupied, &t, 100, 1);
+    let g = metrics(
+        &hy,
+        std::slice::from_ref(&(0..receivers.len())),
+        &occupied,
+        &occupied,
+        &t,
+        100,
+        1,
+    );
     let (mut decided, mut lit) = (0, 0);
     for (k, &(x, z)) in pts.iter().enumerate() {
         let f = opening_factor(x, z, (-0.6, 0.6), (-0.6, 0.6), 3.0);

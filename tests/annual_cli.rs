@@ -1,0 +1,267 @@
+//! `candela annual` from the command line: a year on the shoebox office, its JSON report
+//! consistent with its own hourly CSV (DA, UDI and sDA recomputed from the CSV's hours agree
+//! exactly; ASE agrees with the points' sun hours), and bad input refused with a message.
+
+mod common;
+use common::cli;
+use std::path::{Path, PathBuf};
+
+/// A synthetic year in EPW format at a Lyon-like site (45.73° N, 4.94° E, UTC+1): a clear-sky
+/// model scaled by a day-to-day cloudiness drawn from a fixed sequence, so the year has clear,
+/// intermediate and overcast days. Illuminance fields are left missing (the irradiances count).
+fn synthetic_year(path: &Path) {
+    let mut out = String::from(
+        "LOCATION,Lyon-Bron,ARA,FRA,candela synthetic,074800,45.73,4.94,1.0,201.0\n\
+         DESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\n\
+         HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\nCOMMENTS 1,synthetic\nCOMMENTS 2,synthetic\n\
+         DATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n",
+    );
+    let days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+    let lat = 45.73f64.to_radians();
+    let mut doy = 0;
+    let mut state = 12345u64;
+    for (m, &n) in days.iter().enumerate() {
+        for d in 0..n {
+            doy += 1;
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let k = [0.05, 0.3, 0.7, 1.0, 1.0][(state >> 33) as usize % 5];
+            let decl = 23.45f64.to_radians()
+                * (2.0 * std::f64::consts::PI * (284.0 + doy as f64) / 365.0).sin();
+            for h in 1..=24 {
+                let ha = (15.0 * (h as f64 - 0.5 - 12.3)).to_radians();
+                let s = lat.sin() * decl.sin() + lat.cos() * decl.cos() * ha.cos();
+                let (dn, dh) = if s > 0.01 {
+                    (
+                        950.0 * (-0.17 / s).exp() * k,
+                        60.0 + 250.0 * s * (1.0 - k) + 40.0 * s,
+                    )
+                } else {
+                    (0.0, 0.0)
+                };
+                let ghi = dh + dn * s.max(0.0);
+                out += &format!(
+                    "2003,{},{},{h},60,A7A7E8E8*0?9?9?9?9?9?9?9A7A7A7A7A7*0*0E8E8*0*0,10.0,5.0,60,\
+                     98600,1310,1367,350,{ghi:.0},{dn:.0},{dh:.0},999999,999999,999999,9999,180,\
+                     3.0,5,3,20.0,77777,9,999999999,0,0.2,0,88,0.0,0.0,0.0\n",
+                    m + 1,
+                    d + 1
+                );
+            }
+        }
+    }
+    std::fs::write(path, out).unwrap();
+}
+
+fn scene() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/annual-shoebox.ron")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("candela-annual-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn a_year_on_the_shoebox_is_consistent_with_its_hourly_csv() {
+    let dir = tmp("year");
+    let epw = dir.join("year.epw");
+    synthetic_year(&epw);
+    let scene = scene();
+    let (code, out, err) = cli(
+        &[
+            "annual",
+            scene.to_str().unwrap(),
+            "--weather",
+            epw.to_str().unwrap(),
+            "--out",
+            dir.join("sb").to_str().unwrap(),
+            "--mf",
+            "1",
+            "--sky-samples",
+            "512",
+            "--sun-samples",
+            "256",
+            "--direct-samples",
+            "16",
+            "--draws",
+            "20",
+            "-q",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 0, "{out}\n{err}");
+    println!("{out}");
+    assert!(out.contains("sDA 300 lx / 50 %") && out.contains("ASE 1000 lx, 250 h"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("sb.annual.json")).unwrap())
+            .unwrap();
+    let g = &json["grids"][0];
+    let points = g["points"].as_array().unwrap();
+    assert_eq!(points.len(), 35);
+    assert_eq!(json["occupied"]["hours"], 3650);
+
+    // The CSV: month, day, hour, then (E, se) per point, for every daylight hour.
+    let csv = std::fs::read_to_string(dir.join("sb.annual.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 3 + 2 * 35);
+    assert_eq!(header[3], "work plane[0;0]_lx");
+    let mut da = [0usize; 35];
+    let mut udi = [[0usize; 3]; 35];
+    let mut rows = 0;
+    for line in lines {
+        rows += 1;
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let hour = v[2] as usize;
+        // Occupied 8:00–18:00: records of hours 9 … 18.
+        if !(9..=18).contains(&hour) {
+            continue;
+        }
+        for p in 0..35 {
+            let e = v[3 + 2 * p];
+            assert!(v[4 + 2 * p] >= 0.0);
+            if e >= 300.0 {
+                da[p] += 1;
+            }
+            udi[p][if e < 100.0 {
+                0
+            } else if e <= 3000.0 {
+                1
+            } else {
+                2
+            }] += 1;
+        }
+    }
+    assert!(rows > 4000 && rows < 5000, "{rows} daylight hours");
+    let mut sda = 0;
+    for (p, pt) in points.iter().enumerate() {
+        // The CSV holds 6 decimals: the counts agree unless an hour sits within 10⁻⁶ lx of a
+        // threshold.
+        let d = pt["da"]["value"].as_f64().unwrap();
+        assert!(
+            (d - da[p] as f64 / 3650.0).abs() < 0.5 / 3650.0,
+            "point {p}: {d} vs {}",
+            da[p]
+        );
+        let u = pt["udi_useful"]["value"].as_f64().unwrap();
+        assert!(
+            (u - udi[p][1] as f64 / 3650.0).abs() < 0.5 / 3650.0,
+            "point {p}"
+        );
+        let ci = pt["da"]["ci95"].as_array().unwrap();
+        assert!(ci[0].as_f64().unwrap() <= d + 1e-12 && d <= ci[1].as_f64().unwrap() + 1e-12);
+        sda += (d >= 0.5) as usize;
+    }
+    assert_eq!(g["sda"]["value"].as_f64().unwrap(), sda as f64 / 35.0);
+    let ase = points
+        .iter()
+        .filter(|p| p["sun_hours"]["value"].as_f64().unwrap() > 250.0)
+        .count();
+    assert_eq!(g["ase"]["value"].as_f64().unwrap(), ase as f64 / 35.0);
+    // The window row sees the sun for hundreds of hours; the back of the room never.
+    assert!(ase > 0 && ase < 35, "ASE {ase} of 35");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_input_is_refused_with_a_message() {
+    let dir = tmp("bad");
+    let scene = scene();
+    let s = scene.to_str().unwrap();
+    let excerpt = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/lyon-excerpt.epw");
+    let out = dir.join("o");
+    let o = out.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, i32, &str)> = vec![
+        (vec!["annual", s, "--out", o], 1, "no weather file"),
+        (
+            vec![
+                "annual",
+                s,
+                "--weather",
+                excerpt.to_str().unwrap(),
+                "--out",
+                o,
+            ],
+            1,
+            "a year of hourly records",
+        ),
+        (
+            vec!["annual", s, "--weather", "/nonexistent/x.epw", "--out", o],
+            1,
+            "/nonexistent/x.epw",
+        ),
+        (
+            vec!["annual", s, "--weather", "w.epw", "--mf", "9"],
+            2,
+            "--mf",
+        ),
+        (
+            vec!["annual", s, "--weather", "w.epw", "--occupied", "18-8"],
+            2,
+            "--occupied",
+        ),
+        (
+            vec!["annual", s, "--weather", "w.epw", "--udi", "x-3"],
+            2,
+            "--udi",
+        ),
+        (
+            vec!["annual", s, "--weather", "w.epw", "--draws", "1"],
+            2,
+            "--draws",
+        ),
+        (
+            vec!["annual", s, "--weather", "w.epw", "--da", "nan"],
+            2,
+            "--da",
+        ),
+        (
+            vec!["annual", s, "--weather", "w.epw", "--sky-samples", "0"],
+            2,
+            "--sky-samples",
+        ),
+        (
+            vec![
+                "annual",
+                s,
+                "--weather",
+                "w.epw",
+                "--out",
+                "/nonexistent-dir/x",
+            ],
+            1,
+            "nonexistent-dir",
+        ),
+    ];
+    for (args, want, msg) in cases {
+        let (code, stdout, err) = cli(&args, &dir);
+        assert_eq!(code, want, "{args:?}: {stdout}\n{err}");
+        assert!(err.contains(msg), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // A scene without grids.
+    let no_grid = dir.join("nogrid.ron");
+    std::fs::write(
+        &no_grid,
+        "(camera: (position: (0, 1, 0), look_at: (0, 1, 1), vfov_deg: 30, resolution: (1, 1)))",
+    )
+    .unwrap();
+    let epw = dir.join("year.epw");
+    synthetic_year(&epw);
+    let (code, _, err) = cli(
+        &[
+            "annual",
+            no_grid.to_str().unwrap(),
+            "--weather",
+            epw.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("grids"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
