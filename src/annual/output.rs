@@ -76,6 +76,7 @@ pub fn json_report(run: &AnnualRun) -> Value {
             "direct_sun_samples": s.direct_samples,
             "replicate_years": s.draws,
             "sunny_hours_traced": run.sunny_hours,
+            "sun_nodes": run.sun_nodes,
         },
         "thresholds": {
             "da_lx": t.da_lx,

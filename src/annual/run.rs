@@ -99,6 +99,8 @@ pub struct AnnualRun {
     pub occupied_hours: usize,
     pub daylight_hours: usize,
     pub sunny_hours: usize,
+    /// Sun positions traced for the sun's inter-reflected light.
+    pub sun_nodes: usize,
     /// Sky and sun passes, seconds.
     pub seconds: (f64, f64, f64),
     pub notes: Vec<String>,
@@ -339,6 +341,7 @@ pub fn run(
         occupied_hours: occupied.hours.len(),
         daylight_hours: daylight.hours.len(),
         sunny_hours: n_sunny,
+        sun_nodes: sun_c.nodes,
         year,
         seconds: (
             (t1 - t0).as_secs_f64(),
