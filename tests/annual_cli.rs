@@ -103,6 +103,11 @@ fn a_year_on_the_shoebox_is_consistent_with_its_hourly_csv() {
     let points = g["points"].as_array().unwrap();
     assert_eq!(points.len(), 35);
     assert_eq!(json["occupied"]["hours"], 3650);
+    for key in ["da", "udi", "sun-hours"] {
+        let png = dir.join(format!("sb.annual.grid-work-plane.{key}.png"));
+        let img = image::open(&png).unwrap_or_else(|e| panic!("{}: {e}", png.display()));
+        assert!(img.width() > 300 && img.height() > 300);
+    }
 
     // The CSV: month, day, hour, then (E, se) per point, for every daylight hour.
     let csv = std::fs::read_to_string(dir.join("sb.annual.csv")).unwrap();

@@ -234,3 +234,94 @@ pub fn output_paths(
     }
     Ok((json, csv))
 }
+
+/// The heat maps of each grid: daylight autonomy and useful daylight illuminance (%, on a
+/// fixed 0–100 scale) and hours of direct sun above the ASE threshold (h, 0 to the largest),
+/// as NAME.annual.grid-SLUG.da.png, .udi.png and .sun-hours.png. Returns the paths written.
+pub fn write_heatmaps(stem: &Path, run: &AnnualRun) -> Result<Vec<PathBuf>, OutputError> {
+    use crate::report::falsecolour::FalsecolourSettings;
+    use crate::report::heatmap::{render_metric_heatmap, GridMetric, GridValues};
+    let t = &run.settings.thresholds;
+    let mut written = Vec::new();
+    for (g, r) in run.grids.iter().zip(&run.results) {
+        let size = |p: &[glam::Vec3], n: usize, step: usize| -> f64 {
+            // The grid's extent: the span of its cell centres plus one cell.
+            if n < 2 {
+                return 1.0;
+            }
+            let d = (p[(n - 1) * step] - p[0]).length() as f64;
+            d * n as f64 / (n - 1) as f64
+        };
+        let (nx, ny) = (g.nx as usize, g.ny as usize);
+        let size_m = (size(&g.points, nx, 1), size(&g.points, ny, nx));
+        // (file key, title, unit, values, scale maximum)
+        #[allow(clippy::type_complexity)]
+        let maps: [(&str, String, &str, Vec<f64>, Option<f64>); 3] = [
+            (
+                "da",
+                format!("daylight autonomy DA{}", t.da_lx),
+                "%",
+                r.points.iter().map(|p| 100.0 * p.da.value).collect(),
+                Some(100.0),
+            ),
+            (
+                "udi",
+                format!(
+                    "useful daylight illuminance UDI {}–{} lx",
+                    t.udi_lx.0, t.udi_lx.1
+                ),
+                "%",
+                r.points
+                    .iter()
+                    .map(|p| 100.0 * p.udi_useful.value)
+                    .collect(),
+                Some(100.0),
+            ),
+            (
+                "sun-hours",
+                format!(
+                    "hours of direct sun above {} lx (ASE counts > {} h)",
+                    t.ase_lx, t.ase_hours
+                ),
+                "h",
+                r.points.iter().map(|p| p.sun_hours.value).collect(),
+                None,
+            ),
+        ];
+        for (key, name, unit, values, max) in maps {
+            let path = crate::output::with_suffix(
+                stem,
+                &format!(
+                    ".annual.grid-{}.{key}.png",
+                    crate::world::measure::slug(&g.name)
+                ),
+            );
+            let max = max.or_else(|| {
+                let m = values.iter().copied().fold(0.0, f64::max);
+                Some(if m > 0.0 { m } else { 1.0 })
+            });
+            let grid = GridValues {
+                name: g.name.clone(),
+                nx,
+                ny,
+                values,
+                stderr: Vec::new(),
+                size_m,
+            };
+            let settings = FalsecolourSettings {
+                min: Some(0.0),
+                max,
+                ..Default::default()
+            };
+            let metric = GridMetric {
+                name,
+                unit: unit.to_string(),
+            };
+            let (img, _) = render_metric_heatmap(&grid, &metric, &settings)
+                .map_err(|e| OutputError::invalid(&path, e))?;
+            crate::output::write_rgb_png(&path, &img)?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}

@@ -192,11 +192,18 @@ pub fn run(a: &AnnualArgs) -> Result<String> {
     let out = out?;
     candela::annual::output::write_json(&json, &out)?;
     candela::annual::output::write_csv(&csv, &out)?;
+    let stem = PathBuf::from(
+        json.to_string_lossy()
+            .strip_suffix(".annual.json")
+            .unwrap_or_default(),
+    );
+    let maps = candela::annual::output::write_heatmaps(&stem, &out)?;
     Ok(format!(
-        "{}wrote {} and {} ({:.1} s sky, {:.1} s sun, {:.1} s metrics)\n",
+        "{}wrote {}, {} and {} heat maps ({:.1} s sky, {:.1} s sun, {:.1} s metrics)\n",
         candela::annual::output::summary(&out),
         json.display(),
         csv.display(),
+        maps.len(),
         out.seconds.0,
         out.seconds.1,
         out.seconds.2

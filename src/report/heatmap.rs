@@ -175,42 +175,88 @@ fn validate(grid: &GridValues) -> Result<(), String> {
     Ok(())
 }
 
+/// A grid quantity other than illuminance for [`render_metric_heatmap`]: its name for the
+/// title (e.g. "daylight autonomy DA300") and its unit symbol (e.g. "%", "h"); the values are
+/// drawn as given.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridMetric {
+    pub name: String,
+    pub unit: String,
+}
+
 /// Renders the heat map in memory (see [`write_grid_heatmap`]).
 pub fn render_grid_heatmap(
     grid: &GridValues,
     settings: &FalsecolourSettings,
 ) -> Result<(RgbImage, HeatmapInfo), String> {
+    render_heatmap(grid, None, settings)
+}
+
+/// The heat map of a metric's values on a grid (daylight autonomy in %, hours of sun, …):
+/// as [`render_grid_heatmap`], with the metric's name and unit, and its minimum, mean and
+/// maximum in the title.
+pub fn render_metric_heatmap(
+    grid: &GridValues,
+    metric: &GridMetric,
+    settings: &FalsecolourSettings,
+) -> Result<(RgbImage, HeatmapInfo), String> {
+    render_heatmap(grid, Some(metric), settings)
+}
+
+fn render_heatmap(
+    grid: &GridValues,
+    metric: Option<&GridMetric>,
+    settings: &FalsecolourSettings,
+) -> Result<(RgbImage, HeatmapInfo), String> {
     validate(grid)?;
     let units = settings.units;
     let q = Quantity::Illuminance;
-    let unit = units.symbol(q);
-    let shown: Vec<f64> = grid.values.iter().map(|&v| units.from_si(q, v)).collect();
+    let unit = match metric {
+        Some(m) => m.unit.as_str(),
+        None => units.symbol(q),
+    };
+    let shown: Vec<f64> = match metric {
+        Some(_) => grid.values.clone(),
+        None => grid.values.iter().map(|&v| units.from_si(q, v)).collect(),
+    };
     let settings = FalsecolourSettings {
         quantity: q,
         ..settings.clone()
     };
     let cs = ColourScale::resolve(&settings, &shown)?;
     let stats_si = GridStats::of(&grid.values, &grid.stderr).expect("grid is not empty");
-    let stats = stats_si.in_units(units);
+    let stats = match metric {
+        Some(_) => stats_si,
+        None => stats_si.in_units(units),
+    };
 
     let (nx, ny) = (grid.nx, grid.ny);
     let cell = cell_px(nx, ny);
     let value_px = (cell as f32 * 0.30).min(16.0);
 
     let ratio = |r: Option<f64>| r.map_or("–".to_string(), |r| format!("{r:.2}"));
+    let name = printable(&grid.name, MAX_GRID_NAME_CHARS);
     let title_lines = vec![
-        format!(
-            "{} — illuminance ({unit})",
-            printable(&grid.name, MAX_GRID_NAME_CHARS)
-        ),
-        format!(
-            "Emin {}   Eavg {}   Emax {} {unit}   U₀ = Emin/Eavg = {}   Emin/Emax = {}",
-            format_sig(stats.min, 4),
-            format_sig(stats.avg, 4),
-            format_sig(stats.max, 4),
-            ratio(stats.u0),
-            ratio(stats.min_over_max),
-        ),
+        match metric {
+            Some(m) => format!("{name} — {} ({unit})", m.name),
+            None => format!("{name} — illuminance ({unit})"),
+        },
+        match metric {
+            Some(_) => format!(
+                "min {}   mean {}   max {} {unit}",
+                format_sig(stats.min, 4),
+                format_sig(stats.avg, 4),
+                format_sig(stats.max, 4),
+            ),
+            None => format!(
+                "Emin {}   Eavg {}   Emax {} {unit}   U₀ = Emin/Eavg = {}   Emin/Emax = {}",
+                format_sig(stats.min, 4),
+                format_sig(stats.avg, 4),
+                format_sig(stats.max, 4),
+                ratio(stats.u0),
+                ratio(stats.min_over_max),
+            ),
+        },
         {
             let len = units.length_symbol();
             let mut s = format!(
