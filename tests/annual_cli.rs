@@ -109,11 +109,11 @@ fn a_year_on_the_shoebox_is_consistent_with_its_hourly_csv() {
         assert!(img.width() > 300 && img.height() > 300);
     }
 
-    // The CSV: month, day, hour, then (E, se) per point, for every daylight hour.
+    // The CSV: month, day, hour, then (E, se, direct sun) per point, for every daylight hour.
     let csv = std::fs::read_to_string(dir.join("sb.annual.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(header.len(), 3 + 2 * 35);
+    assert_eq!(header.len(), 3 + 3 * 35);
     assert_eq!(header[3], "work plane[0;0]_lx");
     let mut da = [0usize; 35];
     let mut udi = [[0usize; 3]; 35];
@@ -127,8 +127,9 @@ fn a_year_on_the_shoebox_is_consistent_with_its_hourly_csv() {
             continue;
         }
         for p in 0..35 {
-            let e = v[3 + 2 * p];
-            assert!(v[4 + 2 * p] >= 0.0);
+            let e = v[3 + 3 * p];
+            assert!(v[4 + 3 * p] >= 0.0);
+            assert!(v[5 + 3 * p] >= 0.0 && v[5 + 3 * p] <= e + 1e-6);
             if e >= 300.0 {
                 da[p] += 1;
             }

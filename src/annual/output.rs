@@ -102,7 +102,8 @@ pub fn write_json(path: &Path, run: &AnnualRun) -> Result<(), OutputError> {
 }
 
 /// Writes the hourly CSV: one row per hour with daylight, the columns `month,day,hour` (the
-/// EPW record hour, 1–24), then per grid point its illuminance and standard error (lx).
+/// EPW record hour, 1–24), then per grid point its illuminance, standard error and direct
+/// sunlight (lx).
 pub fn write_csv(path: &Path, run: &AnnualRun) -> Result<(), OutputError> {
     let h = &run.hourly;
     crate::output::write_atomic(path, |w| {
@@ -111,7 +112,10 @@ pub fn write_csv(path: &Path, run: &AnnualRun) -> Result<(), OutputError> {
             let name = g.name.replace([',', '"', '\n', '\r'], "_");
             for k in 0..g.points.len() {
                 let (i, j) = (k % g.nx as usize, k / g.nx as usize);
-                write!(w, ",{name}[{i};{j}]_lx,{name}[{i};{j}]_stderr_lx")?;
+                write!(
+                    w,
+                    ",{name}[{i};{j}]_lx,{name}[{i};{j}]_stderr_lx,{name}[{i};{j}]_direct_sun_lx"
+                )?;
             }
         }
         writeln!(w)?;
@@ -122,7 +126,7 @@ pub fn write_csv(path: &Path, run: &AnnualRun) -> Result<(), OutputError> {
             write!(w, "{},{},{}", hs.month, hs.day, hs.hour)?;
             for r in 0..h.receivers {
                 let i = t * h.receivers + r;
-                write!(w, ",{:.6},{:.6}", h.mean[i], h.stderr[i])?;
+                write!(w, ",{:.6},{:.6},{:.6}", h.mean[i], h.stderr[i], h.direct[i])?;
             }
             writeln!(w)?;
         }
