@@ -310,7 +310,7 @@ fn polygon_area(pts: &[[f64; 2]]) -> f64 {
 pub fn colour_rendition(spectrum: &[f64; LEN]) -> Option<ColourRendition> {
     let test: [f64; N] = std::array::from_fn(|i| spectrum[FIRST + i]);
     let xyz2 = sums(|i| test[i], Observer::Cie1931_2);
-    if !(xyz2[1] > 0.0) || !xyz2.iter().all(|v| v.is_finite()) {
+    if xyz2[1] <= 0.0 || !xyz2.iter().all(|v| v.is_finite()) {
         return None;
     }
     let [cct_k, duv] = uv_to_cct_ohno2013(xyz_to_uv1960(xyz2));

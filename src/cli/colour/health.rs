@@ -220,7 +220,7 @@ pub fn add_text(line: &mut dyn FnMut(&str, String), e: &Extras) {
                 .join(" ")
         };
         line(
-            "  irradiance (W/m² if S is W·m⁻²·nm⁻¹)",
+            "  E_e,α (W/m²; S in W·m⁻²·nm⁻¹)",
             format!("{:.6e}", q.irradiance_w_m2[0])
                 + &q.irradiance_w_m2[1..]
                     .iter()
@@ -331,19 +331,20 @@ pub fn write_cvg(path: &Path, r: &ColourRendition) -> anyhow::Result<()> {
         &format!("TM-30-20  Rf {:.0}  Rg {:.0}", r.rf, r.rg),
         draw::BLACK,
     );
-    draw::draw_text(
-        &mut img,
-        12,
-        SIZE as i32 - 30,
-        15.0,
-        &format!(
-            "CCT {:.0} K, Duv {:+.4}; black circle: reference ({})",
-            r.cct_k,
-            r.duv,
-            reference_name(r.reference)
+    for (k, text) in [
+        format!(
+            "reference (black circle): {} at {:.0} K",
+            reference_name(r.reference),
+            r.cct_k
         ),
-        draw::DARK_GREY,
-    );
+        format!("test source (red), Duv {:+.4}", r.duv),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let y = SIZE as i32 - 50 + 22 * k as i32;
+        draw::draw_text(&mut img, 12, y, 14.0, text, draw::DARK_GREY);
+    }
     candela::output::write_rgb_png(path, &img)
         .with_context(|| format!("writing the colour vector graphic {}", path.display()))?;
     Ok(())
