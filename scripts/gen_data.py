@@ -171,6 +171,20 @@ def main() -> int:
         {k: aligned(s, linear=True) for k, s in basis.items()},
     )
 
+    # colour-science's CIE 2017 colour fidelity index builds its daylight reference with
+    # sd_CIE_illuminant_D_series(xy, shape=...), which reshapes the basis itself with its own
+    # (Sprague) interpolator before combining; colour/tm30.rs uses these for exact agreement.
+    write(
+        "daylight-basis-sprague.csv",
+        "# CIE daylight basis functions S0, S1, S2, Sprague-interpolated to 1 nm\n"
+        f"# source: colour-science {VERSION}, "
+        "colour.colorimetry.SDS_BASIS_FUNCTIONS_CIE_ILLUMINANT_D_SERIES[S0|S1|S2]"
+        ".copy().align(SpectralShape(360, 830, 1))\n"
+        "#   (the basis' own SpragueInterpolator), as sd_CIE_illuminant_D_series(xy, shape)\n"
+        "#   reshapes them for colour.quality.colour_fidelity_index_CIE2017\n" + LICENCE_CIE,
+        {k: aligned(s) for k, s in basis.items()},
+    )
+
     # --- ColorChecker ---------------------------------------------------------------
     cc = colour.SDS_COLOURCHECKERS["ColorChecker N Ohta"]
     first = next(iter(cc.values()))
@@ -198,8 +212,77 @@ def main() -> int:
         {k: aligned(s) for k, s in tcs.items() if k in [f"TCS{i:02d}" for i in range(1, 15)]},
     )
 
+    write_alpha_opic()
+    write_ces()
     write_cornell()
     return 0
+
+
+def write_alpha_opic() -> None:
+    """CIE S 026 action spectra from luxpy's copy of the CIE S 026 table (read as a file, so
+    the script does not import luxpy itself)."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("luxpy")
+    assert spec is not None, "luxpy is not installed (scripts/setup_python.sh)"
+    pkg = os.path.dirname(spec.origin)
+    rel = "toolboxes/photbiochem/data/S026_Table2_Data_downloaded_04062025.csv"
+    src = np.genfromtxt(os.path.join(pkg, rel), delimiter=",", skip_header=1)[:, :6]
+    nm = src[:, 0]
+    assert nm[0] == 380 and nm[-1] == 780 and np.all(np.diff(nm) == 1)
+    # File columns: nm, s-cone, m-cone, l-cone, rhodopic, melanopic; empty cells (the cone
+    # functions below 390 nm) are zero, as luxpy sums them.
+    cols = {}
+    for i, name in enumerate(["s_cone", "m_cone", "l_cone", "rhodopic", "melanopic"]):
+        v = np.zeros(len(WL))
+        v[(WL >= 380) & (WL <= 780)] = np.nan_to_num(src[:, i + 1], nan=0.0)
+        cols[name] = v
+    write(
+        "alpha-opic-cie-s026.csv",
+        "# CIE S 026/E:2018 alpha-opic action spectra s_alpha(lambda), each 1 at its peak:\n"
+        "#   s_cone (cyanopic), m_cone (chloropic), l_cone (erythropic), rhodopic, melanopic\n"
+        "# source: the CIE S 026 Table 2 data (CIE S 026 alpha-opic toolbox, 380-780 nm at 1 nm)\n"
+        f"#   as shipped by luxpy {_luxpy_version(pkg)} in luxpy/{rel}\n"
+        "#   (luxpy.toolboxes.photbiochem._ACTIONSPECTRA_CIES026); values copied unchanged\n"
+        "# zero outside 380-780 nm (S 026 defines them there only) and where the table has\n"
+        "#   no value (the cone functions below 390 nm), as luxpy sums them\n"
+        "# licence: published by the CIE; factual data\n",
+        cols,
+    )
+
+
+def write_ces() -> None:
+    """The 99 CIE 2017 / TM-30 colour evaluation samples, 380-780 nm at 1 nm (their native
+    range; CIE 224:2017 evaluates on 380-780 nm only)."""
+    from colour.quality.cfi2017 import load_TCS_CIE2017
+
+    tcs = load_TCS_CIE2017(SpectralShape(380, 780, 1))
+    assert tcs.values.shape == (401, 99), tcs.values.shape
+    path = os.path.join(DATA, "ces-cie2017.csv")
+    names = [f"CES{i + 1:02d}" for i in range(99)]
+    with open(path, "w", encoding="utf-8", newline="\n") as f:
+        f.write(
+            "# CIE 224:2017 / ANSI/IES TM-30 colour evaluation samples CES01-CES99 (spectral\n"
+            "#   reflectance factors)\n"
+            f"# source: colour-science {VERSION}, colour.quality.cfi2017.load_TCS_CIE2017("
+            "SpectralShape(380, 780, 1))\n"
+            "#   (colour/quality/datasets/tcs_cfi2017_1_nm.csv.gz, the CIE 224:2017 1 nm table;\n"
+            "#   colour-science labels them 'TCS0'..'TCS98', here CES01..CES99 in the same order)\n"
+            "# licence: published by the CIE (CIE 224:2017) and IES (TM-30); redistributed by\n"
+            "#   colour-science (BSD-3-Clause); the tabulated values are factual data.\n"
+            f"# regenerate: {REGEN}\n"
+            "# sampling: 380-780 nm every 1 nm (401 rows; the samples are defined there only)\n"
+        )
+        f.write("nm," + ",".join(names) + "\n")
+        for i, w in enumerate(tcs.wavelengths):
+            f.write(str(int(w)) + "," + ",".join(fmt(v) for v in tcs.values[i]) + "\n")
+    print(f"wrote {path}")
+
+
+def _luxpy_version(pkg: str) -> str:
+    import importlib.metadata
+
+    return importlib.metadata.version("luxpy")
 
 
 CORNELL = """\

@@ -15,11 +15,16 @@ PYTHON="${PYTHON:-python3}"
 
 # Pinned versions: colour-science 0.4.7 and the only dependency it pulls in (numpy);
 # pyradiance 1.3.1 (Radiance 6's binaries: gensky, gendaylit, rtrace) and ladybug-core
-# 0.44.62 (EPW weather files) for the daylight tests.
-# SciPy/matplotlib are optional for colour-science and not needed by candela's scripts.
+# 0.44.62 (EPW weather files) for the daylight tests; luxpy 1.12.5 (CIE S 026 alpha-opic
+# quantities, CIE 191 mesopic photometry; tests/colour_health.rs and data/alpha-opic-*.csv),
+# which imports scipy and matplotlib at start-up. numpy stays below 2.4: luxpy 1.12.5 calls
+# float() on 1-element arrays, which numpy 2.4 refuses.
 PINS=(
   "colour-science==0.4.7"
-  "numpy==2.4.6"
+  "numpy==2.3.5"
+  "luxpy==1.12.5"
+  "scipy==1.17.1"
+  "matplotlib==3.10.7"
   "pyradiance==1.3.1"
   "ladybug-core==0.44.62"
   "ladybug-geometry==1.35.6"
@@ -38,5 +43,7 @@ warnings.filterwarnings("ignore")
 import colour, numpy
 assert colour.__version__ == "0.4.7", colour.__version__
 import pyradiance, ladybug.epw
-print(f"ok: colour-science {colour.__version__}, numpy {numpy.__version__}")
+import luxpy
+assert luxpy.__version__.lstrip("v") == "1.12.5", luxpy.__version__
+print(f"ok: colour-science {colour.__version__}, luxpy {luxpy.__version__}, numpy {numpy.__version__}")
 PY

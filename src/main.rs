@@ -61,7 +61,7 @@ enum Command {
         #[arg(long, allow_hyphen_values = true)]
         exposure: Option<f64>,
     },
-    /// Colorimetry of a spectrum: XYZ, xy, u′v′, CCT, Duv, efficacy, S/P, sRGB, CRI.
+    /// Colorimetry of a spectrum: XYZ, xy, u′v′, CCT, Duv, efficacy, S/P, sRGB, CRI, α-opic (CIE S 026), TM-30 Rf/Rg.
     Spectrum {
         /// A CSV file (nm,value), a named spectrum (D65, FL2, LED-B3, …) or blackbody:3000K.
         source: String,
@@ -71,6 +71,15 @@ enum Command {
         /// Print JSON instead of a table.
         #[arg(long)]
         json: bool,
+        /// Also print XYZ and xy exactly as colour-science's sd_to_XYZ with this method.
+        #[arg(long, value_parser = ["integration", "astm-e308"])]
+        method: Option<String>,
+        /// Also print the luminous efficacy of radiation by this rule (trapezoid = colour-science).
+        #[arg(long, value_parser = ["sum", "trapezoid"])]
+        efficacy_rule: Option<String>,
+        /// Write the TM-30 colour vector graphic of a light source to this PNG.
+        #[arg(long)]
+        cvg: Option<PathBuf>,
     },
     /// Convert a photometric value between units, e.g. `candela convert 100 lx fc`.
     Convert {
@@ -112,13 +121,23 @@ fn main() -> ExitCode {
             source,
             observer,
             json,
+            method,
+            efficacy_rule,
+            cvg,
         } => {
             let obs = if observer == "1964" {
                 Observer::Cie1964_10
             } else {
                 Observer::Cie1931_2
             };
-            cli::colour::spectrum_command(&source, obs, json).map(|s| {
+            // clap has checked the values: parsing cannot fail.
+            let opts = cli::colour::health::SpectrumOptions {
+                method: method.map(|m| cli::colour::health::parse_method(&m).expect("clap value")),
+                efficacy_rule: efficacy_rule
+                    .map(|r| cli::colour::health::parse_efficacy_rule(&r).expect("clap value")),
+                cvg,
+            };
+            cli::colour::spectrum_command_with(&source, obs, json, &opts).map(|s| {
                 if json {
                     say_json!("{s}")
                 } else {

@@ -97,9 +97,14 @@ fn spectrum_text_and_json_keys() {
         "srgb_linear",
         "srgb_encoded",
         "cri",
+        "alpha_opic",
+        "colour_rendition",
     ] {
         assert!(j.get(k).is_some(), "JSON key {k} missing");
     }
+    // Reflectances get neither α-opic quantities nor colour rendition.
+    let r = json("colorchecker:1", Observer::Cie1931_2);
+    assert!(r.get("alpha_opic").is_none() && r.get("colour_rendition").is_none());
     assert_eq!(j["cri"]["r"].as_array().unwrap().len(), 14);
 }
 

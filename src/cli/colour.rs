@@ -6,6 +6,10 @@
 
 use serde_json::json;
 
+#[path = "colour/health.rs"]
+pub mod health;
+use health::SpectrumOptions;
+
 use candela::colour::tables::Observer;
 
 use candela::colour::grid::{END_NM, START_NM};
@@ -29,9 +33,25 @@ fn observer_name(o: Observer) -> &'static str {
 ///
 /// XYZ, xy and u′v′ use `observer`; CCT, Duv, sRGB and the CRI are defined for (and always
 /// use) the CIE 1931 2° observer.
+/// The binary calls [`spectrum_command_with`]; the tests call this.
+#[allow(dead_code)]
 pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow::Result<String> {
+    spectrum_command_with(source, observer, json, &SpectrumOptions::default())
+}
+
+/// [`spectrum_command`] with the options of [`SpectrumOptions`]: lights also get their CIE
+/// S 026 α-opic quantities and TM-30-20 / CIE 224:2017 colour rendition; `--method` and
+/// `--efficacy-rule` add XYZ and efficacy by the chosen method; `--cvg` writes TM-30's colour
+/// vector graphic.
+pub fn spectrum_command_with(
+    source: &str,
+    observer: Observer,
+    json: bool,
+    opts: &SpectrumOptions,
+) -> anyhow::Result<String> {
     let src = resolve_source(source)?;
     let c = spectrum_colorimetry(&src, observer)?;
+    let extras = health::extras(&src.table, src.reflectance, observer, opts)?;
     let (xyz_n, xyz_abs, xy, upvp, uv) = (c.xyz_y100, c.xyz_absolute, c.xy, c.upvp, c.uv_1960);
     let (ohno, rob) = (c.cct_duv_ohno, c.cct_duv_robertson);
     let (efficacy, sp) = (c.luminous_efficacy_lm_per_w, c.sp_ratio);
@@ -73,6 +93,7 @@ pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow:
             j["object_under_d65"] =
                 json!({"xyz": xyz_o, "lab": lab, "srgb_linear": lin, "srgb_encoded": enc});
         }
+        health::add_json(&mut j, &extras);
         return Ok(serde_json::to_string_pretty(&j)? + "\n");
     }
 
@@ -167,6 +188,7 @@ pub fn spectrum_command(source: &str, observer: Observer, json: bool) -> anyhow:
             ),
         );
     }
+    health::add_text(&mut line, &extras);
     for n in &notes {
         line("note", n.clone());
     }

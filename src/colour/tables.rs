@@ -166,6 +166,7 @@ const DAYLIGHT: &str = include_str!("../../data/daylight-basis.csv");
 const COLORCHECKER: &str = include_str!("../../data/colorchecker-ohta.csv");
 const TCS: &str = include_str!("../../data/tcs-cie13.3.csv");
 const CORNELL: &str = include_str!("../../data/cornell-box.csv");
+const ALPHA_OPIC: &str = include_str!("../../data/alpha-opic-cie-s026.csv");
 
 fn load_cmfs(text: &str, origin: &str) -> Cmfs {
     let t = parse_table(text, origin);
@@ -210,6 +211,17 @@ pub fn photopic_v() -> &'static [f64; LEN] {
 /// defined 380–780 nm range, as colour-science's `luminous_flux` aligns it).
 pub fn scotopic_v() -> &'static [f64; LEN] {
     &LEFS.1
+}
+
+/// CIE S 026 α-opic action spectra `[s-cone, m-cone, l-cone, rhodopic, melanopic]`, each 1 at
+/// its peak, 360–830 nm at 1 nm (zero outside S 026's 380–780 nm); see `colour::alpha_opic`.
+pub fn alpha_opic_action_spectra() -> &'static [[f64; LEN]; 5] {
+    static T: LazyLock<[[f64; LEN]; 5]> = LazyLock::new(|| {
+        let o = "data/alpha-opic-cie-s026.csv";
+        let t = parse_table(ALPHA_OPIC, o);
+        ["s_cone", "m_cone", "l_cone", "rhodopic", "melanopic"].map(|c| t.column_1nm(c, o))
+    });
+    &T
 }
 
 /// CIE daylight basis functions `[S0, S1, S2]`, 360–830 nm at 1 nm (CIE 15:2018 table,
