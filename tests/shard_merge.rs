@@ -528,3 +528,57 @@ fn the_shard_comes_from_slurm_aws_batch_or_kubernetes() {
         "{err}"
     );
 }
+
+#[test]
+fn a_shard_stopped_by_sigterm_continues_to_the_uninterrupted_state() {
+    // What Slurm sends a pre-empted or cancelled task: the shard checkpoints at the end of its
+    // pass, and the requeued task (the same command) continues it.
+    let t = tempfile::tempdir().unwrap();
+    let dir = t.path();
+    scene(dir, "s.ron", RHO);
+    let args = [
+        "render",
+        "s.ron",
+        "--quiet",
+        "--threads",
+        "1",
+        "--shard",
+        "1/2",
+        "--spp",
+        "2048",
+        "--out",
+    ];
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_candela"))
+        .current_dir(dir)
+        .args(args)
+        .arg("part")
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(150));
+    let _ = std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status();
+    let status = child.wait().unwrap();
+    let state = dir.join(shard_state("part", 1, 2));
+    if status.code() == Some(130) && state.exists() {
+        let st = candela::state::RenderState::load(&state).unwrap();
+        assert!(st.film.pixels[0].count < 512);
+        println!("stopped at {} of 512 spp", st.film.pixels[0].count);
+    } else {
+        println!("not stopped mid-way ({status:?}): the rerun starts or continues it");
+    }
+    let mut args: Vec<&str> = args.to_vec();
+    args.push("part");
+    let (code, _, err) = run_env(dir, &args, &[]);
+    assert_eq!(code, 0, "{err}");
+    args.pop();
+    args.push("whole");
+    let (code, _, err) = run_env(dir, &args, &[]);
+    assert_eq!(code, 0, "{err}");
+    let a = std::fs::read(dir.join(shard_state("whole", 1, 2))).unwrap();
+    let b = std::fs::read(&state).unwrap();
+    assert!(
+        a == b,
+        "the requeued shard's state differs from the uninterrupted one"
+    );
+}
