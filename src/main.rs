@@ -49,18 +49,8 @@ struct Cli {
 enum Command {
     /// Render a scene to NAME.exr (absolute XYZ, Y = luminance in cd/m², plus its standard error) and NAME.png (sRGB).
     Render(Box<cli::render::RenderOpts>),
-    /// Combine independent renders of the same scene (different seeds) from their state files into one estimate.
-    Merge {
-        /// State files written with --save-state (or checkpoints).
-        #[arg(required = true, num_args = 2..)]
-        states: Vec<PathBuf>,
-        /// Output name: writes OUT.exr, OUT.png and OUT.state; an existing directory (or a path ending in `/`) writes DIR/merged.exr, .png and .state. Refused if an output would replace an input.
-        #[arg(short, long)]
-        out: PathBuf,
-        /// Exposure of the PNG in EV, between -100 and 100 (default: automatic).
-        #[arg(long, allow_hyphen_values = true)]
-        exposure: Option<f64>,
-    },
+    /// Combine independent renders of the same scene (different seeds), or the shards of one render (render --shard), from their state files into one estimate.
+    Merge(cli::render::MergeOpts),
     /// Colorimetry of a spectrum: XYZ, xy, u′v′, CCT, Duv, efficacy, S/P, sRGB, CRI, α-opic (CIE S 026), TM-30 Rf/Rg.
     Spectrum {
         /// A CSV file (nm,value), a named spectrum (D65, FL2, LED-B3, …) or blackbody:3000K.
@@ -112,11 +102,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(opts) => cli::render::render(&opts),
-        Command::Merge {
-            states,
-            out,
-            exposure,
-        } => cli::render::merge(&states, &out, exposure),
+        Command::Merge(opts) => cli::render::merge(&opts),
         Command::Spectrum {
             source,
             observer,

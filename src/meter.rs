@@ -226,22 +226,151 @@ fn from_batches(sums: &[f64], n: u64, non_finite: u64) -> Estimate {
     }
 }
 
-/// Results of all meters and grids of a world.
-#[derive(Clone, Debug, Default)]
-pub struct Measurements {
-    pub meters: Vec<Estimate>,
-    /// Per grid, row-major (j·nx + i).
-    pub grids: Vec<Vec<Estimate>>,
-    pub stats: RayStats,
+/// The batch sums behind one meter's or grid point's estimate, as a shard of a render stores
+/// them so that `candela merge` can add the shards' samples: batch b of every shard continues
+/// the same scrambled sequence (shard I takes samples I·P … (I+1)·P − 1 of it, P =
+/// `per_batch`), so the merged batches stay independent of each other.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MeterSums {
+    /// The meter's name, or the grid's name for a grid point.
+    pub name: String,
+    /// A grid point's (i, j, nx, ny); None for a meter.
+    pub grid: Option<[u32; 4]>,
+    /// Whether the meter measures luminance (cd/m²); else illuminance (lx).
+    pub luminance: bool,
+    /// Σ of each batch's samples (lx or cd/m²).
+    pub sums: [f64; BATCHES as usize],
+    /// Samples in each batch.
+    pub per_batch: u64,
+    /// Samples that were not finite (counted as 0).
+    pub non_finite: u64,
 }
 
-/// Measure every meter and grid point in parallel (each with its own stream).
-pub fn measure_all(world: &World) -> Measurements {
-    measure_all_until(world, &AtomicBool::new(false)).expect("never stopped")
+impl MeterSums {
+    /// The estimate from these sums (zero without samples).
+    pub fn estimate(&self) -> Estimate {
+        if self.per_batch == 0 {
+            return Estimate::default();
+        }
+        from_batches(&self.sums, self.per_batch, self.non_finite)
+    }
+    /// Add the sums of the next shard of the same meter.
+    pub fn merge(&mut self, o: &MeterSums) {
+        for (a, b) in self.sums.iter_mut().zip(&o.sums) {
+            *a += b;
+        }
+        self.per_batch += o.per_batch;
+        self.non_finite += o.non_finite;
+    }
 }
 
-/// [`measure_all`], giving up (`None`) soon after `stop` is set (e.g. by Ctrl-C).
-pub fn measure_all_until(world: &World, stop: &AtomicBool) -> Option<Measurements> {
+/// Samples per batch of one shard of `count` for a meter budget of `samples`: the batch size of
+/// the whole budget ([`batch_size`]) shared out, rounded up; a target relative error is not
+/// pursued (each shard would stop on its own share's error).
+pub fn shard_batch_size(samples: u64, count: u32) -> u64 {
+    batch_size(samples).div_ceil(count as u64)
+}
+
+/// Measure shard `index` of `count` of every meter and grid point: samples
+/// index·P … (index+1)·P − 1 of each batch ([`shard_batch_size`]), with their batch sums.
+pub fn measure_shard_until(
+    world: &World,
+    index: u32,
+    count: u32,
+    stop: &AtomicBool,
+) -> Option<(Measurements, Vec<MeterSums>)> {
+    let per = shard_batch_size(world.measure.samples, count);
+    let first = index as u64 * per;
+    let mut labels = Vec::new();
+    for m in &world.meters {
+        let luminance = matches!(m.kind, MeterKind::Luminance { .. });
+        labels.push((m.name.clone(), None, luminance));
+    }
+    for grid in &world.grids {
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                labels.push((grid.name.clone(), Some([i, j, grid.nx, grid.ny]), false));
+            }
+        }
+    }
+    let results: Vec<(([f64; BATCHES as usize], u64), RayStats)> = jobs(world)
+        .par_iter()
+        .map(|(kind, stream)| {
+            let mut stats = RayStats::default();
+            let r = sum_range(first, per, stop, |batch, s| {
+                sample_meter(world, kind, *stream, batch, s, &mut stats)
+            })?;
+            Some((r, stats))
+        })
+        .collect::<Option<_>>()?;
+    let mut sums = Vec::with_capacity(results.len());
+    let mut estimates = Vec::with_capacity(results.len());
+    for (((batch_sums, non_finite), stats), (name, grid, luminance)) in
+        results.into_iter().zip(labels)
+    {
+        let m = MeterSums {
+            name,
+            grid,
+            luminance,
+            sums: batch_sums,
+            per_batch: per,
+            non_finite,
+        };
+        estimates.push((m.estimate(), stats));
+        sums.push(m);
+    }
+    Some((collect(world, estimates), sums))
+}
+
+/// The batch sums of samples `first .. first + per` of every batch, and how many were not
+/// finite; `None` once `stop` is set.
+fn sum_range(
+    first: u64,
+    per: u64,
+    stop: &AtomicBool,
+    mut sample: impl FnMut(u32, u64) -> Option<f64>,
+) -> Option<([f64; BATCHES as usize], u64)> {
+    let (mut sums, mut non_finite) = ([0.0f64; BATCHES as usize], 0u64);
+    let mut taken = 0u64;
+    for (b, sum) in sums.iter_mut().enumerate() {
+        for s in first..first + per {
+            if taken % POLL == 0 && stop.load(Ordering::Relaxed) {
+                return None;
+            }
+            taken += 1;
+            *sum += sample(b as u32, s).unwrap_or_else(|| {
+                non_finite += 1;
+                0.0
+            });
+        }
+    }
+    Some((sums, non_finite))
+}
+
+/// Rebuild a world's [`Measurements`] from one estimate per meter and grid point, in the
+/// order of [`jobs`].
+pub fn collect(world: &World, results: Vec<(Estimate, RayStats)>) -> Measurements {
+    let mut out = Measurements::default();
+    let mut it = results.into_iter();
+    for _ in &world.meters {
+        let (e, s) = it.next().expect("one result per job");
+        out.stats.merge(&s);
+        out.meters.push(e);
+    }
+    for grid in &world.grids {
+        let mut v = Vec::with_capacity((grid.nx * grid.ny) as usize);
+        for _ in 0..grid.nx * grid.ny {
+            let (e, s) = it.next().expect("one result per job");
+            out.stats.merge(&s);
+            v.push(e);
+        }
+        out.grids.push(v);
+    }
+    out
+}
+
+/// Every meter and grid point with its stream: the meters, then each grid's points row by row.
+fn jobs(world: &World) -> Vec<(MeterKind, u64)> {
     let mut jobs: Vec<(MeterKind, u64)> = Vec::new();
     for (k, m) in world.meters.iter().enumerate() {
         jobs.push((m.kind.clone(), mix64(0x6d65_7465_7200 ^ k as u64)));
@@ -259,7 +388,26 @@ pub fn measure_all_until(world: &World, stop: &AtomicBool) -> Option<Measurement
             }
         }
     }
-    let results: Vec<(Estimate, RayStats)> = jobs
+    jobs
+}
+
+/// Results of all meters and grids of a world.
+#[derive(Clone, Debug, Default)]
+pub struct Measurements {
+    pub meters: Vec<Estimate>,
+    /// Per grid, row-major (j·nx + i).
+    pub grids: Vec<Vec<Estimate>>,
+    pub stats: RayStats,
+}
+
+/// Measure every meter and grid point in parallel (each with its own stream).
+pub fn measure_all(world: &World) -> Measurements {
+    measure_all_until(world, &AtomicBool::new(false)).expect("never stopped")
+}
+
+/// [`measure_all`], giving up (`None`) soon after `stop` is set (e.g. by Ctrl-C).
+pub fn measure_all_until(world: &World, stop: &AtomicBool) -> Option<Measurements> {
+    let results: Vec<(Estimate, RayStats)> = jobs(world)
         .par_iter()
         .map(|(kind, stream)| {
             let mut stats = RayStats::default();
@@ -267,23 +415,7 @@ pub fn measure_all_until(world: &World, stop: &AtomicBool) -> Option<Measurement
             Some((e, stats))
         })
         .collect::<Option<_>>()?;
-    let mut out = Measurements::default();
-    let mut it = results.into_iter();
-    for _ in &world.meters {
-        let (e, s) = it.next().expect("one result per job");
-        out.stats.merge(&s);
-        out.meters.push(e);
-    }
-    for grid in &world.grids {
-        let mut v = Vec::with_capacity((grid.nx * grid.ny) as usize);
-        for _ in 0..grid.nx * grid.ny {
-            let (e, s) = it.next().expect("one result per job");
-            out.stats.merge(&s);
-            v.push(e);
-        }
-        out.grids.push(v);
-    }
-    Some(out)
+    Some(collect(world, results))
 }
 
 /// Samples of a grid's points that were not finite (see [`Estimate::non_finite`]).

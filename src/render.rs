@@ -149,6 +149,10 @@ pub struct Progressive {
     pub max_time: Option<Duration>,
     /// Call the checkpoint callback at the end of the first pass after each interval.
     pub checkpoint_interval: Option<Duration>,
+    /// Index of every pixel's first sample in its random stream, and of the first caustic light
+    /// path: a shard of a render takes its own range of the sequences (0 for a whole render).
+    pub first_sample: u64,
+    pub first_light_path: u64,
 }
 
 /// "Every pixel's luminance known to ±`relative` at 95 % confidence".
@@ -360,7 +364,7 @@ pub fn render_progressive(
                                 // sequence, the decision buffer draws from another scramble.
                                 Some(d) => {
                                     let half = plan[i] / 2;
-                                    let first = est.count;
+                                    let first = prog.first_sample + est.count;
                                     render_pixel(
                                         world,
                                         seed,
@@ -372,7 +376,7 @@ pub fn render_progressive(
                                         est_e.as_mut(),
                                         &mut r.stats,
                                     );
-                                    let first = d.count;
+                                    let first = prog.first_sample + d.count;
                                     render_pixel(
                                         world,
                                         seed ^ DECISION_STREAM,
@@ -386,7 +390,7 @@ pub fn render_progressive(
                                     );
                                 }
                                 None => {
-                                    let first = est.count;
+                                    let first = prog.first_sample + est.count;
                                     render_pixel(
                                         world,
                                         seed,
@@ -430,7 +434,7 @@ pub fn render_progressive(
                 &[CAUSTIC_STREAM]
             };
             for (b, &stream) in streams.iter().enumerate() {
-                let first = film.light_paths[b];
+                let first = prog.first_light_path + film.light_paths[b];
                 let seed = world.settings.seed ^ stream;
                 let mut sums = vec![[0.0f64; 6]; w * h];
                 let traced = pool.install(|| {

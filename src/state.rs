@@ -11,6 +11,7 @@
 //! allocated for them; then the values ([`Film::check`]).
 
 use crate::film::{Film, IlluminanceSums, PixelSums};
+use crate::meter::MeterSums;
 use crate::output::write_atomic;
 use crate::sampling::mix64;
 use crate::scene::build::MAX_PIXELS;
@@ -21,9 +22,10 @@ use std::path::Path;
 pub const MAGIC: &str = "candela-render-state";
 /// Format version: 4 added the checksum, 12 the per-pixel batch sums with the illuminance sums
 /// in buffers of their own (12 because no single flipped bit turns it into one of the
-/// unchecked versions 1–3, see [`RenderState::decode`]); other versions are refused with a
-/// message.
-pub const VERSION: u32 = 12;
+/// unchecked versions 1–3, see [`RenderState::decode`]), 13 the shard a state renders
+/// ([`ShardInfo`]; no single flipped bit turns 13 into 1–3 either); other versions are refused
+/// with a message.
+pub const VERSION: u32 = 13;
 
 /// Bytes of the checksum at the end of the file.
 const CHECKSUM_BYTES: usize = 8;
@@ -33,6 +35,9 @@ const PIXEL_FLOATS: u64 = 8 + crate::film::PIXEL_BATCHES as u64;
 const E_FLOATS: u64 = 4 + crate::film::PIXEL_BATCHES as u64;
 const MIN_PIXEL_BYTES: u64 = PIXEL_FLOATS * 8 + 2;
 const MIN_E_BYTES: u64 = E_FLOATS * 8 + 1;
+/// Encoded size of one [`MeterSums`] at least: its 16 batch sums of 8 bytes, the name's length,
+/// the grid tag, the luminance flag and two varints.
+const MIN_METER_BYTES: u64 = crate::meter::BATCHES as u64 * 8 + 5;
 /// Most bytes of a pixel of one buffer with its illuminance sums.
 const MAX_PIXEL_BYTES: u64 = (PIXEL_FLOATS + E_FLOATS) * 8 + 3 * 10;
 /// Longest scene name (the path the state was rendered from) and longest merged-seed list a
@@ -41,8 +46,14 @@ pub const MAX_SCENE_NAME_BYTES: u64 = 64 << 10;
 pub const MAX_MERGED_SEEDS: u64 = 1 << 20;
 /// Largest state file read: that of the largest film allowed ([`MAX_PIXELS`], adaptive: two
 /// buffers), with the longest name and seed list, the fixed fields and the checksum.
-pub const MAX_STATE_BYTES: u64 =
-    2 * MAX_PIXELS * MAX_PIXEL_BYTES + MAX_SCENE_NAME_BYTES + 10 * MAX_MERGED_SEEDS + 1024;
+pub const MAX_STATE_BYTES: u64 = 2 * MAX_PIXELS * MAX_PIXEL_BYTES
+    + MAX_SCENE_NAME_BYTES
+    + 10 * MAX_MERGED_SEEDS
+    + MAX_METERS * 256
+    + 1024;
+/// Most meters and grid points whose sums a state file is read with (at most 256 bytes each
+/// with a short name).
+pub const MAX_METERS: u64 = 1 << 20;
 
 /// The contents of a state file. Reading decodes the fields in this order by hand (see
 /// [`RenderState::decode`]); a change here is a new [`VERSION`] and a change there.
@@ -58,10 +69,30 @@ pub struct RenderState {
     pub max_depth: u32,
     pub illuminance: bool,
     pub film: Film,
+    /// The shard of a render this state holds (`candela render --shard`); None for a whole
+    /// render or a merge.
+    pub shard: Option<ShardInfo>,
+    /// A finished shard's meter and grid-point batch sums (meters first, then each grid's
+    /// points row by row), for `candela merge`; empty otherwise.
+    pub meters: Vec<MeterSums>,
     /// The other seeds a merged state contains (`candela merge`; empty for one render), so a
     /// later merge can refuse a seed that is already in it.
     pub merged_seeds: Vec<u64>,
 }
+
+/// Which part of a sharded render a state holds: shard `index` of `count` (0-based) renders
+/// samples `index·spp .. (index+1)·spp` of every pixel's sequence, so the `count` shards
+/// together take the samples of one render at `count·spp`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ShardInfo {
+    pub index: u32,
+    pub count: u32,
+    /// Samples per pixel of a finished shard.
+    pub spp: u32,
+}
+
+/// Most shards a render may be split into.
+pub const MAX_SHARDS: u32 = 1 << 20;
 
 /// The fields of a [`RenderState`] with everything borrowed: what is written, so that saving a
 /// render's film needs no copy of it.
@@ -75,6 +106,8 @@ struct StateRef<'a> {
     max_depth: u32,
     illuminance: bool,
     film: &'a Film,
+    shard: Option<ShardInfo>,
+    meters: &'a [MeterSums],
     merged_seeds: &'a [u64],
 }
 
@@ -239,6 +272,8 @@ impl RenderState {
             illuminance: world.settings.illuminance,
             film,
             merged_seeds: Vec::new(),
+            shard: None,
+            meters: Vec::new(),
         }
     }
 
@@ -261,16 +296,21 @@ impl RenderState {
             illuminance: self.illuminance,
             film: &self.film,
             merged_seeds: &self.merged_seeds,
+            shard: self.shard,
+            meters: &self.meters,
         }
         .save(path)
     }
 
-    /// Writes the state [`Self::new`] would make of `film`, without copying the film.
+    /// Writes the state [`Self::new`] would make of `film` (of shard `shard`, if any, with its
+    /// meter sums), without copying the film.
     pub fn save_film(
         scene: &Path,
         scene_hash: u64,
         world: &World,
         film: &Film,
+        shard: Option<ShardInfo>,
+        meters: &[MeterSums],
         path: &Path,
     ) -> anyhow::Result<()> {
         StateRef {
@@ -283,6 +323,8 @@ impl RenderState {
             illuminance: world.settings.illuminance,
             film,
             merged_seeds: &[],
+            shard,
+            meters,
         }
         .save(path)
     }
@@ -389,6 +431,38 @@ impl RenderState {
             };
         }
         let [e, decision_e] = e_buffers;
+        let shard: Option<ShardInfo> = take(&mut bytes, "its shard")?;
+        if let Some(s) = shard {
+            if s.count == 0 || s.count > MAX_SHARDS || s.index >= s.count || s.spp == 0 {
+                return Err(format!(
+                    "it claims to be shard {} of {} at {} samples per pixel (shards are 0 … count − 1, at most {MAX_SHARDS}, with at least 1 sample per pixel)",
+                    s.index, s.count, s.spp
+                ));
+            }
+        }
+        let n_meters: u64 = take(&mut bytes, "the length of its meter list")?;
+        if n_meters > bytes.len() as u64 / MIN_METER_BYTES {
+            return Err(format!(
+                "its meter list claims {n_meters} meters ({MIN_METER_BYTES} bytes or more each), but only {} bytes remain",
+                bytes.len()
+            ));
+        }
+        let mut meters = Vec::with_capacity(n_meters as usize);
+        for k in 0..n_meters {
+            let m: MeterSums = take(&mut bytes, "a meter's sums")?;
+            if m.name.len() as u64 > MAX_SCENE_NAME_BYTES
+                || m.per_batch > crate::film::MAX_SAMPLES
+                || m.non_finite > m.per_batch * crate::meter::BATCHES as u64
+                || m.sums.iter().any(|v| !(v.is_finite() && *v >= 0.0))
+                || (m.per_batch == 0 && m.sums.iter().any(|&v| v != 0.0))
+            {
+                return Err(format!(
+                    "meter {k} ({:?}) holds sums that no render gives (sums finite and ≥ 0, at most as many non-finite samples as samples)",
+                    crate::limits::printable(&m.name, 60)
+                ));
+            }
+            meters.push(m);
+        }
         let seeds: u64 = take(&mut bytes, "the length of its merged-seed list")?;
         if seeds > MAX_MERGED_SEEDS || seeds > bytes.len() as u64 {
             return Err(format!(
@@ -427,6 +501,8 @@ impl RenderState {
             illuminance: p.illuminance,
             film,
             merged_seeds,
+            shard,
+            meters,
         })
     }
 }

@@ -77,9 +77,29 @@ pub struct RenderOpts {
     /// After the render, evaluate the glare of the image as `candela glare NAME.exr` does with its defaults (DGP, UGR, DGI, VCP, CGI, E_v with 95 % intervals; meant for a fisheye camera) and print it.
     #[arg(long)]
     glare: bool,
+    /// Render shard I of N (0-based): samples I·spp … (I+1)·spp − 1 of every pixel, so N shards at --spp S merge (`candela merge`) into the render at N·S spp. Writes NAME.shard-I-of-N.state (always) and images; rerunning the same command continues its state. `auto` takes I and N from a Slurm array (SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN, SLURM_ARRAY_TASK_COUNT); `auto/N` takes I from SLURM_ARRAY_TASK_ID, AWS_BATCH_JOB_ARRAY_INDEX or JOB_COMPLETION_INDEX (Kubernetes). See docs/cluster.md.
+    #[arg(long, value_name = "I/N|auto|auto/N")]
+    shard: Option<String>,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+}
+
+/// Options of `candela merge`.
+#[derive(clap::Args)]
+pub struct MergeOpts {
+    /// State files written with --save-state (or checkpoints), or the shards of a render (NAME.shard-I-of-N.state, any order).
+    #[arg(required = true, num_args = 1..)]
+    states: Vec<PathBuf>,
+    /// Output name: writes OUT.exr, OUT.png and OUT.state (and OUT.report.json for shards); an existing directory (or a path ending in `/`) writes DIR/merged.*. Refused if an output would replace an input.
+    #[arg(short, long)]
+    out: PathBuf,
+    /// Exposure of the PNG in EV, between -100 and 100 (default: automatic).
+    #[arg(long, allow_hyphen_values = true)]
+    exposure: Option<f64>,
+    /// Shards: merge those present even if some are missing or unfinished, giving the estimate of the samples they hold (said in OUT.report.json and on the output); without it such a merge is refused.
+    #[arg(long)]
+    partial: bool,
 }
 
 /// `1%`, `0.5 %` or `0.01` → 0.01.
@@ -104,8 +124,8 @@ fn parse_fraction(s: &str) -> Result<f64, String> {
 static STOP: AtomicBool = AtomicBool::new(false);
 
 impl RenderOpts {
-    fn job(&self) -> RenderJob {
-        RenderJob {
+    fn job(&self) -> Result<RenderJob> {
+        Ok(RenderJob {
             scene: self.scene.clone(),
             overrides: Overrides {
                 spp: self.spp,
@@ -138,7 +158,12 @@ impl RenderOpts {
             overwrite: self.overwrite,
             save_state: self.save_state,
             falsecolour: self.falsecolour,
-        }
+            shard: self
+                .shard
+                .as_deref()
+                .map(job::shard::parse_from_env)
+                .transpose()?,
+        })
     }
 }
 
@@ -218,7 +243,7 @@ impl Progress for Bar {
 
 /// `candela render`: exit code 130 when interrupted.
 pub fn render(a: &RenderOpts) -> Result<()> {
-    let job = a.job();
+    let job = a.job()?;
     // The options' own checks, whether or not the option is in effect (the job checks those
     // that are again).
     if let Some(n) = job.threads {
@@ -349,14 +374,59 @@ pub fn render(a: &RenderOpts) -> Result<()> {
 }
 
 /// `candela merge`.
-pub fn merge(states: &[PathBuf], out: &Path, exposure: Option<f64>) -> Result<()> {
-    let m = job::merge(states, out, exposure)?;
+pub fn merge(a: &MergeOpts) -> Result<()> {
+    let options = job::MergeOptions {
+        exposure_ev: a.exposure,
+        partial: a.partial,
+    };
+    let m = job::merge_with(&a.states, &a.out, &options)?;
+    let Some(s) = &m.shards else {
+        say!(
+            "merged {} renders (seeds {:?}): {:.1} image samples per pixel; wrote {}",
+            m.renders,
+            m.seeds,
+            m.samples_per_pixel,
+            m.exr_path.display()
+        );
+        return Ok(());
+    };
+    let list = |v: &[u32]| {
+        v.iter()
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if s.partial {
+        say!(
+            "PARTIAL estimate: {} of {} shards merged ({}); missing: [{}]; unfinished: [{}]",
+            s.merged.len(),
+            s.count,
+            list(&s.merged),
+            list(&s.missing),
+            list(&s.unfinished)
+        );
+    }
+    for meter in m.meters.iter().filter(|x| x.grid.is_none()) {
+        let e = meter.estimate();
+        let unit = if meter.luminance { "cd/m²" } else { "lx" };
+        say!(
+            "meter {:?}: {:.4} ± {:.4} {unit} (95 %, {} samples)",
+            meter.name,
+            e.mean,
+            e.ci95(),
+            e.samples
+        );
+    }
     say!(
-        "merged {} renders (seeds {:?}): {:.1} image samples per pixel; wrote {}",
-        m.renders,
-        m.seeds,
+        "merged shards [{}] of {} ({} spp each): {:.1} image samples per pixel; wrote {}, {}",
+        list(&s.merged),
+        s.count,
+        s.spp_per_shard,
         m.samples_per_pixel,
-        m.exr_path.display()
+        m.exr_path.display(),
+        m.report_path
+            .as_ref()
+            .map_or(String::new(), |p| p.display().to_string())
     );
     Ok(())
 }

@@ -1,5 +1,7 @@
 //! Merging independent renders of one scene (different seeds) from their state files into one
-//! estimate: the sums add, so the merged film is the render with all their samples.
+//! estimate: the sums add, so the merged film is the render with all their samples. Shards of
+//! one render (`render --shard`) are merged in the order of their index whatever the order they
+//! are given in, so the merged sums, and every output, are the same bit for bit.
 
 use super::files::{check_exposure, check_output_dir, film_layers, output_stem, write_png};
 use crate::output::{self, with_suffix};
@@ -8,11 +10,42 @@ use anyhow::{bail, Context, Result};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
+/// How to merge.
+#[derive(Clone, Debug, Default)]
+pub struct MergeOptions {
+    /// Exposure of the PNG in EV (None: automatic).
+    pub exposure_ev: Option<f64>,
+    /// Merge the shards present even if some are missing or unfinished (the estimate of the
+    /// samples they hold); without it such a merge is refused.
+    pub partial: bool,
+}
+
+/// What the shards of a merged render were: written to OUT.report.json and printed.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ShardSummary {
+    /// Shards of the render (N).
+    pub count: u32,
+    /// Samples per pixel of each finished shard.
+    pub spp_per_shard: u32,
+    /// Indices (0-based) of the shards merged.
+    pub merged: Vec<u32>,
+    /// Indices of the shards not given.
+    pub missing: Vec<u32>,
+    /// Indices of the merged shards that had not finished (a checkpoint).
+    pub unfinished: Vec<u32>,
+    /// Whether the estimate lacks samples of the render (missing or unfinished shards).
+    pub partial: bool,
+    /// Indices of the merged shards that measured their share of the meters and grid points
+    /// (finished shards): the merged meters hold their samples.
+    pub meter_shards: Vec<u32>,
+}
+
 /// What a merge wrote.
 #[derive(Clone, Debug)]
 pub struct MergeOutputs {
     pub exr_path: PathBuf,
     pub png_path: PathBuf,
+    /// The merged state (not written for a partial merge of shards).
     pub state_path: PathBuf,
     /// Number of state files merged.
     pub renders: usize,
@@ -20,12 +53,34 @@ pub struct MergeOutputs {
     pub seeds: Vec<u64>,
     /// Image samples per pixel of the merged film.
     pub samples_per_pixel: f64,
+    /// For shards: which were merged, and OUT.report.json with the merged meters.
+    pub shards: Option<ShardSummary>,
+    pub report_path: Option<PathBuf>,
+    /// The merged meters' and grid points' sums (shards that measured them).
+    pub meters: Vec<crate::meter::MeterSums>,
 }
 
 /// Merges `states` into OUT.exr, OUT.png and OUT.state (`out` names a stem, or an existing
 /// directory for `DIR/merged.*`); refuses to overwrite an input, to mix scenes or settings,
 /// and to count a seed twice. `exposure_ev` sets the PNG's exposure (None: automatic).
 pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result<MergeOutputs> {
+    merge_with(
+        states,
+        out,
+        &MergeOptions {
+            exposure_ev,
+            partial: false,
+        },
+    )
+}
+
+/// [`merge`] with options. Shards of one render (see [`super::shard`]) are checked to be of
+/// the same render (scene, settings, seed, shard count, samples per shard), taken in the order
+/// of their index, and the missing or unfinished ones named (refused unless
+/// `options.partial`); OUT.report.json then says which shards the estimate holds and gives the
+/// merged meters and grid points.
+pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Result<MergeOutputs> {
+    let exposure_ev = options.exposure_ev;
     check_exposure(exposure_ev)?;
     // Like `render --out`, a directory gets files named `merged.*`.
     let stem = output_stem(Some(out), "merged", &["exr", "png", "state"]);
@@ -50,6 +105,13 @@ pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result
     for p in states {
         loaded.push((p, RenderState::load(p)?));
     }
+    let shards = match super::shard::order(&mut loaded, options.partial)? {
+        Some(s) => Some(s),
+        None if loaded.len() < 2 => {
+            bail!("nothing to merge: give two state files or more (or the shards of a render)")
+        }
+        None => None,
+    };
     let (p0, first) = &loaded[0];
     let mut film = first.film.clone();
     let mut seeds = first.seeds();
@@ -67,6 +129,17 @@ pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result
                 p0.display(),
                 p.display()
             );
+        }
+        // The shards of a render share its seed and take disjoint samples of its sequences.
+        if shards.is_some() {
+            film.merge(&s.film);
+            film.check(first.illuminance).map_err(|e| {
+                anyhow::anyhow!(
+                    "merging {}: the merged film is out of range: {e}",
+                    p.display()
+                )
+            })?;
+            continue;
         }
         if let Some(seed) = s.seeds().into_iter().find(|x| seen.contains(x)) {
             bail!(
@@ -92,21 +165,45 @@ pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result
             crate::state::MAX_MERGED_SEEDS + 1
         );
     }
+    let meters = match &shards {
+        Some(_) => super::shard::merge_meters(&loaded)?,
+        _ => Vec::new(),
+    };
     let mut layers = film_layers(&first.scene, &film, first.illuminance);
     layers
         .attributes
         .push(("merged_seeds".to_string(), format!("{seeds:?}")));
+    if let Some(s) = &shards {
+        layers.attributes.push((
+            "merged_shards".to_string(),
+            format!("{:?} of {}", s.merged, s.count),
+        ));
+    }
     output::write_exr(&exr_path, &layers).context("cannot write the EXR")?;
     write_png(&film, &png_path, exposure_ev)?;
     let merged = RenderState {
         seed: seeds[0],
         merged_seeds: seeds[1..].to_vec(),
         film,
+        shard: None,
+        meters: Vec::new(),
         ..first.clone()
     };
-    merged
-        .save(&state_path)
-        .context("cannot write the merged state")?;
+    let report_path = match &shards {
+        Some(s) => {
+            let path = with_suffix(&stem, ".report.json");
+            super::shard::write_report(&path, s, &merged, &meters)?;
+            Some(path)
+        }
+        None => None,
+    };
+    // A partial estimate's state would resume past samples of shards it lacks and repeat
+    // them: it gets none (merge the shards again once they are all done).
+    if !shards.as_ref().is_some_and(|s| s.partial) {
+        merged
+            .save(&state_path)
+            .context("cannot write the merged state")?;
+    }
     Ok(MergeOutputs {
         exr_path,
         png_path,
@@ -114,5 +211,8 @@ pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result
         renders: loaded.len(),
         samples_per_pixel: merged.film.samples_per_pixel(),
         seeds,
+        shards,
+        report_path,
+        meters,
     })
 }

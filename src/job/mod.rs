@@ -6,6 +6,7 @@
 
 pub(crate) mod files;
 mod merge;
+pub mod shard;
 
 use crate::output::with_suffix;
 pub use files::would_replace;
@@ -14,7 +15,8 @@ use files::{
     check_output_dir, check_outputs, output_stem, state_bytes_at_least, write_exr, write_hdr,
     write_png, Planned,
 };
-pub use merge::{merge, MergeOutputs};
+pub use merge::{merge, merge_with, MergeOptions, MergeOutputs, ShardSummary};
+pub use shard::Shard;
 
 use crate::film::Film;
 use crate::meter::{Estimate, GridStats};
@@ -65,6 +67,10 @@ pub struct RenderJob {
     pub save_state: bool,
     /// Also write false-colour maps of luminance (and illuminance).
     pub falsecolour: bool,
+    /// Render only this shard of the render (see [`shard`]): samples I·spp … (I+1)·spp − 1 of
+    /// every pixel, outputs named NAME.shard-I-of-N.*, the state always written, and an existing
+    /// state of the shard continued (a requeued job picks up where it stopped).
+    pub shard: Option<Shard>,
 }
 
 impl RenderJob {
@@ -86,6 +92,7 @@ impl RenderJob {
             overwrite: false,
             save_state: false,
             falsecolour: false,
+            shard: None,
         }
     }
 }
@@ -271,6 +278,11 @@ fn check_job(job: &RenderJob) -> Result<()> {
     if job.overrides.spp == Some(0) {
         return Err(invalid_option("--spp must be at least 1"));
     }
+    if job.shard.is_some() && job.target.is_some() {
+        return Err(invalid_option(
+            "--shard splits a fixed number of samples per pixel among the shards; --target-error decides it pixel by pixel as the render goes, which separate shards cannot share: give --shard with --spp",
+        ));
+    }
     if job.resume && job.overwrite {
         return Err(invalid_option(
             "--resume continues NAME.state and --overwrite replaces it: give one of them",
@@ -281,7 +293,13 @@ fn check_job(job: &RenderJob) -> Result<()> {
 
 /// The film to continue: from NAME.state with `resume` (refused if the scene, its settings or
 /// the adaptive mode changed), else a new one.
-fn initial_film(job: &RenderJob, world: &World, hash: u64, state_path: &Path) -> Result<Film> {
+fn initial_film(
+    job: &RenderJob,
+    world: &World,
+    hash: u64,
+    shard: Option<crate::state::ShardInfo>,
+    state_path: &Path,
+) -> Result<Film> {
     let (w, h) = (world.camera.width, world.camera.height);
     if !job.resume {
         return Ok(if job.target.is_some() {
@@ -296,6 +314,21 @@ fn initial_film(job: &RenderJob, world: &World, hash: u64, state_path: &Path) ->
             "cannot resume from {}: the scene file {}, a file it refers to (mesh, spectrum, luminaire data) or its settings (seed, max depth, resolution, illuminance, caustics) changed since the state was written",
             state_path.display(),
             job.scene.display()
+        );
+    }
+    if st.shard != shard {
+        let what = |s: Option<crate::state::ShardInfo>| match s {
+            Some(s) => format!(
+                "shard {} of {} at {} samples per pixel",
+                s.index, s.count, s.spp
+            ),
+            None => "a whole render (no --shard)".to_string(),
+        };
+        bail!(
+            "cannot resume from {}: it holds {}, but this run asks for {}; rerun it as it was started, or start it again with --overwrite",
+            state_path.display(),
+            what(st.shard),
+            what(shard)
         );
     }
     if (st.film.width, st.film.height) != (w, h) {
@@ -386,7 +419,10 @@ pub fn run(
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "render".into());
-    let stem = output_stem(job.out.as_deref(), &name, &["exr", "png", "hdr"]);
+    let mut stem = output_stem(job.out.as_deref(), &name, &["exr", "png", "hdr"]);
+    if let Some(s) = &job.shard {
+        stem = with_suffix(&stem, &s.suffix());
+    }
     let (exr_path, png_path) = (with_suffix(&stem, ".exr"), with_suffix(&stem, ".png"));
     let hdr_path = with_suffix(&stem, ".hdr");
     check_output_dir(&stem)?;
@@ -394,7 +430,9 @@ pub fn run(
     let report_path = with_suffix(&stem, ".report.json");
     let (w, h) = (world.camera.width, world.camera.height);
     let state_existed = state_path.exists();
-    let save_state = job.save_state || job.resume || state_existed;
+    // A shard continues its own state: the same command, requeued, picks up where it stopped.
+    let resuming = job.resume || (job.shard.is_some() && state_existed && !job.overwrite);
+    let save_state = job.save_state || resuming || state_existed || job.shard.is_some();
     let mut inputs = vec![(job.scene.clone(), "the scene file".to_string())];
     inputs.extend(
         world
@@ -408,13 +446,13 @@ pub fn run(
         0
     };
     check_outputs(&planned_outputs(job, &world, &stem), &inputs, need_bytes)?;
-    if state_existed && !job.resume && !job.overwrite {
+    if state_existed && !resuming && !job.overwrite {
         bail!(
             "{} holds the samples of an earlier render: continue it with --resume, or start again and replace it with --overwrite (or choose another --out)",
             crate::limits::printable(&state_path.display().to_string(), 300)
         );
     }
-    let prog = Progressive {
+    let mut prog = Progressive {
         max_spp: job
             .max_spp
             .or(job.overrides.spp)
@@ -426,8 +464,19 @@ pub fn run(
         target: job.target,
         max_time: job.max_time,
         checkpoint_interval: job.checkpoint_interval,
+        first_sample: 0,
+        first_light_path: 0,
     };
-    let mut film = initial_film(job, &world, hash, &state_path)?;
+    let shard_info = job.shard.map(|s| s.info(prog.max_spp));
+    if let Some(s) = &job.shard {
+        prog.first_sample = s.index as u64 * prog.max_spp as u64;
+        prog.first_light_path = s.index as u64 * shard::LIGHT_PATHS_PER_SHARD;
+    }
+    let resume_job = RenderJob {
+        resume: resuming,
+        ..job.clone()
+    };
+    let mut film = initial_film(&resume_job, &world, hash, shard_info, &state_path)?;
     let resumed_samples = film.total_samples();
     let illuminance = world.settings.illuminance;
     // The images before the state: on a nearly full disk the small files still get written.
@@ -439,9 +488,17 @@ pub fn run(
         // The PNG too, so that the image pair on disk is always of the same estimate.
         writes.attempt(&png_path, || write_png(film, &png_path, job.exposure_ev));
     };
-    let write_state = |film: &Film, writes: &mut Writes| {
+    let write_state = |film: &Film, meters: &[crate::meter::MeterSums], writes: &mut Writes| {
         writes.attempt(&state_path, || {
-            RenderState::save_film(scene_path, hash, &world, film, &state_path)
+            RenderState::save_film(
+                scene_path,
+                hash,
+                &world,
+                film,
+                shard_info,
+                meters,
+                &state_path,
+            )
         });
     };
     progress.start(prog.max_spp as u64 * world.camera.inside_pixels() as u64)?;
@@ -460,7 +517,7 @@ pub fn run(
         &mut |f| {
             let mut writes = Writes::default();
             write_images(f, &mut writes);
-            write_state(f, &mut writes);
+            write_state(f, &[], &mut writes);
             for e in &writes.failed {
                 progress
                     .borrow_mut()
@@ -493,7 +550,7 @@ pub fn run(
             Outcome::InterruptedBeforeFirstPass
         } else {
             write_images(&result.film, &mut writes);
-            write_state(&result.film, &mut writes);
+            write_state(&result.film, &[], &mut writes);
             Outcome::InterruptedRender
         };
         writes.finish()?;
@@ -506,11 +563,15 @@ pub fn run(
     });
     write_images(&result.film, &mut writes);
     let t_measure = std::time::Instant::now();
-    let measurements = crate::meter::measure_all_until(&world, stop);
+    // A shard measures its share of every meter's samples and keeps their sums for the merge.
+    let measurements = match job.shard {
+        Some(s) => crate::meter::measure_shard_until(&world, s.index, s.count, stop),
+        None => crate::meter::measure_all_until(&world, stop).map(|m| (m, Vec::new())),
+    };
     let measure_seconds = t_measure.elapsed().as_secs_f64();
-    let Some(measurements) = measurements else {
+    let Some((measurements, meter_sums)) = measurements else {
         if save_state {
-            write_state(&result.film, &mut writes);
+            write_state(&result.film, &[], &mut writes);
         }
         outputs.outcome = Outcome::InterruptedMeasuring;
         writes.finish()?;
@@ -541,6 +602,11 @@ pub fn run(
             "target_floor_cd_m2": job.target.and_then(|t| t.floor_cd_m2),
             "fraction_of_eligible_pixels_at_target": last.converged_fraction,
             "max_time_s": job.max_time.map(|d| d.as_secs_f64()),
+            "shard": job.shard.map(|s| serde_json::json!({
+                "index": s.index,
+                "count": s.count,
+                "first_sample": prog.first_sample,
+            })),
         }),
     });
     writes.attempt(&report_path, || {
@@ -548,7 +614,7 @@ pub fn run(
         Ok(())
     });
     if save_state {
-        write_state(&result.film, &mut writes);
+        write_state(&result.film, &meter_sums, &mut writes);
     }
     writes.finish()?;
     outputs.outputs = written;
