@@ -1,0 +1,292 @@
+#!/usr/bin/env python3
+"""Annual daylight of the shoebox (scenes/annual-shoebox.ron) by Radiance's matrix method.
+
+    python scripts/radiance_annual.py WEATHER.epw [--mf 2] [--ab 6] [--ad 65536] [--lw 1e-7]
+        [--nproc 2] [--work DIR] > out.json
+
+Needs Radiance 6 on PATH with RAYPATH set (pyradiance's wheel: bin/ and lib/; bench/annual.sh sets
+them) and numpy.
+
+Frame. candela's scene is y up, +z south, +x east. Radiance's skies (gendaymtx, reinhart.cal with
+`u=+Y`) are z up, +y north, +x east, so the model is rotated into Radiance's frame:
+(X, Y, Z) = (x, -z, y), a proper rotation (det +1). The south window (candela z = 6) is at
+Y = -6 facing -Y = south; the sensors are at Z = 0.8 facing +Z.
+
+Method: honeybee-radiance's two-phase annual-daylight recipe with exact suns (the "direct sun"
+decomposition of the five-phase method, without a window matrix since the glazing is specular):
+
+    E_total = DC_ab(N) · (sky + sun patches) - DC_ab(1) · (sun patches) + S_ab(0) · suns
+
+- sky / sun patches: gendaymtx -m MF -O0 (-O0 is visible radiance, W sr^-1 m^-2 at 179 lm/W;
+  -O1 would be full-spectrum solar radiance) with -s (sky only) and -d (sun only, spread over the
+  patches nearest the sun); patch 0 is the ground (reflectance 0.2, gendaymtx's default).
+- DC_ab(N): rfluxmtx, sensors as sender rays (-I), receiver the ground hemisphere (h=u) and the
+  Reinhart sky (h=rMF, u=+Y); with N bounces it holds direct and inter-reflected light.
+- DC_ab(1): the same at one bounce, i.e. the patches seen directly through the pane; subtracting
+  its sun-patch product leaves the inter-reflected sun only, taken from the patch approximation.
+- S_ab(0): rcontrib -ab 0 with one `light` per sunny hour (gendaymtx -D: the solar disk of 0.533
+  degrees at the hour's sun position with the Perez-model direct-normal illuminance), one
+  modifier per sun; this is the direct sun alone, used as is for ASE (LM-83: direct sun, no
+  inter-reflection) and added to the total.
+- dctimestep applies each DC to its sky matrix; rmtxop -c 47.4 119.9 11.6 turns RGB irradiance
+  into illuminance (lx).
+
+Metrics over the occupied hours 8:00-18:00 local standard time, i.e. the EPW records of hours
+9..18 of every day (the record of hour h covers (h-1):00-h:00): DA300, cDA300, UDI 100-3000
+(with the fell-short and exceeded shares), sDA300/50 % (share of points with DA300 >= 0.5),
+ASE1000,250h (share of points with more than 250 occupied hours of direct sun > 1000 lx). No
+blinds are modelled.
+
+Output: JSON on stdout with per point hourly illuminance (lx, all 8760 records), the direct-sun
+illuminance, the metrics, per stage wall-clock times and the peak resident memory of the
+children (the largest one, as getrusage reports it) and of this script.
+"""
+
+import argparse
+import json
+import os
+import re
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+# Room, materials and grid of scenes/annual-shoebox.ron in candela's frame (y up, +z south).
+WALL, CEILING, FLOOR = 0.5, 0.8, 0.2
+GRID_X = [0.4 + 0.8 * i for i in range(5)]
+GRID_Z = [0.6 + 0.8 * j for j in range(7)]
+GRID_Y = 0.8
+OCCUPIED_HOURS = range(9, 19)  # EPW record hours: 8:00-18:00 local standard time
+WEIGHTS = (47.4, 119.9, 11.6)  # Radiance RGB -> illuminance (lm/W)
+
+
+def to_rad(p):
+    """candela (x, y up, z south) -> Radiance (X east, Y north, Z up)."""
+    x, y, z = p
+    return (x, -z, y)
+
+
+def quad(mod, name, origin, eu, ev):
+    """A Radiance polygon for candela's Quad (origin, edge_u, edge_v), in Radiance's frame."""
+    o = np.array(origin, float)
+    u = np.array(eu, float)
+    v = np.array(ev, float)
+    pts = [o, o + u, o + u + v, o + v]
+    coords = " ".join("%g %g %g" % to_rad(p) for p in pts)
+    return "%s polygon %s\n0\n0\n12 %s\n" % (mod, name, coords)
+
+
+def scene_rad():
+    # Plastic with no specular; glass with transmissivity 1 (no absorption) and n = 1.52:
+    # Radiance's glass parameters are transmissivity, its Fresnel reflections come on top.
+    s = [
+        "void plastic wall\n0\n0\n5 %g %g %g 0 0\n" % (WALL, WALL, WALL),
+        "void plastic ceiling\n0\n0\n5 %g %g %g 0 0\n" % (CEILING, CEILING, CEILING),
+        "void plastic floor\n0\n0\n5 %g %g %g 0 0\n" % (FLOOR, FLOOR, FLOOR),
+        "void glass pane\n0\n0\n4 1 1 1 1.52\n",
+    ]
+    # Radiance polygons are two-sided, so the winding of candela's quads does not matter here.
+    s += [
+        quad("floor", "floor", (0, 0, 0), (0, 0, 6), (4, 0, 0)),
+        quad("ceiling", "ceiling", (0, 3, 0), (4, 0, 0), (0, 0, 6)),
+        quad("wall", "west", (0, 0, 0), (0, 3, 0), (0, 0, 6)),
+        quad("wall", "east", (4, 0, 0), (0, 0, 6), (0, 3, 0)),
+        quad("wall", "north", (0, 0, 0), (4, 0, 0), (0, 3, 0)),
+        quad("wall", "south_below", (0, 0, 6), (0, 0.9, 0), (4, 0, 0)),
+        quad("wall", "south_above", (0, 2.4, 6), (0, 0.6, 0), (4, 0, 0)),
+        quad("wall", "south_west", (0, 0.9, 6), (0, 1.5, 0), (0.5, 0, 0)),
+        quad("wall", "south_east", (3.5, 0.9, 6), (0, 1.5, 0), (0.5, 0, 0)),
+        quad("pane", "pane", (0.5, 0.9, 6), (0, 1.5, 0), (3, 0, 0)),
+    ]
+    return "".join(s)
+
+
+def sky_receiver(mf):
+    # Patch 0 the ground hemisphere, then the Reinhart patches: gendaymtx's row order.
+    return (
+        "#@rfluxmtx h=u u=+Y\n"
+        "void glow groundglow\n0\n0\n4 1 1 1 0\n"
+        "groundglow source ground\n0\n0\n4 0 0 -1 180\n"
+        "#@rfluxmtx h=r%d u=+Y\n"
+        "void glow skyglow\n0\n0\n4 1 1 1 0\n"
+        "skyglow source skydome\n0\n0\n4 0 0 1 180\n" % mf
+    )
+
+
+def sensors():
+    """Grid points in candela's order (x fastest, then z), as Radiance rays facing up."""
+    pts = [(x, GRID_Y, z) for z in GRID_Z for x in GRID_X]
+    lines = ["%g %g %g 0 0 1" % to_rad(p) for p in pts]
+    return pts, "\n".join(lines) + "\n"
+
+
+class Runner:
+    def __init__(self, work):
+        self.work = work
+        self.times = {}
+
+    def run(self, stage, cmd, stdin=None, stdout=None):
+        t0 = time.perf_counter()
+        fin = open(os.path.join(self.work, stdin), "rb") if stdin else None
+        fout = open(os.path.join(self.work, stdout), "wb") if stdout else subprocess.PIPE
+        try:
+            p = subprocess.run(cmd, cwd=self.work, stdin=fin, stdout=fout, stderr=subprocess.PIPE)
+        finally:
+            if fin:
+                fin.close()
+            if stdout:
+                fout.close()
+        self.times[stage] = self.times.get(stage, 0.0) + time.perf_counter() - t0
+        if p.returncode != 0:
+            sys.exit("%s failed (%d): %s\n%s" % (stage, p.returncode, " ".join(cmd), p.stderr.decode()))
+        return p.stdout
+
+
+def read_matrix(path):
+    """A Radiance float matrix (header NROWS/NCOLS/NCOMP, then binary float32) as (rows, cols, comps)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"\n\n") + 2
+    head = data[:end].decode(errors="replace")
+    dims = {k: int(v) for k, v in re.findall(r"(NROWS|NCOLS|NCOMP)=(\d+)", head)}
+    fmt = re.search(r"FORMAT=(\S+)", head).group(1)
+    dtype = {"float": "<f4", "double": "<f8"}[fmt]
+    a = np.frombuffer(data[end:], dtype=dtype)
+    return a.reshape(dims["NROWS"], dims["NCOLS"], dims.get("NCOMP", 3)).astype(np.float64)
+
+
+def metrics(total, direct):
+    """total, direct: (points, 8760) lx. Occupied records: hours 9..18 of each day."""
+    hours = np.arange(8760) % 24 + 1
+    occ = np.isin(hours, list(OCCUPIED_HOURS))
+    e = total[:, occ]
+    d = direct[:, occ]
+    n_occ = int(occ.sum())
+    da = (e >= 300.0).mean(axis=1)
+    cda = np.minimum(e / 300.0, 1.0).mean(axis=1)
+    udi_short = (e < 100.0).mean(axis=1)
+    udi = ((e >= 100.0) & (e <= 3000.0)).mean(axis=1)
+    udi_over = (e > 3000.0).mean(axis=1)
+    sun_hours = (d > 1000.0).sum(axis=1)
+    return {
+        "occupied_hours": n_occ,
+        "da300": da.tolist(),
+        "cda300": cda.tolist(),
+        "udi_100_3000": udi.tolist(),
+        "udi_fell_short": udi_short.tolist(),
+        "udi_exceeded": udi_over.tolist(),
+        "sun_hours_over_1000lx": sun_hours.tolist(),
+        "sda300_50": float((da >= 0.5).mean()),
+        "ase1000_250h": float((sun_hours > 250).mean()),
+        "mean_occupied_illuminance_lx": e.mean(axis=1).tolist(),
+        "mean_occupied_direct_sun_lx": d.mean(axis=1).tolist(),
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("epw")
+    ap.add_argument("--mf", type=int, default=2, help="Reinhart subdivision (MF)")
+    ap.add_argument("--ab", type=int, default=6, help="bounces of the total DC")
+    ap.add_argument("--ad", type=int, default=65536, help="ambient divisions of both DCs")
+    ap.add_argument("--lw", type=float, default=1e-7, help="limit weight (below 1/ad)")
+    ap.add_argument("--nproc", type=int, default=2)
+    ap.add_argument("--work", help="keep the intermediate files here (default: a temporary dir)")
+    ap.add_argument("--no-hourly", action="store_true", help="metrics only, no hourly arrays")
+    args = ap.parse_args()
+
+    t_start = time.perf_counter()
+    work = args.work or tempfile.mkdtemp(prefix="radannual-")
+    os.makedirs(work, exist_ok=True)
+    r = Runner(work)
+    epw = os.path.abspath(args.epw)
+    with open(os.path.join(work, "scene.rad"), "w") as f:
+        f.write(scene_rad())
+    with open(os.path.join(work, "sky.rad"), "w") as f:
+        f.write(sky_receiver(args.mf))
+    pts, rays = sensors()
+    with open(os.path.join(work, "grid.pts"), "w") as f:
+        f.write(rays)
+    npts = len(pts)
+
+    r.run("epw2wea", ["epw2wea", epw, "weather.wea"])
+    mf = ["-m", str(args.mf), "-O0", "-of"]
+    r.run("gendaymtx", ["gendaymtx"] + mf + ["-s", "weather.wea"], stdout="sky.smx")
+    r.run("gendaymtx", ["gendaymtx"] + mf + ["-d", "weather.wea"], stdout="sun.smx")
+    r.run("gendaymtx", ["gendaymtx"] + mf + ["-d", "-D", "suns.rad", "-M", "suns.mod", "weather.wea"],
+          stdout="nosun.smx")
+    r.run("oconv", ["oconv", "scene.rad"], stdout="scene.oct")
+    with open(os.path.join(work, "suns_scene.rad"), "w") as f:
+        f.write(scene_rad())
+    r.run("oconv", ["oconv", "scene.rad", "suns.rad"], stdout="suns.oct")
+
+    common = ["-I", "-n", str(args.nproc), "-y", str(npts), "-faf", "-lw", str(args.lw),
+              "-lr", "-20", "-aa", "0"]
+    for name, ab in (("dc_total", args.ab), ("dc_direct", 1)):
+        r.run("rfluxmtx " + name, ["rfluxmtx", "-ab", str(ab), "-ad", str(args.ad)] + common
+              + ["-", "sky.rad", "scene.rad"], stdin="grid.pts", stdout=name + ".mtx")
+
+    # Exact suns, direct only: every sun a point-sampled disk, no jitter needed for a disk of
+    # 0.533 degrees; -dt 0 -dc 1 so that no source is skipped.
+    sun_mods = [m.strip() for m in open(os.path.join(work, "suns.mod")) if m.strip()]
+    r.run("rcontrib suns", ["rcontrib", "-V+", "-I", "-n", str(args.nproc), "-y", str(npts), "-faf",
+                            "-ab", "0", "-dc", "1", "-dt", "0", "-dj", "0", "-dr", "0",
+                            "-M", "suns.mod", "suns.oct"], stdin="grid.pts", stdout="suns.mtx")
+
+    def timestep(stage, dc, smx, out):
+        r.run(stage, ["dctimestep", "-of", dc, smx], stdout=out + ".rgb")
+        r.run(stage, ["rmtxop", "-ff", "-c"] + [str(w) for w in WEIGHTS] + [out + ".rgb"],
+              stdout=out + ".ill")
+        return read_matrix(os.path.join(work, out + ".ill"))[:, :, 0]
+
+    sky = timestep("dctimestep sky", "dc_total.mtx", "sky.smx", "sky")
+    sun_tot = timestep("dctimestep sun", "dc_total.mtx", "sun.smx", "sun_total")
+    sun_dir = timestep("dctimestep sun", "dc_direct.mtx", "sun.smx", "sun_direct")
+
+    t0 = time.perf_counter()
+    suns = read_matrix(os.path.join(work, "suns.mtx"))  # (npts, nsuns, 3) lx/179 per sun
+    # gendaymtx names each sun solarN, N the minutes since 1 January 0:00 of the hour's middle.
+    cols = np.array([(int(m[len("solar"):]) - 30) // 60 for m in sun_mods])
+    direct = np.zeros((npts, 8760))
+    direct[:, cols] = np.tensordot(suns, np.array(WEIGHTS), axes=([2], [0]))
+    inter_sun = sun_tot - sun_dir
+    total = sky + inter_sun + direct
+    m = metrics(total, direct)
+    r.times["combine + metrics"] = time.perf_counter() - t0
+
+    self_ru = resource.getrusage(resource.RUSAGE_SELF)
+    child_ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    out = {
+        "tool": "Radiance " + subprocess.run(["rtrace", "-version"], capture_output=True,
+                                             text=True).stdout.strip(),
+        "method": "2-phase DC (ab N) - direct DC (ab 1) x sun patches + exact suns (ab 0)",
+        "frame": "Radiance (X, Y, Z) = candela (x, -z, y): +Y north, +Z up",
+        "settings": {"mf": args.mf, "ab": args.ab, "ad": args.ad, "lw": args.lw,
+                     "nproc": args.nproc, "sun_suns": len(sun_mods)},
+        "points": [list(p) for p in pts],
+        "metrics": m,
+        "annual_mean_lx": {
+            "total": total.mean(axis=1).tolist(),
+            "sky": sky.mean(axis=1).tolist(),
+            "inter_reflected_sun": inter_sun.mean(axis=1).tolist(),
+            "direct_sun": direct.mean(axis=1).tolist(),
+        },
+        "timings_s": {k: round(v, 3) for k, v in r.times.items()},
+        "wall_s": round(time.perf_counter() - t_start, 3),
+        "cpu_children_s": round(child_ru.ru_utime + child_ru.ru_stime, 3),
+        "peak_rss_largest_child_mib": round(child_ru.ru_maxrss / 1024.0, 1),
+        "peak_rss_self_mib": round(self_ru.ru_maxrss / 1024.0, 1),
+        "work_dir": work,
+    }
+    if not args.no_hourly:
+        out["hourly_lx"] = np.round(total, 2).tolist()
+        out["hourly_direct_sun_lx"] = np.round(direct, 2).tolist()
+    json.dump(out, sys.stdout)
+    sys.stdout.write("\n")
+
+
+if __name__ == "__main__":
+    main()
