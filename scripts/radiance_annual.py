@@ -116,6 +116,25 @@ def sky_receiver(mf):
     )
 
 
+def reinhart_patches(mf):
+    """Centre directions (Radiance frame) and solid angles (sr) of gendaymtx's patches 0..N-1
+    (0 the ground), as gendaymtx's rh_init lays them out: azimuth from +Y (north) towards +X."""
+    tnaz = (30, 30, 24, 24, 18, 12, 6)
+    alpha = (np.pi / 2.0) / (7 * mf + 0.5)
+    dirs, doms = [(0.0, 0.0, -1.0)], [2.0 * np.pi]
+    for i in range(7 * mf):
+        alt = alpha * (i + 0.5)
+        n = tnaz[i // mf] * mf
+        dom = 2.0 * np.pi * (np.sin(alpha * (i + 1)) - np.sin(alpha * i)) / n
+        for j in range(n):
+            azi = 2.0 * np.pi * j / n
+            dirs.append((np.cos(alt) * np.sin(azi), np.cos(alt) * np.cos(azi), np.sin(alt)))
+            doms.append(dom)
+    dirs.append((0.0, 0.0, 1.0))
+    doms.append(2.0 * np.pi * (1.0 - np.cos(alpha * 0.5)))
+    return np.array(dirs), np.array(doms)
+
+
 def sensors():
     """Grid points in candela's order (x fastest, then z), as Radiance rays facing up."""
     pts = [(x, GRID_Y, z) for z in GRID_Z for x in GRID_X]
@@ -190,8 +209,10 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("epw")
     ap.add_argument("--mf", type=int, default=2, help="Reinhart subdivision (MF)")
-    ap.add_argument("--ab", type=int, default=6, help="bounces of the total DC")
+    ap.add_argument("--ab", type=int, default=12, help="bounces (ambient) of the DCs")
     ap.add_argument("--ad", type=int, default=65536, help="ambient divisions of both DCs")
+    ap.add_argument("--sun-ad", type=int, default=8192,
+                    help="ambient divisions of the inter-reflected sun coefficients")
     ap.add_argument("--lw", type=float, default=1e-7, help="limit weight (below 1/ad)")
     ap.add_argument("--nproc", type=int, default=2)
     ap.add_argument("--work", help="keep the intermediate files here (default: a temporary dir)")
@@ -219,15 +240,33 @@ def main():
     r.run("gendaymtx", ["gendaymtx"] + mf + ["-d", "-D", "suns.rad", "-M", "suns.mod", "weather.wea"],
           stdout="nosun.smx")
     r.run("oconv", ["oconv", "scene.rad"], stdout="scene.oct")
-    with open(os.path.join(work, "suns_scene.rad"), "w") as f:
-        f.write(scene_rad())
     r.run("oconv", ["oconv", "scene.rad", "suns.rad"], stdout="suns.oct")
 
     common = ["-I", "-n", str(args.nproc), "-y", str(npts), "-faf", "-lw", str(args.lw),
               "-lr", "-20", "-aa", "0"]
-    for name, ab in (("dc_total", args.ab), ("dc_direct", 1)):
-        r.run("rfluxmtx " + name, ["rfluxmtx", "-ab", str(ab), "-ad", str(args.ad)] + common
-              + ["-", "sky.rad", "scene.rad"], stdin="grid.pts", stdout=name + ".mtx")
+    r.run("rfluxmtx sky", ["rfluxmtx", "-ab", str(args.ab), "-ad", str(args.ad)] + common
+          + ["-", "sky.rad", "scene.rad"], stdin="grid.pts", stdout="dc_sky.mtx")
+
+    # Inter-reflected sun: a 0.533-degree sun at the centre of every patch the year's sun
+    # reaches, its radiance set for a normal irradiance of 1 W/m^2. Traced with -ab N and with
+    # -ab 0 with the same deterministic shadow rays (-dj 0 -dc 1 -dt 0), the difference is the
+    # inter-reflected light alone, free of the direct part's sampling noise.
+    sun_patch = read_matrix(os.path.join(work, "sun.smx"))[:, :, 1]  # (patches, hours)
+    dirs, doms = reinhart_patches(args.mf)
+    used = np.nonzero((sun_patch > 0).any(axis=1))[0]
+    sun_sr = 2.0 * np.pi * (1.0 - np.cos(np.radians(0.533 / 2.0)))
+    with open(os.path.join(work, "patch_suns.rad"), "w") as f:
+        for p in used:
+            f.write("void light psol%d\n0\n0\n3 %.6g %.6g %.6g\n" % ((p,) + (1.0 / sun_sr,) * 3))
+            f.write("psol%d source psun%d\n0\n0\n4 %.9f %.9f %.9f 0.533\n" % ((p, p) + tuple(dirs[p])))
+    with open(os.path.join(work, "patch_suns.mod"), "w") as f:
+        f.write("".join("psol%d\n" % p for p in used))
+    r.run("oconv", ["oconv", "scene.rad", "patch_suns.rad"], stdout="patch_suns.oct")
+    direct_opts = ["-dc", "1", "-dt", "0", "-dj", "0", "-dr", "0"]
+    for name, ab, ad in (("sun_coef_total", args.ab, args.sun_ad), ("sun_coef_direct", 0, 1)):
+        r.run("rcontrib patch suns", ["rcontrib", "-V+", "-ab", str(ab), "-ad", str(ad)] + common
+              + direct_opts + ["-M", "patch_suns.mod", "patch_suns.oct"],
+              stdin="grid.pts", stdout=name + ".mtx")
 
     # Exact suns, direct only: every sun a point-sampled disk, no jitter needed for a disk of
     # 0.533 degrees; -dt 0 -dc 1 so that no source is skipped.
@@ -242,9 +281,16 @@ def main():
               stdout=out + ".ill")
         return read_matrix(os.path.join(work, out + ".ill"))[:, :, 0]
 
-    sky = timestep("dctimestep sky", "dc_total.mtx", "sky.smx", "sky")
-    sun_tot = timestep("dctimestep sun", "dc_total.mtx", "sun.smx", "sun_total")
-    sun_dir = timestep("dctimestep sun", "dc_direct.mtx", "sun.smx", "sun_direct")
+    sky = timestep("dctimestep sky", "dc_sky.mtx", "sky.smx", "sky")
+
+    t0 = time.perf_counter()
+    coef = (read_matrix(os.path.join(work, "sun_coef_total.mtx"))
+            - read_matrix(os.path.join(work, "sun_coef_direct.mtx")))
+    coef = np.tensordot(coef, np.array(WEIGHTS), axes=([2], [0]))  # lx per W/m^2 normal
+    # gendaymtx's sun patches: radiance x solid angle = the share of the direct-normal
+    # (visible) irradiance it gave that patch.
+    inter_sun = coef @ (sun_patch[used] * doms[used, None])
+    r.times["inter-reflected sun"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
     suns = read_matrix(os.path.join(work, "suns.mtx"))  # (npts, nsuns, 3) lx/179 per sun
@@ -252,7 +298,6 @@ def main():
     cols = np.array([(int(m[len("solar"):]) - 30) // 60 for m in sun_mods])
     direct = np.zeros((npts, 8760))
     direct[:, cols] = np.tensordot(suns, np.array(WEIGHTS), axes=([2], [0]))
-    inter_sun = sun_tot - sun_dir
     total = sky + inter_sun + direct
     m = metrics(total, direct)
     r.times["combine + metrics"] = time.perf_counter() - t0
@@ -262,9 +307,10 @@ def main():
     out = {
         "tool": "Radiance " + subprocess.run(["rtrace", "-version"], capture_output=True,
                                              text=True).stdout.strip(),
-        "method": "2-phase DC (ab N) - direct DC (ab 1) x sun patches + exact suns (ab 0)",
+        "method": "sky DC (ab N) x sky + patch-sun coefficients (ab N - ab 0) x sun patches + exact suns (ab 0)",
         "frame": "Radiance (X, Y, Z) = candela (x, -z, y): +Y north, +Z up",
-        "settings": {"mf": args.mf, "ab": args.ab, "ad": args.ad, "lw": args.lw,
+        "settings": {"mf": args.mf, "ab": args.ab, "ad": args.ad, "sun_ad": args.sun_ad, "lw": args.lw,
+                     "sun_patches": len(used),
                      "nproc": args.nproc, "sun_suns": len(sun_mods)},
         "points": [list(p) for p in pts],
         "metrics": m,
