@@ -12,24 +12,35 @@ Frame. candela's scene is y up, +z south, +x east. Radiance's skies (gendaymtx, 
 (X, Y, Z) = (x, -z, y), a proper rotation (det +1). The south window (candela z = 6) is at
 Y = -6 facing -Y = south; the sensors are at Z = 0.8 facing +Z.
 
-Method: honeybee-radiance's two-phase annual-daylight recipe with exact suns (the "direct sun"
-decomposition of the five-phase method, without a window matrix since the glazing is specular):
+Method: daylight coefficients for the sky, sun coefficients for the inter-reflected sun and
+one exact sun per sunny hour for the direct sun (the decomposition of the five-phase method,
+without a window matrix since the pane is specular):
 
-    E_total = DC_ab(N) · (sky + sun patches) - DC_ab(1) · (sun patches) + S_ab(0) · suns
+    E_total = DC_sky(ab N) . sky  +  (S(ab N) - S(ab 0)) . sun patches  +  suns(ab 0)
 
-- sky / sun patches: gendaymtx -m MF -O0 (-O0 is visible radiance, W sr^-1 m^-2 at 179 lm/W;
-  -O1 would be full-spectrum solar radiance) with -s (sky only) and -d (sun only, spread over the
-  patches nearest the sun); patch 0 is the ground (reflectance 0.2, gendaymtx's default).
-- DC_ab(N): rfluxmtx, sensors as sender rays (-I), receiver the ground hemisphere (h=u) and the
-  Reinhart sky (h=rMF, u=+Y); with N bounces it holds direct and inter-reflected light.
-- DC_ab(1): the same at one bounce, i.e. the patches seen directly through the pane; subtracting
-  its sun-patch product leaves the inter-reflected sun only, taken from the patch approximation.
-- S_ab(0): rcontrib -ab 0 with one `light` per sunny hour (gendaymtx -D: the solar disk of 0.533
-  degrees at the hour's sun position with the Perez-model direct-normal illuminance), one
-  modifier per sun; this is the direct sun alone, used as is for ASE (LM-83: direct sun, no
+- sky, sun patches: gendaymtx -m MF -O0 (-O0 is visible radiance, W sr^-1 m^-2 at 179 lm/W;
+  -O1 would be full-spectrum solar radiance), -s (sky only; patch 0 the ground, reflectance 0.2,
+  lit by sky and sun) and -d (sun only, spread over the 4 patches nearest the sun).
+- DC_sky: rfluxmtx, the sensors as sender rays (-I), the receiver the ground hemisphere (h=u)
+  then the Reinhart sky (h=rMF, u=+Y), gendaymtx's patch order.
+- S: rcontrib with a 0.533-degree sun at the centre of each patch the year's sun reaches, at
+  -ab N and at -ab 0. Both compute the direct part with the same deterministic shadow rays
+  (-dj 0 -dc 1 -dt 0), so their difference is the inter-reflected sun alone, exactly free of
+  the direct part (subtracting a one-bounce DC from an N-bounce one, as honeybee's recipe does,
+  leaves the two runs' sampling noise of the sun patches seen through the pane, several times
+  the inter-reflected part near the window). Each hour weights the patches as gendaymtx -d does.
+- suns: rcontrib -ab 0, one `light` per sunny hour (gendaymtx -D: the direct-normal illuminance
+  of gendaymtx's Perez efficacy) at the hour's sun position (by default ladybug's NOAA position
+  with refraction, as candela's, within about 0.05 degrees; gendaymtx's own formula is up to 1
+  degree off), one modifier per sun: the direct sun alone, for ASE (LM-83: direct sun, no
   inter-reflection) and added to the total.
-- dctimestep applies each DC to its sky matrix; rmtxop -c 47.4 119.9 11.6 turns RGB irradiance
+- dctimestep applies DC_sky to the sky matrix; rmtxop -c 47.4 119.9 11.6 turns RGB irradiance
   into illuminance (lx).
+
+Efficacy: epw2wea passes irradiances and gendaymtx converts them with the Perez (1990) efficacy
+at a dew point of 11 C (a wea has none). --photometric writes the wea from the EPW's
+illuminance fields instead (units 3), which for scripts/synthetic_epw.py are the Perez efficacy
+at each record's dew point, as candela computes it.
 
 Metrics over the occupied hours 8:00-18:00 local standard time, i.e. the EPW records of hours
 9..18 of every day (the record of hour h covers (h-1):00-h:00): DA300, cDA300, UDI 100-3000
@@ -135,6 +146,47 @@ def reinhart_patches(mf):
     return np.array(dirs), np.array(doms)
 
 
+def photometric_wea(epw, out):
+    """A wea in photometric units (weather_data_file_units 3: direct-normal and diffuse-horizontal
+    illuminance, lx) from the EPW's illuminance fields, with epw2wea's header and hour labels."""
+    with open(epw) as f:
+        lines = f.read().splitlines()
+    loc = lines[0].split(",")
+    rows = [line.split(",") for line in lines[8:] if line.strip()]
+    head = "place %s_%s\nlatitude %s\nlongitude %.6f\ntime_zone %.0f\nsite_elevation %s\n" % (
+        loc[1], loc[3], loc[6], -float(loc[7]), -15.0 * float(loc[8]), loc[9])
+    body = []
+    for r in rows:
+        dn, dh = float(r[17]), float(r[18])
+        if dn >= 999999 or dh >= 999999:
+            sys.exit("--photometric: the EPW has no illuminance fields (999999)")
+        body.append("%d %d %.3f %.0f %.0f" % (int(r[1]), int(r[2]), int(r[3]) - 0.5, dn, dh))
+    with open(out, "w") as f:
+        f.write(head + "weather_data_file_units 3\n" + "\n".join(body) + "\n")
+
+
+def ladybug_suns(suns_rad, lat, lon, tz):
+    """Rewrite gendaymtx's -D suns with NOAA positions (ladybug, with refraction) for each
+    sun's hour: gendaymtx's own formula is up to about 1 degree off."""
+    from ladybug.sunpath import Sunpath
+    import datetime
+
+    sp = Sunpath(lat, lon, tz)
+    text = open(suns_rad).read()
+
+    def fix(m):
+        t = (int(m.group(1)) - 30) // 60
+        day = datetime.date(2017, 1, 1) + datetime.timedelta(days=t // 24)
+        sun = sp.calculate_sun(day.month, day.day, t % 24 + 0.5)
+        alt, az = np.radians(sun.altitude), np.radians(sun.azimuth)
+        return "solar%s source sun%s\n0\n0\n4 %.6f %.6f %.6f 0.5330" % (
+            m.group(1), m.group(1), np.cos(alt) * np.sin(az), np.cos(alt) * np.cos(az), np.sin(alt))
+
+    text = re.sub(r"solar(\d+) source sun\d+\n0\n0\n4 \S+ \S+ \S+ \S+", fix, text)
+    with open(suns_rad, "w") as f:
+        f.write(text)
+
+
 def sensors():
     """Grid points in candela's order (x fastest, then z), as Radiance rays facing up."""
     pts = [(x, GRID_Y, z) for z in GRID_Z for x in GRID_X]
@@ -211,11 +263,19 @@ def main():
     ap.add_argument("--mf", type=int, default=2, help="Reinhart subdivision (MF)")
     ap.add_argument("--ab", type=int, default=12, help="bounces (ambient) of the DCs")
     ap.add_argument("--ad", type=int, default=65536, help="ambient divisions of both DCs")
-    ap.add_argument("--sun-ad", type=int, default=8192,
+    ap.add_argument("--sun-ad", type=int, default=1024,
                     help="ambient divisions of the inter-reflected sun coefficients")
     ap.add_argument("--lw", type=float, default=1e-7, help="limit weight (below 1/ad)")
     ap.add_argument("--nproc", type=int, default=2)
     ap.add_argument("--work", help="keep the intermediate files here (default: a temporary dir)")
+    ap.add_argument("--photometric", action="store_true",
+                    help="gendaymtx from the EPW's illuminance fields (Perez efficacy with each "
+                    "record's dew point) instead of epw2wea's irradiances (efficacy at 11 C)")
+    ap.add_argument("--radiance-sun-positions", action="store_true",
+                    help="exact suns where gendaymtx puts them, not at ladybug's NOAA positions")
+    ap.add_argument("--reuse-dc", action="store_true",
+                    help="keep the sky DC and sun coefficients already in --work (same scene and "
+                    "settings, another weather file): only the skies, suns and products are redone")
     ap.add_argument("--no-hourly", action="store_true", help="metrics only, no hourly arrays")
     args = ap.parse_args()
 
@@ -233,19 +293,31 @@ def main():
         f.write(rays)
     npts = len(pts)
 
-    r.run("epw2wea", ["epw2wea", epw, "weather.wea"])
+    if args.photometric:
+        t0 = time.perf_counter()
+        photometric_wea(epw, os.path.join(work, "weather.wea"))
+        r.times["epw2wea"] = time.perf_counter() - t0
+    else:
+        r.run("epw2wea", ["epw2wea", epw, "weather.wea"])
     mf = ["-m", str(args.mf), "-O0", "-of"]
     r.run("gendaymtx", ["gendaymtx"] + mf + ["-s", "weather.wea"], stdout="sky.smx")
     r.run("gendaymtx", ["gendaymtx"] + mf + ["-d", "weather.wea"], stdout="sun.smx")
     r.run("gendaymtx", ["gendaymtx"] + mf + ["-d", "-D", "suns.rad", "-M", "suns.mod", "weather.wea"],
           stdout="nosun.smx")
     r.run("oconv", ["oconv", "scene.rad"], stdout="scene.oct")
+    if not args.radiance_sun_positions:
+        loc = open(epw).readline().split(",")
+        ladybug_suns(os.path.join(work, "suns.rad"), float(loc[6]), float(loc[7]), float(loc[8]))
     r.run("oconv", ["oconv", "scene.rad", "suns.rad"], stdout="suns.oct")
 
     common = ["-I", "-n", str(args.nproc), "-y", str(npts), "-faf", "-lw", str(args.lw),
               "-lr", "-20", "-aa", "0"]
-    r.run("rfluxmtx sky", ["rfluxmtx", "-ab", str(args.ab), "-ad", str(args.ad)] + common
-          + ["-", "sky.rad", "scene.rad"], stdin="grid.pts", stdout="dc_sky.mtx")
+    def reuse(name):
+        return args.reuse_dc and os.path.exists(os.path.join(work, name))
+
+    if not reuse("dc_sky.mtx"):
+        r.run("rfluxmtx sky", ["rfluxmtx", "-ab", str(args.ab), "-ad", str(args.ad)] + common
+              + ["-", "sky.rad", "scene.rad"], stdin="grid.pts", stdout="dc_sky.mtx")
 
     # Inter-reflected sun: a 0.533-degree sun at the centre of every patch the year's sun
     # reaches, its radiance set for a normal irradiance of 1 W/m^2. Traced with -ab N and with
@@ -255,15 +327,20 @@ def main():
     dirs, doms = reinhart_patches(args.mf)
     used = np.nonzero((sun_patch > 0).any(axis=1))[0]
     sun_sr = 2.0 * np.pi * (1.0 - np.cos(np.radians(0.533 / 2.0)))
+    mods = "".join("psol%d\n" % p for p in used)
+    if reuse("patch_suns.mod") and open(os.path.join(work, "patch_suns.mod")).read() != mods:
+        sys.exit("--reuse-dc: the year's sun reaches other patches than in %s" % work)
     with open(os.path.join(work, "patch_suns.rad"), "w") as f:
         for p in used:
             f.write("void light psol%d\n0\n0\n3 %.6g %.6g %.6g\n" % ((p,) + (1.0 / sun_sr,) * 3))
             f.write("psol%d source psun%d\n0\n0\n4 %.9f %.9f %.9f 0.533\n" % ((p, p) + tuple(dirs[p])))
     with open(os.path.join(work, "patch_suns.mod"), "w") as f:
-        f.write("".join("psol%d\n" % p for p in used))
+        f.write(mods)
     r.run("oconv", ["oconv", "scene.rad", "patch_suns.rad"], stdout="patch_suns.oct")
     direct_opts = ["-dc", "1", "-dt", "0", "-dj", "0", "-dr", "0"]
     for name, ab, ad in (("sun_coef_total", args.ab, args.sun_ad), ("sun_coef_direct", 0, 1)):
+        if reuse(name + ".mtx"):
+            continue
         r.run("rcontrib patch suns", ["rcontrib", "-V+", "-ab", str(ab), "-ad", str(ad)] + common
               + direct_opts + ["-M", "patch_suns.mod", "patch_suns.oct"],
               stdin="grid.pts", stdout=name + ".mtx")
@@ -309,7 +386,9 @@ def main():
                                              text=True).stdout.strip(),
         "method": "sky DC (ab N) x sky + patch-sun coefficients (ab N - ab 0) x sun patches + exact suns (ab 0)",
         "frame": "Radiance (X, Y, Z) = candela (x, -z, y): +Y north, +Z up",
-        "settings": {"mf": args.mf, "ab": args.ab, "ad": args.ad, "sun_ad": args.sun_ad, "lw": args.lw,
+        "settings": {"photometric_wea": args.photometric, "reused_dc": args.reuse_dc,
+                     "sun_positions": "gendaymtx" if args.radiance_sun_positions else "ladybug NOAA",
+                     "mf": args.mf, "ab": args.ab, "ad": args.ad, "sun_ad": args.sun_ad, "lw": args.lw,
                      "sun_patches": len(used),
                      "nproc": args.nproc, "sun_suns": len(sun_mods)},
         "points": [list(p) for p in pts],
