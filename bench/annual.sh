@@ -145,4 +145,18 @@ print("| tool | runs | wall s (median) | CPU s (median) | peak RSS MiB (median) 
 print("|---|---|---|---|---|---|---|")
 for t, n, w, c, m, s, a in rows:
     print("| %s | %d | %.1f | %.1f | %.0f | %s | %s |" % (t, n, w, c, m, fmt(s), fmt(a)))
+
+# Per point: DA300 and direct-sun hours > 1000 lx of round 1 (same point order: x fastest).
+cpath, rpath = os.path.join(out, "candela-1.annual.json"), os.path.join(out, "radiance-1.json")
+if os.path.exists(cpath) and os.path.exists(rpath):
+    pts = find(json.load(open(cpath)), "points") or []
+    rm = json.load(open(rpath))["metrics"]
+    if len(pts) == len(rm["da300"]):
+        dda = [as_fraction(p["da"]) - d for p, d in zip(pts, rm["da300"])]
+        dsun = [as_fraction(p["sun_hours"]) - h for p, h in zip(pts, rm["sun_hours_over_1000lx"])]
+        print()
+        print("per point, candela - Radiance: DA300 mean %+.2f pp, max |.| %.2f pp; "
+              "sun hours > 1000 lx mean %+.1f h, max |.| %.0f h"
+              % (100 * sum(dda) / len(dda), 100 * max(map(abs, dda)),
+                 sum(dsun) / len(dsun), max(map(abs, dsun))))
 PY
