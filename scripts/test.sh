@@ -8,7 +8,8 @@ cd "$(dirname "$0")/.."
 bash scripts/setup_python.sh
 # tests/slurm.rs starts a one-node Slurm cluster: as root, install its Debian packages.
 if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null && ! command -v slurmctld >/dev/null; then
-    DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends slurm-wlm munge ||
+    { apt-get update -qq &&
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends slurm-wlm munge; } ||
         echo "test.sh: slurm-wlm and munge could not be installed; tests/slurm.rs will skip" >&2
 fi
 export CANDELA_PYTHON="${CANDELA_PYTHON:-$PWD/target/venv/bin/python}"
