@@ -498,6 +498,10 @@ fn png_header(w: u32, h: u32) -> Vec<u8> {
     out.extend(13u32.to_be_bytes());
     out.extend(&ihdr);
     out.extend(crc32(&ihdr).to_be_bytes());
+    // An empty IDAT: decoders read the header up to the first data chunk.
+    out.extend(0u32.to_be_bytes());
+    out.extend(b"IDAT");
+    out.extend(crc32(b"IDAT").to_be_bytes());
     out.extend(0u32.to_be_bytes());
     out.extend(b"IEND");
     out.extend(crc32(b"IEND").to_be_bytes());

@@ -86,18 +86,6 @@ pub struct TexturedDiffuse {
 }
 
 impl TexturedDiffuse {
-    /// Loads the texture `file` (relative to the scene) with its coordinate transform and
-    /// wrap mode; errors name `field`.
-    pub fn build(
-        ctx: &Context,
-        field: &str,
-        desc: &crate::description::schema::TextureDesc,
-    ) -> Result<Self, SceneError> {
-        let path = ctx.resolve(&desc.file);
-        Self::load(&path, desc.uv_scale, desc.uv_offset, desc.wrap)
-            .map_err(|e| ctx.err(format!("{field}.reflectance"), e))
-    }
-
     /// Loads the texture at `path`; `uv_scale`, `uv_offset` transform texture coordinates.
     pub fn load(
         path: &std::path::Path,

@@ -131,8 +131,17 @@ impl Material {
     pub fn build(ctx: &Context, field: &str, desc: &MaterialDesc) -> Result<Self, SceneError> {
         Ok(match desc {
             MaterialDesc::Diffuse {
-                reflectance: crate::description::schema::SpectrumDesc::Texture(t),
-            } => Material::TexturedDiffuse(TexturedDiffuse::build(ctx, field, t)?),
+                reflectance:
+                    crate::description::schema::SpectrumDesc::Texture {
+                        file,
+                        uv_scale,
+                        uv_offset,
+                        wrap,
+                    },
+            } => Material::TexturedDiffuse(
+                TexturedDiffuse::load(&ctx.resolve(file), *uv_scale, *uv_offset, *wrap)
+                    .map_err(|e| ctx.err(format!("{field}.reflectance"), e))?,
+            ),
             MaterialDesc::Diffuse { reflectance } => {
                 Material::Diffuse(Diffuse::build(ctx, field, reflectance)?)
             }

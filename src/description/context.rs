@@ -243,7 +243,7 @@ impl Context<'_> {
                 in_range(self, field, &sd, &format!("{}", p.display()))?;
                 DenseSpectrum::from_fn(|nm| sd.value(nm))
             }
-            SpectrumDesc::Texture(_) => {
+            SpectrumDesc::Texture { .. } => {
                 return Err(self.err(
                     field,
                     "an image texture can only be a `Diffuse` material's reflectance",

@@ -358,24 +358,19 @@ pub enum SpectrumDesc {
     /// components in [0, 1]); decoded to linear sRGB, then as `Rgb`.
     Srgb(f64, f64, f64),
     /// An image texture (only as a `Diffuse` material's reflectance): each texel's colour
-    /// upsampled as `Srgb` (PNG, JPEG) or `Rgb` (OpenEXR).
-    Texture(TextureDesc),
-}
-
-/// An image texture of reflectance (docs/scene-format.md → textures).
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TextureDesc {
-    /// PNG, JPEG (sRGB) or OpenEXR (linear) image, relative to the scene file.
-    pub file: String,
-    /// Texture coordinates are multiplied by this (default (1, 1)), then offset.
-    #[serde(default = "default_uv_scale")]
-    pub uv_scale: [f32; 2],
-    #[serde(default)]
-    pub uv_offset: [f32; 2],
-    /// `Repeat` (default) or `Clamp`.
-    #[serde(default)]
-    pub wrap: crate::texture::Wrap,
+    /// upsampled as `Srgb` (PNG, JPEG) or `Rgb` (OpenEXR); docs/scene-format.md → textures.
+    Texture {
+        /// PNG, JPEG (sRGB) or OpenEXR (linear) image, relative to the scene file.
+        file: String,
+        /// Texture coordinates are multiplied by this (default (1, 1)), then offset.
+        #[serde(default = "default_uv_scale")]
+        uv_scale: [f32; 2],
+        #[serde(default)]
+        uv_offset: [f32; 2],
+        /// `Repeat` (default) or `Clamp`.
+        #[serde(default)]
+        wrap: crate::texture::Wrap,
+    },
 }
 
 fn default_uv_scale() -> [f32; 2] {
