@@ -388,6 +388,9 @@ fn model_scene(extra: &str) -> String {
 
 const TRIANGLE: &str = "v 0 0 0\nv 1 0 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\n";
 
+/// A bad-input case: what it is, how to write its files, what the message must contain.
+type Case<'a> = (&'a str, Box<dyn Fn() + 'a>, Vec<&'a str>);
+
 /// Bad models and textures: each ends with exit code 1 and a message naming the file and the
 /// line or field at fault, without a panic or an allocation of the size a header claims.
 #[test]
@@ -396,7 +399,7 @@ fn bad_models_and_textures_are_clear_errors() {
     let d = dir.path();
     let write = |name: &str, text: &[u8]| std::fs::write(d.join(name), text).unwrap();
     let obj = |mtllib: &str| format!("mtllib {mtllib}\n{TRIANGLE}usemtl Floor\nf 1/1 2/2 3/3\n");
-    let cases: Vec<(&str, Box<dyn Fn()>, Vec<&str>)> = vec![
+    let cases: Vec<Case> = vec![
         (
             "missing MTL",
             Box::new(|| write("m.obj", obj("nowhere.mtl").as_bytes())),
