@@ -211,7 +211,7 @@ enum Mtl {
 type Models = (Vec<tobj::Model>, Vec<MtlMaterial>);
 
 /// Reads and parses an OBJ file (and, with [`Mtl::Use`], its material libraries).
-fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<(Models, String), GeometryError> {
+fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
     let bytes = read_mesh(path)?;
     check_memory(
         path,
@@ -219,8 +219,7 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<(Models, String), GeometryErr
         obj_memory(&bytes),
     )?;
     let text = String::from_utf8_lossy(&bytes);
-    let text = text.strip_prefix('\u{feff}').unwrap_or(&text).to_string();
-    drop(bytes);
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -300,7 +299,7 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<(Models, String), GeometryErr
     let (models, _materials) = loaded.map_err(|e| match e {
         tobj::LoadError::FaceVertexOutOfBounds | tobj::LoadError::FaceParseError => {
             // tobj does not say where: find the face ourselves.
-            parse(locate_bad_face(&text).unwrap_or_else(|| {
+            parse(locate_bad_face(text).unwrap_or_else(|| {
                 match e {
                     tobj::LoadError::FaceVertexOutOfBounds => {
                         "a face refers to a vertex index that does not exist (index out of range)"
@@ -345,7 +344,7 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<(Models, String), GeometryErr
             }
         }
     }
-    Ok(((models, mtls), text))
+    Ok((models, mtls))
 }
 
 /// Appends the triangles of `models` to `mesh` (and their normals to `normals` when
@@ -428,7 +427,7 @@ fn all_have_normals(models: &[&tobj::Model]) -> bool {
 /// Material libraries (`mtllib`) are not used, so one that does not exist is ignored; one that
 /// is a FIFO, a device, a directory or over 16 MiB is refused, naming it.
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
-    let ((models, _), _) = parse_obj(path, Mtl::Ignore)?;
+    let (models, _) = parse_obj(path, Mtl::Ignore)?;
     let models: Vec<&tobj::Model> = models.iter().collect();
     let mut mesh = TriangleMesh::default();
     let with_normals = all_have_normals(&models);
@@ -474,7 +473,7 @@ pub struct ObjModel {
 /// naming the file and line. Groups with no triangles are left out; a file with none at all is
 /// an error.
 pub fn load_obj_model(path: &Path) -> Result<ObjModel, GeometryError> {
-    let ((models, materials), _) = parse_obj(path, Mtl::Use)?;
+    let (models, materials) = parse_obj(path, Mtl::Use)?;
     let mut ids: Vec<Option<usize>> = Vec::new();
     for m in &models {
         if !ids.contains(&m.mesh.material_id) {
