@@ -29,4 +29,5 @@ pub mod sampling;
 pub mod scene;
 pub mod spectrum;
 pub mod state;
+pub mod texture;
 pub mod world;

@@ -33,31 +33,77 @@ impl Diffuse {
     }
 
     pub fn eval(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
-        if !same_hemisphere(wo, wi) {
-            return SampledSpectrum::ZERO;
-        }
-        self.reflectance.sample(wl) * FRAC_1_PI
+        lambert_eval(self.reflectance.sample(wl), wo, wi)
     }
     pub fn sample(&self, wo: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<BsdfSample> {
-        let mut wi = crate::sampling::cosine_hemisphere(u);
-        if wo.z < 0.0 {
-            wi.z = -wi.z;
-        }
-        let pdf = crate::sampling::cosine_hemisphere_pdf(wi.z.abs());
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.reflectance.sample(wl) * FRAC_1_PI,
-            pdf,
-            specular: false,
-        })
+        lambert_sample(self.reflectance.sample(wl), wo, u)
     }
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        Self::pdf_cosine(wo, wi)
+    }
+    /// Density of the cosine-weighted sample, whatever the reflectance.
+    #[inline]
+    pub fn pdf_cosine(wo: Vec3, wi: Vec3) -> f32 {
         if !same_hemisphere(wo, wi) {
             return 0.0;
         }
         crate::sampling::cosine_hemisphere_pdf(wi.z.abs())
+    }
+}
+
+/// f = ρ/π of reflectance `r` at the path's wavelengths.
+#[inline]
+pub fn lambert_eval(r: SampledSpectrum, wo: Vec3, wi: Vec3) -> SampledSpectrum {
+    if !same_hemisphere(wo, wi) {
+        return SampledSpectrum::ZERO;
+    }
+    r * FRAC_1_PI
+}
+
+/// Cosine-weighted sample of the Lambertian of reflectance `r`.
+#[inline]
+pub fn lambert_sample(r: SampledSpectrum, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+    let mut wi = crate::sampling::cosine_hemisphere(u);
+    if wo.z < 0.0 {
+        wi.z = -wi.z;
+    }
+    let pdf = crate::sampling::cosine_hemisphere_pdf(wi.z.abs());
+    if pdf <= 0.0 {
+        return None;
+    }
+    Some(BsdfSample {
+        wi,
+        f: r * FRAC_1_PI,
+        pdf,
+        specular: false,
+    })
+}
+
+/// Lambertian reflection whose reflectance is an image texture ([`crate::texture`]).
+#[derive(Clone, Debug)]
+pub struct TexturedDiffuse {
+    pub texture: std::sync::Arc<crate::texture::Texture>,
+}
+
+impl TexturedDiffuse {
+    /// Loads the texture at `path`; `uv_scale`, `uv_offset` transform texture coordinates.
+    pub fn load(
+        path: &std::path::Path,
+        uv_scale: [f32; 2],
+        uv_offset: [f32; 2],
+        wrap: crate::texture::Wrap,
+    ) -> Result<Self, String> {
+        if !(uv_scale.iter().chain(&uv_offset)).all(|v| v.is_finite()) {
+            return Err(format!(
+                "uv_scale {uv_scale:?} and uv_offset {uv_offset:?} must be finite"
+            ));
+        }
+        let mut t = crate::texture::Texture::load(path).map_err(|e| e.to_string())?;
+        t.scale = Vec2::from(uv_scale);
+        t.offset = Vec2::from(uv_offset);
+        t.wrap = wrap;
+        Ok(TexturedDiffuse {
+            texture: std::sync::Arc::new(t),
+        })
     }
 }

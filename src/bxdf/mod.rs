@@ -36,7 +36,7 @@ use glam::{Vec2, Vec3};
 pub use coated::Coated;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
-pub use diffuse::Diffuse;
+pub use diffuse::{Diffuse, TexturedDiffuse};
 pub use ior::{ConductorIor, Ior};
 pub use microfacet::{Distribution, Masking, Microfacet};
 pub use oren_nayar::OrenNayar;
@@ -49,6 +49,12 @@ pub use thin_dielectric::ThinDielectric;
 pub enum Material {
     /// Lambertian reflection.
     Diffuse(Diffuse),
+    /// Lambertian reflection with an image texture as reflectance; integrators resolve it at
+    /// each hit with [`Material::at_texture`].
+    TexturedDiffuse(TexturedDiffuse),
+    /// Lambertian reflection with the reflectance already sampled at the path's wavelengths
+    /// (a texture's value at one hit, from [`Material::at_texture`]).
+    DiffuseAt(SampledSpectrum),
     /// Oren–Nayar rough diffuse reflection.
     OrenNayar(OrenNayar),
     /// Energy-normalised modified Phong.
@@ -124,6 +130,18 @@ impl Material {
     /// The material at `field` (e.g. `materials["glass"]`) from its description.
     pub fn build(ctx: &Context, field: &str, desc: &MaterialDesc) -> Result<Self, SceneError> {
         Ok(match desc {
+            MaterialDesc::Diffuse {
+                reflectance:
+                    crate::description::schema::SpectrumDesc::Texture {
+                        file,
+                        uv_scale,
+                        uv_offset,
+                        wrap,
+                    },
+            } => Material::TexturedDiffuse(
+                TexturedDiffuse::load(&ctx.resolve(file), *uv_scale, *uv_offset, *wrap)
+                    .map_err(|e| ctx.err(format!("{field}.reflectance"), e))?,
+            ),
             MaterialDesc::Diffuse { reflectance } => {
                 Material::Diffuse(Diffuse::build(ctx, field, reflectance)?)
             }
@@ -188,11 +206,103 @@ impl Material {
         })
     }
 
+    /// The candela material of an MTL material (docs/scene-format.md → models), errors at
+    /// `field`:
+    /// * `d` (or `1 − Tr`) below 1: a thin glass pane ([`ThinDielectric`]) of index `Ni`
+    ///   (1.5 unless `Ni` is in (1, 3]);
+    /// * else `map_Kd`: a textured [`Diffuse`] (the map replaces `Kd`; its `-s`, `-o` and
+    ///   `-clamp` options are kept);
+    /// * else a non-zero `Ks`: [`Phong`] with diffuse `Kd`, specular `Ks` and exponent `Ns`
+    ///   (default 0), both scaled down together where `Kd + Ks` exceeds 1;
+    /// * else [`Diffuse`] of reflectance `Kd` (default 0.8).
+    ///
+    /// Colours are linear sRGB in [0, 1] upsampled to smooth spectra.
+    pub fn from_mtl(
+        ctx: &Context,
+        field: &str,
+        m: &crate::geometry::mtl::MtlMaterial,
+    ) -> Result<Self, SceneError> {
+        use crate::description::context::Role;
+        use crate::description::schema::{IorDesc, SpectrumDesc};
+        let at = |stmt: &str| {
+            format!(
+                "{field} (`{stmt}` of material {:?}, '{}' line {})",
+                m.name,
+                m.file.display(),
+                m.line
+            )
+        };
+        let colour = |stmt: &str, c: [f64; 3]| {
+            if let Some(v) = c.iter().find(|v| !(0.0..=1.0).contains(*v)) {
+                return Err(ctx.err(
+                    at(stmt),
+                    format!(
+                        "component {v} is outside [0, 1]; MTL colours are linear sRGB reflectances"
+                    ),
+                ));
+            }
+            ctx.spectrum(
+                &at(stmt),
+                &SpectrumDesc::Rgb(c[0], c[1], c[2]),
+                Role::Reflectance,
+            )
+        };
+        let d = m.d.unwrap_or(1.0);
+        if !(0.0..=1.0).contains(&d) {
+            return Err(ctx.err(at("d"), format!("dissolve {d} is outside [0, 1]")));
+        }
+        if d < 1.0 {
+            let n = m.ni.filter(|n| *n > 1.0 && *n <= 3.0).unwrap_or(1.5);
+            return ThinDielectric::build(ctx, &at("Ni"), &IorDesc::Constant(n as f32))
+                .map(Material::ThinDielectric);
+        }
+        if let Some(map) = &m.map_kd {
+            let path = m
+                .file
+                .parent()
+                .unwrap_or(std::path::Path::new(""))
+                .join(&map.file);
+            let wrap = if map.clamp {
+                crate::texture::Wrap::Clamp
+            } else {
+                crate::texture::Wrap::Repeat
+            };
+            return TexturedDiffuse::load(&path, map.scale, map.offset, wrap)
+                .map(Material::TexturedDiffuse)
+                .map_err(|e| ctx.err(at("map_Kd"), e));
+        }
+        let kd = colour("Kd", m.kd.unwrap_or([0.8; 3]))?;
+        match m.ks.filter(|ks| ks.iter().any(|v| *v != 0.0)) {
+            Some(ks) => {
+                let ks = colour("Ks", ks)?;
+                let ns = m.ns.unwrap_or(0.0);
+                let peak = (0..kd.values.len())
+                    .map(|i| kd.values[i] + ks.values[i])
+                    .fold(0.0f32, f32::max);
+                let k = if peak > 1.0 { 1.0 / peak } else { 1.0 };
+                if !(0.0..=phong::MAX_EXPONENT as f64).contains(&ns) {
+                    return Err(ctx.err(
+                        at("Ns"),
+                        format!("exponent {ns} is outside [0, {:e}]", phong::MAX_EXPONENT),
+                    ));
+                }
+                Ok(Material::Phong(Phong::new(
+                    kd.scaled(k),
+                    ks.scaled(k),
+                    ns as f32,
+                )))
+            }
+            None => Ok(Material::Diffuse(Diffuse { reflectance: kd })),
+        }
+    }
+
     /// The material's [`MaterialFlags`].
     #[inline]
     pub fn flags(&self) -> MaterialFlags {
         match self {
-            Material::Diffuse(_) => Diffuse::FLAGS,
+            Material::Diffuse(_) | Material::TexturedDiffuse(_) | Material::DiffuseAt(_) => {
+                Diffuse::FLAGS
+            }
             Material::OrenNayar(_) => OrenNayar::FLAGS,
             Material::Phong(_) => Phong::FLAGS,
             Material::Conductor(m) => m.flags(),
@@ -200,6 +310,19 @@ impl Material {
             Material::ThinDielectric(_) => ThinDielectric::FLAGS,
             Material::Coated(m) => m.flags(),
             Material::Black => MaterialFlags::BLACK,
+        }
+    }
+
+    /// The material at a hit with texture coordinates `tex`, for a textured material (its
+    /// texture evaluated at the wavelengths of `wl`); `None` for any other, which is used as
+    /// it is. Integrators call it once per hit, before anything else.
+    #[inline]
+    pub fn at_texture(&self, tex: Vec2, wl: &SampledWavelengths) -> Option<Material> {
+        match self {
+            Material::TexturedDiffuse(t) => {
+                Some(Material::DiffuseAt(t.texture.reflectance(tex, wl)))
+            }
+            _ => None,
         }
     }
 
@@ -218,6 +341,12 @@ impl Material {
     pub fn eval(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
         match self {
             Material::Diffuse(d) => d.eval(wo, wi, wl),
+            Material::DiffuseAt(r) => diffuse::lambert_eval(*r, wo, wi),
+            // Unresolved (no hit to look the texture up at): the image's centre; integrators
+            // always resolve it first.
+            Material::TexturedDiffuse(t) => {
+                diffuse::lambert_eval(t.texture.reflectance(Vec2::splat(0.5), wl), wo, wi)
+            }
             Material::OrenNayar(m) => m.eval(wo, wi, wl),
             Material::Phong(m) => m.eval(wo, wi, wl),
             Material::Conductor(m) => m.eval(wo, wi, wl),
@@ -237,6 +366,10 @@ impl Material {
     ) -> Option<BsdfSample> {
         match self {
             Material::Diffuse(d) => d.sample(wo, u, wl),
+            Material::DiffuseAt(r) => diffuse::lambert_sample(*r, wo, u),
+            Material::TexturedDiffuse(t) => {
+                diffuse::lambert_sample(t.texture.reflectance(Vec2::splat(0.5), wl), wo, u)
+            }
             Material::OrenNayar(m) => m.sample(wo, u, wl),
             Material::Phong(m) => m.sample(wo, uc, u, wl),
             Material::Conductor(m) => m.sample(wo, u, wl),
@@ -251,6 +384,7 @@ impl Material {
     pub fn pdf(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> f32 {
         match self {
             Material::Diffuse(d) => d.pdf(wo, wi),
+            Material::DiffuseAt(_) | Material::TexturedDiffuse(_) => Diffuse::pdf_cosine(wo, wi),
             Material::OrenNayar(m) => m.pdf(wo, wi),
             Material::Phong(m) => m.pdf(wo, wi),
             Material::Conductor(m) => m.pdf(wo, wi),

@@ -243,6 +243,12 @@ impl Context<'_> {
                 in_range(self, field, &sd, &format!("{}", p.display()))?;
                 DenseSpectrum::from_fn(|nm| sd.value(nm))
             }
+            SpectrumDesc::Texture { .. } => {
+                return Err(self.err(
+                    field,
+                    "an image texture can only be a `Diffuse` material's reflectance",
+                ));
+            }
             SpectrumDesc::Rgb(..) | SpectrumDesc::Srgb(..) => {
                 let (rgb, encoded) = match *desc {
                     SpectrumDesc::Rgb(r, g, b) => ([r, g, b], false),

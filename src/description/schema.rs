@@ -357,6 +357,33 @@ pub enum SpectrumDesc {
     /// An sRGB colour as encoded in images and colour pickers (IEC 61966-2-1 transfer function,
     /// components in [0, 1]); decoded to linear sRGB, then as `Rgb`.
     Srgb(f64, f64, f64),
+    /// An image texture (only as a `Diffuse` material's reflectance): each texel's colour
+    /// upsampled as `Srgb` (PNG, JPEG) or `Rgb` (OpenEXR); docs/scene-format.md → textures.
+    Texture {
+        /// PNG, JPEG (sRGB) or OpenEXR (linear) image, relative to the scene file.
+        file: String,
+        /// Texture coordinates are multiplied by this (default (1, 1)), then offset.
+        #[serde(default = "default_uv_scale")]
+        uv_scale: [f32; 2],
+        #[serde(default)]
+        uv_offset: [f32; 2],
+        /// `Repeat` (default) or `Clamp`.
+        #[serde(default)]
+        wrap: crate::texture::Wrap,
+    },
+}
+
+fn default_uv_scale() -> [f32; 2] {
+    [1.0, 1.0]
+}
+
+/// A material given by an OBJ object's `materials_from_file`: a material of the scene's
+/// `materials` by name, or one defined in place.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MaterialRefDesc {
+    Named(String),
+    Material(MaterialDesc),
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -474,7 +501,9 @@ pub struct ObjectDesc {
     #[serde(default)]
     pub name: Option<String>,
     pub shape: ShapeDesc,
-    /// Name of an entry of `materials` (or `"black"`).
+    /// Name of an entry of `materials` (or `"black"`). For a `Model` shape, optional: the
+    /// material of the faces that name none (docs/scene-format.md → models).
+    #[serde(default)]
     pub material: String,
     #[serde(default)]
     pub emission: Option<EmissionDesc>,
@@ -511,6 +540,25 @@ pub enum ShapeDesc {
     Obj(String),
     /// PLY file (ASCII or binary), relative to the scene file.
     Ply(String),
+    /// A building model: an OBJ file (relative to the scene file) whose faces keep the
+    /// materials of its MTL libraries, mapped to candela materials (docs/scene-format.md →
+    /// models); `materials_from_file` replaces some of them by name.
+    Model {
+        file: String,
+        #[serde(default, deserialize_with = "unique_override_keys")]
+        materials_from_file: BTreeMap<String, MaterialRefDesc>,
+        /// Luminance, cd/m², of a material whose MTL `Ke` is (1, 1, 1); with it, materials
+        /// with a non-zero `Ke` emit (none do without it).
+        #[serde(default)]
+        ke_luminance: Option<f64>,
+    },
+}
+
+fn unique_override_keys<'de, D>(d: D) -> Result<BTreeMap<String, MaterialRefDesc>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    unique_keys(d, "materials_from_file")
 }
 
 #[derive(Debug, Clone, Deserialize)]

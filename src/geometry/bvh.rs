@@ -107,6 +107,19 @@ impl SceneGeometry {
     /// vertex-normal count different from the vertex count) give an error naming the object.
     /// An empty scene is allowed (every ray misses).
     pub fn build(shapes: &[(Shape, u32)]) -> Result<SceneGeometry, GeometryError> {
+        Self::build_with_uvs(shapes, &[])
+    }
+
+    /// [`SceneGeometry::build`] with per-vertex texture coordinates for some meshes:
+    /// `uvs[k]`, if present, belongs to the mesh `shapes[k]` (one per vertex), and hits on it
+    /// interpolate them into [`Hit::tex`](super::Hit::tex).
+    pub fn build_with_uvs(
+        shapes: &[(Shape, u32)],
+        uvs: &[Option<&[glam::Vec2]>],
+    ) -> Result<SceneGeometry, GeometryError> {
+        let mut prim_uvs: Vec<[u32; 3]> = Vec::new();
+        let mut all_uvs: Vec<glam::Vec2> = Vec::new();
+        let any_uvs = uvs.iter().any(Option::is_some);
         let mut prims: Vec<Prim> = Vec::new();
         let mut objects: Vec<u32> = Vec::new();
         let mut prim_normals: Vec<[u32; 3]> = Vec::new();
@@ -115,8 +128,9 @@ impl SceneGeometry {
             .iter()
             .any(|(s, _)| matches!(s, Shape::Mesh(m) if m.normals.is_some()));
         let no_n = [u32::MAX; 3];
-        for (shape, object) in shapes {
+        for (k, (shape, object)) in shapes.iter().enumerate() {
             let object = *object;
+            let shape_uvs = uvs.get(k).copied().flatten();
             match shape {
                 Shape::Sphere { center, radius } => {
                     if !(finite3(*center) && radius.is_finite() && *radius > 0.0) {
@@ -204,6 +218,17 @@ impl SceneGeometry {
                         None => false,
                     };
                     let nv = m.positions.len();
+                    let tbase = all_uvs.len() as u32;
+                    if let Some(t) = shape_uvs {
+                        if t.len() != nv {
+                            return Err(invalid(
+                                shape,
+                                object,
+                                format!("it has {} texture coordinates for {nv} vertices", t.len()),
+                            ));
+                        }
+                        all_uvs.extend_from_slice(t);
+                    }
                     for (f, tri) in m.indices.iter().enumerate() {
                         if let Some(&bad) = tri.iter().find(|&&i| i as usize >= nv) {
                             return Err(invalid(
@@ -221,6 +246,10 @@ impl SceneGeometry {
                         if any_normals {
                             prim_normals.push(if has_n { tri.map(|i| nbase + i) } else { no_n });
                         }
+                        if any_uvs {
+                            let has_t = shape_uvs.is_some();
+                            prim_uvs.push(if has_t { tri.map(|i| tbase + i) } else { no_n });
+                        }
                         objects.push(object);
                     }
                     continue;
@@ -229,6 +258,9 @@ impl SceneGeometry {
             objects.push(object);
             if any_normals {
                 prim_normals.push(no_n);
+            }
+            if any_uvs {
+                prim_uvs.push(no_n);
             }
         }
         if prims.len() >= u32::MAX as usize {
@@ -329,6 +361,11 @@ impl SceneGeometry {
         } else {
             Vec::new()
         };
+        let prim_uvs: Vec<[u32; 3]> = if any_uvs {
+            order.iter().map(|&i| prim_uvs[i as usize]).collect()
+        } else {
+            Vec::new()
+        };
         // Traversal only needs the node array once the primitives are in leaf order.
         bvh.primitive_indices = Vec::new();
         bvh.exact_node_aabbs = None;
@@ -352,6 +389,8 @@ impl SceneGeometry {
             prim_object,
             prim_normals,
             normals,
+            prim_uvs,
+            uvs: all_uvs,
             object_prims,
             bounds,
         })

@@ -8,7 +8,7 @@ use glam::Vec3;
 use std::path::Path;
 
 /// A mesh file's error; an unreadable file's hint says where relative paths are resolved.
-fn mesh_err(ctx: &Context, field: &str, rel: &str, e: GeometryError) -> SceneError {
+pub(crate) fn mesh_err(ctx: &Context, field: &str, rel: &str, e: GeometryError) -> SceneError {
     match e {
         GeometryError::Io { path, source } => ctx.err(
             field,
@@ -125,6 +125,9 @@ impl Shape {
             }
             ShapeDesc::Obj(rel) => {
                 Shape::Mesh(load_obj(&ctx.resolve(rel)).map_err(|e| mesh_err(ctx, field, rel, e))?)
+            }
+            ShapeDesc::Model { .. } => {
+                return Err(ctx.err(field, "a Model is built with its materials by the scene"))
             }
             ShapeDesc::Ply(rel) => {
                 Shape::Mesh(load_ply(&ctx.resolve(rel)).map_err(|e| mesh_err(ctx, field, rel, e))?)

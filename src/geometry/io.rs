@@ -8,9 +8,10 @@
 //! is estimated from the file's contents (OBJ: its statements; PLY: its header) and checked
 //! against the memory available.
 
+use super::mtl::MtlMaterial;
 use super::{GeometryError, TriangleMesh};
 use crate::limits;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::path::Path;
 
 /// Largest mesh file read at all; below it, the memory available decides.
@@ -198,14 +199,19 @@ fn locate_bad_face(text: &str) -> Option<String> {
     None
 }
 
-/// Loads a Wavefront OBJ file: polygons are triangulated (fan), all objects/groups are merged
-/// into one mesh, materials and texture coordinates are ignored. Vertex normals are kept only
-/// if every object in the file has them. A UTF-8 byte-order mark is skipped; bytes that are not
-/// UTF-8 (only names and comments can hold them) are replaced.
-///
-/// Material libraries (`mtllib`) are not used, so one that does not exist is ignored; one that
-/// is a FIFO, a device, a directory or over 16 MiB is refused, naming it.
-pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
+/// How an OBJ file's material libraries are read.
+#[derive(Clone, Copy, PartialEq)]
+enum Mtl {
+    /// Not used: one that does not exist is ignored, one that is not a plain file is refused.
+    Ignore,
+    /// Parsed; one that is missing or malformed is an error.
+    Use,
+}
+
+type Models = (Vec<tobj::Model>, Vec<MtlMaterial>);
+
+/// Reads and parses an OBJ file (and, with [`Mtl::Use`], its material libraries).
+fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
     let bytes = read_mesh(path)?;
     check_memory(
         path,
@@ -226,21 +232,60 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
         message,
     };
     let mtl_error = std::cell::RefCell::new(None);
+    let mtls = std::cell::RefCell::new(Vec::<MtlMaterial>::new());
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
         let mtl = path.parent().unwrap_or(Path::new("")).join(name);
-        match limits::read_file(&mtl, MAX_MTL_FILE_BYTES) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                mtl_error
-                    .borrow_mut()
-                    .get_or_insert(GeometryError::Material {
-                        path: path.to_path_buf(),
-                        mtl,
-                        source: e,
-                    });
+        let fail = |e: GeometryError| {
+            mtl_error.borrow_mut().get_or_insert(e);
+            Ok(Default::default())
+        };
+        let bytes = match limits::read_file(&mtl, MAX_MTL_FILE_BYTES) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound && mtl_mode == Mtl::Ignore => {
+                return Ok(Default::default())
             }
-            _ => {}
+            Err(source) => {
+                return fail(GeometryError::Material {
+                    path: path.to_path_buf(),
+                    mtl,
+                    source,
+                })
+            }
+            Ok(b) => b,
+        };
+        if mtl_mode == Mtl::Ignore {
+            return Ok(Default::default());
         }
-        Ok(Default::default())
+        let parsed = match super::mtl::parse_mtl(&mtl, &bytes) {
+            Ok(p) => p,
+            Err(e) => return fail(e),
+        };
+        let mut all = mtls.borrow_mut();
+        // tobj's own map type (it is not named in tobj's API).
+        let empty: tobj::MTLLoadResult = Ok(Default::default());
+        let Ok((mut mats, mut map)) = empty else {
+            unreachable!()
+        };
+        for m in parsed {
+            if let Some(prev) = all.iter().find(|p| p.name == m.name) {
+                return fail(GeometryError::MaterialSyntax {
+                    mtl: m.file.clone(),
+                    line: m.line,
+                    message: format!(
+                        "material {:?} is defined again (first in '{}', line {})",
+                        m.name,
+                        prev.file.display(),
+                        prev.line
+                    ),
+                });
+            }
+            map.insert(m.name.clone(), mats.len());
+            mats.push(tobj::Material {
+                name: m.name.clone(),
+                ..Default::default()
+            });
+            all.push(m);
+        }
+        Ok((mats, map))
     };
     // tobj should not panic on malformed input, but a mesh loader must never take the
     // renderer down: convert any panic into an error.
@@ -267,15 +312,57 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
         tobj::LoadError::PositionParseError => {
             parse("a vertex position ('v' line) is not three numbers".into())
         }
+        tobj::LoadError::MaterialParseError => {
+            parse("a 'usemtl' statement names no material".into())
+        }
         e => parse(e.to_string()),
     })?;
-    let mut mesh = TriangleMesh::default();
-    let all_normals = !models.is_empty()
-        && models
-            .iter()
-            .all(|m| !m.mesh.normals.is_empty() && m.mesh.normals.len() == m.mesh.positions.len());
-    let mut normals = Vec::new();
-    for m in &models {
+    let mtls = mtls.into_inner();
+    if mtl_mode == Mtl::Use {
+        // A `usemtl` naming no material of the libraries would silently lose its faces'
+        // material: say where it is.
+        for (n, line) in text.lines().enumerate() {
+            let l = line.trim_start();
+            if let Some(name) = l
+                .strip_prefix("usemtl")
+                .filter(|r| r.starts_with([' ', '\t']))
+            {
+                let name = name.trim();
+                if !mtls.iter().any(|m| m.name == name) {
+                    let mut known: Vec<&str> = mtls.iter().map(|m| m.name.as_str()).collect();
+                    known.sort_unstable();
+                    return Err(parse(format!(
+                        "line {}: `usemtl {name}` names a material that no material library (`mtllib`) of the file defines{}",
+                        n + 1,
+                        if known.is_empty() {
+                            " (it has none)".to_string()
+                        } else {
+                            format!("; defined: {}", known.join(", "))
+                        }
+                    )));
+                }
+            }
+        }
+    }
+    Ok((models, mtls))
+}
+
+/// Appends the triangles of `models` to `mesh` (and their normals to `normals` when
+/// `with_normals`, texture coordinates to `uvs` when given).
+fn append_models(
+    path: &Path,
+    models: &[&tobj::Model],
+    mesh: &mut TriangleMesh,
+    normals: Option<&mut Vec<Vec3>>,
+    mut uvs: Option<&mut Vec<Vec2>>,
+) -> Result<(), GeometryError> {
+    let parse = |message: String| GeometryError::Parse {
+        path: path.to_path_buf(),
+        format: "OBJ",
+        message,
+    };
+    let mut normals = normals;
+    for m in models {
         let base = mesh.positions.len() as u64;
         let mm = &m.mesh;
         if mm.positions.len() % 3 != 0 || mm.indices.len() % 3 != 0 {
@@ -290,12 +377,22 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
                 .chunks_exact(3)
                 .map(|c| Vec3::new(c[0], c[1], c[2])),
         );
-        if all_normals {
+        if let Some(normals) = normals.as_deref_mut() {
             normals.extend(
                 mm.normals
                     .chunks_exact(3)
                     .map(|c| Vec3::new(c[0], c[1], c[2])),
             );
+        }
+        if let Some(uvs) = uvs.as_deref_mut() {
+            if mm.texcoords.len() == 2 * nv {
+                uvs.extend(mm.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])));
+            } else {
+                uvs.resize(uvs.len() + nv, Vec2::ZERO);
+            }
+            if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
+                return Err(parse(format!("texture coordinate {i} is not finite")));
+            }
         }
         for (f, c) in mm.indices.chunks_exact(3).enumerate() {
             if let Some(&i) = c.iter().find(|&&i| i as usize >= nv) {
@@ -312,11 +409,113 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
             mesh.indices.push([idx(c[0])?, idx(c[1])?, idx(c[2])?]);
         }
     }
-    if all_normals {
+    Ok(())
+}
+
+fn all_have_normals(models: &[&tobj::Model]) -> bool {
+    !models.is_empty()
+        && models
+            .iter()
+            .all(|m| !m.mesh.normals.is_empty() && m.mesh.normals.len() == m.mesh.positions.len())
+}
+
+/// Loads a Wavefront OBJ file: polygons are triangulated (fan), all objects/groups are merged
+/// into one mesh, materials and texture coordinates are ignored (see [`load_obj_model`]).
+/// Vertex normals are kept only if every object in the file has them. A UTF-8 byte-order mark
+/// is skipped; bytes that are not UTF-8 (only names and comments can hold them) are replaced.
+///
+/// Material libraries (`mtllib`) are not used, so one that does not exist is ignored; one that
+/// is a FIFO, a device, a directory or over 16 MiB is refused, naming it.
+pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
+    let (models, _) = parse_obj(path, Mtl::Ignore)?;
+    let models: Vec<&tobj::Model> = models.iter().collect();
+    let mut mesh = TriangleMesh::default();
+    let with_normals = all_have_normals(&models);
+    let mut normals = Vec::new();
+    append_models(
+        path,
+        &models,
+        &mut mesh,
+        with_normals.then_some(&mut normals),
+        None,
+    )?;
+    if with_normals {
         mesh.normals = Some(normals);
     }
     validate(path, &mesh)?;
     Ok(mesh)
+}
+
+/// The faces of an OBJ file that share one material.
+#[derive(Clone, Debug)]
+pub struct ObjGroup {
+    /// The material their `usemtl` names; `None` for faces before any `usemtl`.
+    pub material: Option<String>,
+    pub mesh: TriangleMesh,
+    /// Per-vertex texture coordinates (as many as `mesh.positions`; (0, 0) at vertices whose
+    /// faces give none), present when any face of the group has `vt` references.
+    pub uvs: Option<Vec<Vec2>>,
+}
+
+/// An OBJ file with its materials: one [`ObjGroup`] per material used, in order of first use,
+/// and the materials of its libraries.
+#[derive(Clone, Debug)]
+pub struct ObjModel {
+    pub groups: Vec<ObjGroup>,
+    pub materials: Vec<MtlMaterial>,
+}
+
+/// Loads an OBJ file keeping its materials: the faces are grouped by the material their
+/// `usemtl` names (each group one mesh, with its texture coordinates and, if every part of the
+/// group has them, vertex normals), and the material libraries (`mtllib`, relative to the OBJ
+/// file) are parsed. A library that is missing, not a plain file, over 16 MiB or malformed, a
+/// material defined twice, and a `usemtl` naming no material of the libraries are errors
+/// naming the file and line. Groups with no triangles are left out; a file with none at all is
+/// an error.
+pub fn load_obj_model(path: &Path) -> Result<ObjModel, GeometryError> {
+    let (models, materials) = parse_obj(path, Mtl::Use)?;
+    let mut ids: Vec<Option<usize>> = Vec::new();
+    for m in &models {
+        if !ids.contains(&m.mesh.material_id) {
+            ids.push(m.mesh.material_id);
+        }
+    }
+    let mut groups = Vec::with_capacity(ids.len());
+    for id in ids {
+        let part: Vec<&tobj::Model> = models
+            .iter()
+            .filter(|m| m.mesh.material_id == id && !m.mesh.indices.is_empty())
+            .collect();
+        if part.is_empty() {
+            continue;
+        }
+        let with_normals = all_have_normals(&part);
+        let with_uvs = part.iter().any(|m| !m.mesh.texcoords.is_empty());
+        let (mut mesh, mut normals, mut uvs) = (TriangleMesh::default(), Vec::new(), Vec::new());
+        append_models(
+            path,
+            &part,
+            &mut mesh,
+            with_normals.then_some(&mut normals),
+            with_uvs.then_some(&mut uvs),
+        )?;
+        if with_normals {
+            mesh.normals = Some(normals);
+        }
+        validate(path, &mesh)?;
+        groups.push(ObjGroup {
+            material: id.and_then(|i| materials.get(i)).map(|m| m.name.clone()),
+            mesh,
+            uvs: with_uvs.then_some(uvs),
+        });
+    }
+    if groups.is_empty() {
+        return Err(GeometryError::NoTriangles {
+            path: path.to_path_buf(),
+            detail: "no faces with 3 or more vertices were found".into(),
+        });
+    }
+    Ok(ObjModel { groups, materials })
 }
 
 /// Loads a PLY file (ascii, binary little- or big-endian): element `vertex` with float

@@ -36,6 +36,7 @@
 mod bvh;
 mod desc;
 mod io;
+pub mod mtl;
 mod prim;
 mod query;
 mod robust;
@@ -43,7 +44,8 @@ mod sample;
 mod scene;
 mod traverse;
 
-pub use io::{load_obj, load_ply};
+pub(crate) use desc::mesh_err;
+pub use io::{load_obj, load_obj_model, load_ply, ObjGroup, ObjModel};
 pub use query::RayHit;
 pub use robust::{
     gamma, next_float_down, next_float_up, offset_ray_origin, point_error_bound, shadow_ray,
@@ -76,6 +78,13 @@ pub enum GeometryError {
         mtl: PathBuf,
         #[source]
         source: std::io::Error,
+    },
+    /// A statement of a material library is malformed.
+    #[error("material library '{}' is invalid, line {line}: {message}.", mtl.display())]
+    MaterialSyntax {
+        mtl: PathBuf,
+        line: usize,
+        message: String,
     },
     /// The file exists but its contents could not be parsed (corrupt, truncated, non-numeric...).
     #[error("mesh file '{}' is corrupt, truncated or not a valid {format} file: {message}.", path.display())]
@@ -396,6 +405,8 @@ pub struct Hit {
     /// Surface parameterisation: triangle barycentrics (b1, b2) of v1, v2; quad (s, t);
     /// sphere (φ/2π, θ/π) with θ from +Z; disk (r/R, φ/2π).
     pub uv: Vec2,
+    /// Texture coordinates: a mesh's interpolated `vt` where it has them, else `uv`.
+    pub tex: Vec2,
     /// Primitive id (see [`SceneGeometry::primitives_of_object`]).
     pub prim: u32,
     /// The caller's id of the scene object the primitive came from.

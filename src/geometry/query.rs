@@ -244,12 +244,21 @@ impl SceneGeometry {
                 }
             }
         }
+        let mut tex = g.uv;
+        if let Some(idx) = self.prim_uvs.get(prim as usize) {
+            if idx[0] != u32::MAX {
+                tex = g.bary.x * self.uvs[idx[0] as usize]
+                    + g.bary.y * self.uvs[idx[1] as usize]
+                    + g.bary.z * self.uvs[idx[2] as usize];
+            }
+        }
         Hit {
             t,
             p: g.p,
             ng: g.ng,
             ns,
             uv: g.uv,
+            tex,
             prim,
             object: self.prim_object[prim as usize],
             front_face: pre.d.dot(g.ng) < 0.0,

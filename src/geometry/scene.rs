@@ -22,6 +22,10 @@ pub struct SceneGeometry {
     /// primitive has vertex normals.
     pub(super) prim_normals: Vec<[u32; 3]>,
     pub(super) normals: Vec<Vec3>,
+    /// Per primitive texture-coordinate indices into `uvs` (`u32::MAX` = none). Empty when no
+    /// primitive has texture coordinates.
+    pub(super) prim_uvs: Vec<[u32; 3]>,
+    pub(super) uvs: Vec<glam::Vec2>,
     /// (object id, primitive ids), sorted by object id.
     pub(super) object_prims: Vec<(u32, Vec<u32>)>,
     pub(super) bounds: (Vec3, Vec3),
@@ -86,6 +90,8 @@ impl SceneGeometry {
             + self.prim_object.capacity() * 4
             + self.prim_normals.capacity() * 12
             + self.normals.capacity() * 12
+            + self.prim_uvs.capacity() * 12
+            + self.uvs.capacity() * 8
             + self
                 .object_prims
                 .iter()

@@ -212,6 +212,14 @@ pub fn trace_light_path(
         };
         let object = world.objects[hit.object as usize];
         let material = &world.materials[object.material as usize];
+        let textured;
+        let material = match material.at_texture(hit.tex, &wl) {
+            Some(m) => {
+                textured = m;
+                &textured
+            }
+            None => material,
+        };
         // A black surface ends the path, but still receives illuminance (below).
         let black = material.flags().contains(crate::bxdf::MaterialFlags::BLACK);
         depth += 1;

@@ -186,6 +186,14 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
         }
 
         let material = &world.materials[object.material as usize];
+        let textured;
+        let material = match material.at_texture(hit.tex, wl) {
+            Some(m) => {
+                textured = m;
+                &textured
+            }
+            None => material,
+        };
         if material.flags().contains(crate::bxdf::MaterialFlags::BLACK) {
             break;
         }

@@ -262,39 +262,91 @@ pub fn build_for(
         materials.push(mat);
     }
 
-    // Objects and their shapes.
+    // Objects and their shapes. A `Model` becomes one object per material it uses, so the
+    // world's objects are numbered apart from the scene's: `scene_object` maps them back.
     let mut shapes: Vec<(Shape, u32)> = Vec::with_capacity(scene.objects.len());
+    let mut shape_uvs: Vec<Option<Vec<glam::Vec2>>> = Vec::new();
+    let mut scene_object: Vec<usize> = Vec::with_capacity(scene.objects.len());
     let mut objects = Vec::with_capacity(scene.objects.len());
-    let mut pending_area: Vec<(u32, String, &EmissionDesc, DenseSpectrum)> = Vec::new();
-    for (i, o) in scene.objects.iter().enumerate() {
-        let field = object_field(i, o);
-        let mat = *material_index.get(o.material.as_str()).ok_or_else(|| {
+    let mut pending_area: Vec<(u32, String, EmissionDesc, DenseSpectrum)> = Vec::new();
+    let lookup = |field: &str, name: &str| -> Result<u32, SceneError> {
+        material_index.get(name).copied().ok_or_else(|| {
             let mut known: Vec<&str> = material_index.keys().copied().collect();
             known.sort();
+            if name.is_empty() {
+                return ctx.err(
+                    field,
+                    format!(
+                        "missing: name the object's material; defined materials: {}",
+                        known.join(", ")
+                    ),
+                );
+            }
             ctx.err(
-                format!("{field}.material"),
+                field,
                 format!(
-                    "unknown material {:?}; defined materials: {}",
-                    o.material,
+                    "unknown material {name:?}; defined materials: {}",
                     known.join(", ")
                 ),
             )
-        })?;
-        let mut shape = Shape::build(&ctx, &format!("{field}.shape"), &o.shape)?;
-        if let Some(t) = &o.transform {
-            let tf = Transform::build(&ctx, &format!("{field}.transform"), t)?;
-            shape = shape
-                .to_world(&tf)
-                .map_err(|e| ctx.err(format!("{field}.transform"), e.to_string()))?;
-        }
-        shapes.push((shape, i as u32));
-        objects.push(Object {
-            material: mat,
-            light: None,
-        });
-        if let Some(e) = &o.emission {
-            let s = AreaLight::spectrum(&ctx, &field, e)?;
-            pending_area.push((i as u32, field.clone(), e, s));
+        })
+    };
+    for (i, o) in scene.objects.iter().enumerate() {
+        let field = object_field(i, o);
+        let transform = match &o.transform {
+            Some(t) => Some(Transform::build(&ctx, &format!("{field}.transform"), t)?),
+            None => None,
+        };
+        let place = |shape: Shape| -> Result<Shape, SceneError> {
+            match &transform {
+                Some(tf) => shape
+                    .to_world(tf)
+                    .map_err(|e| ctx.err(format!("{field}.transform"), e.to_string())),
+                None => Ok(shape),
+            }
+        };
+        let parts = match &o.shape {
+            ShapeDesc::Model { .. } if o.emission.is_some() => {
+                return Err(ctx.err(
+                    format!("{field}.emission"),
+                    "a Model's materials emit through their MTL `Ke` and the shape's `ke_luminance`; give other emitters as objects of their own",
+                ));
+            }
+            ShapeDesc::Model {
+                file,
+                materials_from_file,
+                ke_luminance,
+            } => model_parts(
+                &ctx,
+                &field,
+                (file, materials_from_file, *ke_luminance),
+                &o.material,
+                &lookup,
+                &mut materials,
+            )?,
+            desc => vec![Part {
+                shape: Shape::build(&ctx, &format!("{field}.shape"), desc)?,
+                uvs: None,
+                material: lookup(&format!("{field}.material"), &o.material)?,
+                emission: o.emission.clone(),
+            }],
+        };
+        for part in parts {
+            let id = objects.len() as u32;
+            shapes.push((place(part.shape)?, id));
+            if part.uvs.is_some() {
+                shape_uvs.resize(shapes.len(), None);
+                shape_uvs[shapes.len() - 1] = part.uvs;
+            }
+            scene_object.push(i);
+            objects.push(Object {
+                material: part.material,
+                light: None,
+            });
+            if let Some(e) = part.emission {
+                let s = AreaLight::spectrum(&ctx, &field, &e)?;
+                pending_area.push((id, field.clone(), e, s));
+            }
         }
     }
     // Bounding spheres of the objects that scatter specularly: where light tracing aims.
@@ -327,12 +379,12 @@ pub fn build_for(
         illuminance,
         caustics,
     )?;
-    let geometry = SceneGeometry::build(&shapes).map_err(|e| {
+    let uvs: Vec<Option<&[glam::Vec2]>> = shape_uvs.iter().map(|u| u.as_deref()).collect();
+    let geometry = SceneGeometry::build_with_uvs(&shapes, &uvs).map_err(|e| {
         let field = match &e {
-            geometry::GeometryError::InvalidShape { object, .. } => scene
-                .objects
+            geometry::GeometryError::InvalidShape { object, .. } => scene_object
                 .get(*object as usize)
-                .map(|o| format!("{}.shape", object_field(*object as usize, o))),
+                .map(|&i| format!("{}.shape", object_field(i, &scene.objects[i]))),
             _ => None,
         };
         ctx.err(field.unwrap_or_else(|| "objects".into()), e.to_string())
@@ -348,7 +400,7 @@ pub fn build_for(
     let mut lights: Vec<Light> = Vec::new();
     let mut infinite_lights = Vec::new();
     for (object, field, e, s) in pending_area {
-        let light = AreaLight::build(&ctx, &field, object, e, &s, &geometry)?;
+        let light = AreaLight::build(&ctx, &field, object, &e, &s, &geometry)?;
         objects[object as usize].light = Some(lights.len() as u32);
         lights.push(Light::Area(light));
     }
@@ -500,6 +552,123 @@ pub fn build_for(
         caustics,
         sources: ctx.sources.into_inner(),
     })
+}
+
+/// One world object made from a scene object: its shape (before the object's transform), its
+/// texture coordinates, material and emission.
+struct Part {
+    shape: Shape,
+    uvs: Option<Vec<glam::Vec2>>,
+    material: u32,
+    emission: Option<EmissionDesc>,
+}
+
+/// The parts of a `Model` object at `field`: one per material its OBJ file uses, with the
+/// material mapped from the MTL (or given by `materials_from_file`), faces that name none
+/// taking `fallback`; materials made here are appended to `materials`.
+fn model_parts(
+    ctx: &Context,
+    field: &str,
+    (file, overrides, ke_luminance): (
+        &str,
+        &std::collections::BTreeMap<String, MaterialRefDesc>,
+        Option<f64>,
+    ),
+    fallback: &str,
+    lookup: &dyn Fn(&str, &str) -> Result<u32, SceneError>,
+    materials: &mut Vec<Material>,
+) -> Result<Vec<Part>, SceneError> {
+    let shape_field = format!("{field}.shape");
+    let model = geometry::load_obj_model(&ctx.resolve(file))
+        .map_err(|e| geometry::mesh_err(ctx, &shape_field, file, e))?;
+    let names = || {
+        let mut n: Vec<&str> = model.materials.iter().map(|m| m.name.as_str()).collect();
+        n.sort_unstable();
+        n.join(", ")
+    };
+    for name in overrides.keys() {
+        if !model.materials.iter().any(|m| &m.name == name) {
+            return Err(ctx.err(
+                format!("{shape_field}.materials_from_file[{name:?}]"),
+                format!(
+                    "{file:?} defines no material {name:?}; its materials: {}",
+                    names()
+                ),
+            ));
+        }
+    }
+    if let Some(l) = ke_luminance {
+        if !(l.is_finite() && l >= 0.0) {
+            return Err(ctx.err(
+                format!("{shape_field}.ke_luminance"),
+                format!("{l} must be a luminance ≥ 0, cd/m²"),
+            ));
+        }
+    }
+    let mut parts = Vec::with_capacity(model.groups.len());
+    for g in model.groups {
+        let Some(name) = g.material else {
+            let material = lookup(&format!("{field}.material"), fallback).map_err(|e| {
+                ctx.err(
+                    format!("{field}.material"),
+                    format!("{file:?} has faces before any `usemtl`; they take the object's `material`: {}", e),
+                )
+            })?;
+            parts.push(Part {
+                shape: Shape::Mesh(g.mesh),
+                uvs: g.uvs,
+                material,
+                emission: None,
+            });
+            continue;
+        };
+        let mtl = model
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .expect("the loader checks every usemtl");
+        let over = format!("{shape_field}.materials_from_file[{name:?}]");
+        let material = match overrides.get(&name) {
+            Some(MaterialRefDesc::Named(n)) => lookup(&over, n)?,
+            Some(MaterialRefDesc::Material(desc)) => {
+                materials.push(Material::build(ctx, &over, desc)?);
+                materials.len() as u32 - 1
+            }
+            None => {
+                materials.push(Material::from_mtl(ctx, &shape_field, mtl)?);
+                materials.len() as u32 - 1
+            }
+        };
+        let emission = match (ke_luminance, mtl.ke) {
+            (Some(l), Some(ke)) if ke.iter().any(|&v| v > 0.0) => {
+                if let Some(v) = ke.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+                    return Err(ctx.err(
+                        format!(
+                            "{shape_field} (`Ke` of material {name:?}, '{}' line {})",
+                            mtl.file.display(),
+                            mtl.line
+                        ),
+                        format!("component {v} must be ≥ 0"),
+                    ));
+                }
+                let peak = ke.iter().copied().fold(0.0, f64::max);
+                let y = 0.2126 * ke[0] + 0.7152 * ke[1] + 0.0722 * ke[2];
+                Some(EmissionDesc {
+                    spectrum: SpectrumDesc::Rgb(ke[0] / peak, ke[1] / peak, ke[2] / peak),
+                    amount: Amount::Luminance(l * y),
+                    two_sided: false,
+                })
+            }
+            _ => None,
+        };
+        parts.push(Part {
+            shape: Shape::Mesh(g.mesh),
+            uvs: g.uvs,
+            material,
+            emission,
+        });
+    }
+    Ok(parts)
 }
 
 /// The site's frame from `site`.

@@ -1,0 +1,323 @@
+//! Image textures of diffuse reflectance. An sRGB PNG or JPEG (decoded with the sRGB transfer
+//! function) or a linear OpenEXR (channels R, G, B) is turned, once at load, into one smooth
+//! reflectance spectrum per texel by [`crate::spectrum::rgb_upsample`]: each texel keeps the
+//! three sigmoid coefficients of its spectrum (12 bytes, [`BYTES_PER_TEXEL`]), not the
+//! spectrum. A lookup filters bilinearly, evaluating the four texels' spectra at the path's
+//! wavelengths. Texture coordinates are transformed as `uv · scale + offset`, then wrapped
+//! (repeated or clamped); v = 0 is the bottom row of the image, as in OBJ files.
+
+use crate::spectrum::rgb_upsample::fit_linear_srgb;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, N_LAMBDA};
+use glam::Vec2;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// Memory of one texel once loaded, bytes: three f32 sigmoid coefficients.
+pub const BYTES_PER_TEXEL: u64 = 12;
+
+/// Most texels of one texture (16 k × 16 k).
+pub const MAX_TEXELS: u64 = 1 << 28;
+
+/// Largest image file read.
+const MAX_TEXTURE_FILE_BYTES: u64 = 4 << 30;
+
+/// Peak bytes per texel while loading, with room to spare: the decoded image (up to 16 B for
+/// 16-bit RGBA), its 8-bit copy (3 B), the linear colours (12 B), the colour index (4 B), the
+/// map of distinct colours (up to ~24 B) and the coefficients (12 B).
+const LOAD_BYTES_PER_TEXEL: u64 = 64;
+
+/// Wavelength span of the normalised coefficients: t = (λ − 360 nm) / 470 nm.
+const T_MIN_NM: f64 = 360.0;
+const T_SPAN_NM: f64 = 470.0;
+
+/// How texture coordinates outside [0, 1] are mapped into the image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+pub enum Wrap {
+    /// Tiles the image.
+    #[default]
+    Repeat,
+    /// Extends the edge texels.
+    Clamp,
+}
+
+/// A texture could not be loaded.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot use texture image '{}': {message}.", path.display())]
+pub struct TextureError {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+/// A reflectance texture (see the module docs).
+#[derive(Clone, Debug)]
+pub struct Texture {
+    width: u32,
+    height: u32,
+    /// Per texel, top row first: (a0, a1, a2) of R(λ) = S((a0·t + a1)·t + a2), t as
+    /// [`T_MIN_NM`]; ±∞ in a2 for the exact constants 1 and 0.
+    coeffs: Vec<[f32; 3]>,
+    pub wrap: Wrap,
+    /// Texture coordinates are `uv · scale + offset` before wrapping.
+    pub scale: Vec2,
+    pub offset: Vec2,
+}
+
+/// The sigmoid S(x) = ½ + x / (2√(1+x²)) in f32 (exactly 0 or 1 beyond |x| = 10¹⁰).
+#[inline(always)]
+fn sigmoid(x: f32) -> f32 {
+    if x.abs() > 1e10 {
+        return if x > 0.0 { 1.0 } else { 0.0 };
+    }
+    0.5 + 0.5 * x / (1.0 + x * x).sqrt()
+}
+
+impl Texture {
+    /// A texture from linear-sRGB reflectance colours (each component clamped to [0, 1]),
+    /// `width × height`, top row first. Each distinct colour is fitted once.
+    pub fn from_linear_rgb(width: u32, height: u32, texels: &[[f32; 3]]) -> Texture {
+        assert_eq!(texels.len(), width as usize * height as usize);
+        let key = |c: &[f32; 3]| c.map(|v| v.clamp(0.0, 1.0).to_bits());
+        let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut distinct: Vec<[u32; 3]> = Vec::new();
+        let ids: Vec<u32> = texels
+            .iter()
+            .map(|c| {
+                let k = key(c);
+                *index.entry(k).or_insert_with(|| {
+                    distinct.push(k);
+                    distinct.len() as u32 - 1
+                })
+            })
+            .collect();
+        drop(index);
+        use rayon::prelude::*;
+        let fitted: Vec<[f32; 3]> = distinct
+            .par_iter()
+            .map(|k| coefficients(k.map(|b| f32::from_bits(b) as f64)))
+            .collect();
+        Texture {
+            width,
+            height,
+            coeffs: ids.iter().map(|&i| fitted[i as usize]).collect(),
+            wrap: Wrap::Repeat,
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+        }
+    }
+
+    /// Loads an image: PNG or JPEG (sRGB-encoded; alpha ignored) or OpenEXR (linear R, G, B);
+    /// components are clamped to [0, 1]. A missing or unreadable file, another format, an
+    /// image over [`MAX_TEXELS`] or one that would not fit in the memory available (checked
+    /// from its header, before decoding) is an error naming the file.
+    pub fn load(path: &Path) -> Result<Texture, TextureError> {
+        let err = |message: String| TextureError {
+            path: path.to_path_buf(),
+            message,
+        };
+        let bytes = crate::limits::read_file(path, MAX_TEXTURE_FILE_BYTES)
+            .map_err(|e| err(e.to_string()))?;
+        let check = |w: u64, h: u64| -> Result<(), TextureError> {
+            let n = w.saturating_mul(h);
+            if w == 0 || h == 0 {
+                return Err(err("the image has no pixels".into()));
+            }
+            if n > MAX_TEXELS {
+                return Err(err(format!(
+                    "the image is {w}×{h} pixels, more than the {MAX_TEXELS} texels a texture may have"
+                )));
+            }
+            crate::limits::check_memory(
+                n.saturating_mul(LOAD_BYTES_PER_TEXEL),
+                &format!("loading this {w}×{h} texture"),
+            )
+            .map_err(err)
+        };
+        if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+            drop(bytes);
+            let layers = crate::output::read_exr(path).map_err(|e| err(e.to_string()))?;
+            check(layers.width as u64, layers.height as u64)?;
+            let ch = |name: &str| {
+                layers
+                    .channel(name)
+                    .ok_or_else(|| err(format!("the OpenEXR image has no channel {name:?}")))
+            };
+            let (r, g, b) = (ch("R")?, ch("G")?, ch("B")?);
+            let texels: Vec<[f32; 3]> = (0..r.len())
+                .map(|i| [r[i], g[i], b[i]].map(|v| if v.is_finite() { v } else { 0.0 }))
+                .collect();
+            return Ok(Texture::from_linear_rgb(
+                layers.width as u32,
+                layers.height as u32,
+                &texels,
+            ));
+        }
+        let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+            .with_guessed_format()
+            .map_err(|e| err(e.to_string()))?;
+        match reader.format() {
+            Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+            _ => {
+                return Err(err(
+                    "it is not a PNG, JPEG or OpenEXR image (judged by its first bytes)".into(),
+                ))
+            }
+        }
+        let (w, h) = reader
+            .into_dimensions()
+            .map_err(|e| err(format!("cannot read its header: {e}")))?;
+        check(w as u64, h as u64)?;
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+            .with_guessed_format()
+            .map_err(|e| err(e.to_string()))?;
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(w);
+        limits.max_image_height = Some(h);
+        limits.max_alloc = Some((w as u64 * h as u64).saturating_mul(16).max(1 << 20));
+        reader.limits(limits);
+        let img = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))
+            .map_err(|_| err("the image decoder failed on malformed input".into()))?
+            .map_err(|e| err(e.to_string()))?;
+        drop(bytes);
+        let rgb = img.to_rgb8();
+        drop(img);
+        let lut: Vec<f32> = (0..=255u8)
+            .map(|v| crate::colour::rgb::srgb_decode(v as f64 / 255.0) as f32)
+            .collect();
+        let texels: Vec<[f32; 3]> = rgb.pixels().map(|p| p.0.map(|v| lut[v as usize])).collect();
+        drop(rgb);
+        Ok(Texture::from_linear_rgb(w, h, &texels))
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Heap memory, bytes.
+    pub fn memory_bytes(&self) -> usize {
+        self.coeffs.capacity() * BYTES_PER_TEXEL as usize
+    }
+
+    /// Reflectance of texel (`x`, `y`) (y = 0 the top row) at `nm`.
+    pub fn texel_reflectance(&self, x: u32, y: u32, nm: f64) -> f64 {
+        let [a0, a1, a2] = self.coeffs[(y * self.width + x) as usize].map(|v| v as f64);
+        let t = (nm - T_MIN_NM) / T_SPAN_NM;
+        let x = (a0 * t + a1) * t + a2;
+        if x.is_infinite() {
+            return if x > 0.0 { 1.0 } else { 0.0 };
+        }
+        0.5 + 0.5 * x / (1.0 + x * x).sqrt()
+    }
+
+    #[inline(always)]
+    fn wrap_index(&self, i: i64, n: u32) -> usize {
+        match self.wrap {
+            Wrap::Repeat => i.rem_euclid(n as i64) as usize,
+            Wrap::Clamp => i.clamp(0, n as i64 - 1) as usize,
+        }
+    }
+
+    /// Reflectance at texture coordinates `tex` (bilinear), per wavelength of `wl`.
+    pub fn reflectance(&self, tex: Vec2, wl: &SampledWavelengths) -> SampledSpectrum {
+        let uv = tex * self.scale + self.offset;
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = (1.0 - uv.y) * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = match (x - x0, y - y0) {
+            (fx, fy) if fx.is_finite() && fy.is_finite() => (fx, fy),
+            _ => (0.0, 0.0),
+        };
+        let (xi, yi) = (x0 as i64, y0 as i64);
+        let cols = [
+            self.wrap_index(xi, self.width),
+            self.wrap_index(xi + 1, self.width),
+        ];
+        let rows = [
+            self.wrap_index(yi, self.height),
+            self.wrap_index(yi + 1, self.height),
+        ];
+        let mut t = [0.0f32; N_LAMBDA];
+        for (t, l) in t.iter_mut().zip(wl.lambda.iter()) {
+            *t = (l - T_MIN_NM as f32) * (1.0 / T_SPAN_NM as f32);
+        }
+        let mut out = SampledSpectrum::ZERO;
+        for (r, wy) in rows.iter().zip([1.0 - fy, fy]) {
+            for (c, wx) in cols.iter().zip([1.0 - fx, fx]) {
+                let w = wx * wy;
+                if w == 0.0 {
+                    continue;
+                }
+                let [a0, a1, a2] = self.coeffs[r * self.width as usize + c];
+                for (o, t) in out.0.iter_mut().zip(t) {
+                    *o += w * sigmoid((a0 * t + a1) * t + a2);
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Normalised sigmoid coefficients of the smooth spectrum of a linear-sRGB colour in [0, 1].
+fn coefficients(rgb: [f64; 3]) -> [f32; 3] {
+    let (s, _) = fit_linear_srgb(rgb).expect("components are clamped to [0, 1]");
+    if let Some(v) = s.constant {
+        return [
+            0.0,
+            0.0,
+            if v > 0.5 {
+                f32::INFINITY
+            } else {
+                f32::NEG_INFINITY
+            },
+        ];
+    }
+    // c in nm: c0 λ² + c1 λ + c2 with λ = L + S t.
+    let [c0, c1, c2] = s.c;
+    let (l, sp) = (T_MIN_NM, T_SPAN_NM);
+    [
+        (c0 * sp * sp) as f32,
+        ((c1 + 2.0 * c0 * l) * sp) as f32,
+        (c0 * l * l + c1 * l + c2) as f32,
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texels_hold_the_upsampled_spectra() {
+        let colours = [
+            [0.2f32, 0.5, 0.1],
+            [1.0, 1.0, 1.0],
+            [0.0, 0.0, 0.0],
+            [0.3; 3],
+        ];
+        let t = Texture::from_linear_rgb(2, 2, &colours);
+        for (i, c) in colours.iter().enumerate() {
+            let (s, _) = fit_linear_srgb(c.map(|v| v as f64)).unwrap();
+            for nm in [380.0, 455.5, 560.0, 700.0, 780.0] {
+                let want = s.value(nm);
+                let got = t.texel_reflectance(i as u32 % 2, i as u32 / 2, nm);
+                assert!((got - want).abs() < 1e-5, "{c:?} at {nm}: {got} vs {want}");
+            }
+        }
+        // Bilinear: the centre of the image averages the four texels; a texel's centre is
+        // the texel (v = 0 is the bottom row).
+        let wl = SampledWavelengths::sample_visible(0.3);
+        let mid = t.reflectance(Vec2::new(0.5, 0.5), &wl);
+        let corner = t.reflectance(Vec2::new(0.25, 0.25), &wl);
+        for k in 0..N_LAMBDA {
+            let l = wl.lambda[k] as f64;
+            let mean = (0..4)
+                .map(|i| t.texel_reflectance(i % 2, i / 2, l))
+                .sum::<f64>()
+                / 4.0;
+            assert!((mid.0[k] as f64 - mean).abs() < 1e-5);
+            let want = t.texel_reflectance(0, 1, l);
+            assert!((corner.0[k] as f64 - want).abs() < 1e-5);
+        }
+    }
+}
