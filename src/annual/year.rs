@@ -57,6 +57,15 @@ pub fn hourly_skies(
     let site = &weather.site;
     let missing = std::sync::atomic::AtomicUsize::new(0);
     let hour = |(i, r): (usize, &crate::daylight::epw::Record)| -> Result<HourSky, String> {
+        let at = |e: &dyn std::fmt::Display| {
+            format!(
+                "record {} ({:02}-{:02} hour {}): {e}",
+                i + 1,
+                r.month,
+                r.day,
+                r.hour
+            )
+        };
         let t = CivilTime {
             year: r.year.clamp(1, 9999),
             month: r.month,
@@ -72,15 +81,7 @@ pub fn hourly_skies(
             Atmosphere::default(),
             None,
         )
-        .map_err(|e| {
-            format!(
-                "record {} ({:02}-{:02} hour {}): {e}",
-                i + 1,
-                r.month,
-                r.day,
-                r.hour
-            )
-        })?;
+        .map_err(|e| at(&e))?;
         let (alt, az) = (pos.altitude_deg.to_radians(), pos.azimuth_deg.to_radians());
         let to_sun = [alt.cos() * az.sin(), alt.cos() * az.cos(), alt.sin()];
         let (dn, dh) = match (r.direct_normal_w_m2, r.diffuse_horizontal_w_m2) {
@@ -99,15 +100,7 @@ pub fn hourly_skies(
             r.dew_point_c.unwrap_or(DEFAULT_DEW_POINT_C),
             ground_reflectance,
         )
-        .map_err(|e| {
-            format!(
-                "record {} ({:02}-{:02} hour {}): {e}",
-                i + 1,
-                r.month,
-                r.day,
-                r.hour
-            )
-        })?;
+        .map_err(|e| at(&e))?;
         Ok(HourSky {
             month: r.month,
             day: r.day,

@@ -445,26 +445,18 @@ pub fn irradiance_tallied<T: FnMut(Vec3, SampledSpectrum)>(
             }
         }
     }
-    {
-        let local = crate::sampling::cosine_hemisphere(sampler.get2d());
-        if local.z > 0.0 {
-            let wi = Frame::from_normal(n).to_world(local);
-            let origin = offset_ray_origin(at.p, at.error, at.ng, wi);
-            stats.bounce_rays += 1;
-            let start = PathStart {
-                specular: false,
-                pdf: crate::sampling::cosine_hemisphere_pdf(local.z),
-                p: at.p,
-                n: Some(n),
-                depth: 1,
-                caustics_by_light_tracing,
-                unscattered_escapes: true,
-            };
-            // cos θ / pdf = π.
-            let mut scaled = |d: Vec3, c: SampledSpectrum| tally(d, c * PI);
-            e += trace_tallied(world, origin, wi, start, wl, sampler, stats, &mut scaled) * PI;
-        }
-    }
+    // cos θ / pdf = π.
+    let mut scaled = |d: Vec3, c: SampledSpectrum| tally(d, c * PI);
+    let start = |p, n, pdf| PathStart {
+        specular: false,
+        pdf,
+        p,
+        n: Some(n),
+        depth: 1,
+        caustics_by_light_tracing,
+        unscattered_escapes: true,
+    };
+    e += receiver_path(world, at, n, start, wl, sampler, stats, &mut scaled) * PI;
     e
 }
 
@@ -480,23 +472,42 @@ pub fn indirect_irradiance(
     sampler: &mut Sampler,
     stats: &mut RayStats,
 ) -> SampledSpectrum {
-    let local = crate::sampling::cosine_hemisphere(sampler.get2d());
-    if local.z <= 0.0 || world.settings.max_depth == Some(0) {
+    if world.settings.max_depth == Some(0) {
         return SampledSpectrum::ZERO;
     }
-    let wi = Frame::from_normal(n).to_world(local);
-    let origin = offset_ray_origin(at.p, at.error, at.ng, wi);
-    stats.bounce_rays += 1;
-    let start = PathStart {
+    let start = |p, n, pdf| PathStart {
         specular: false,
-        pdf: crate::sampling::cosine_hemisphere_pdf(local.z),
-        p: at.p,
+        pdf,
+        p,
         n: Some(n),
         depth: 1,
         caustics_by_light_tracing: false,
         unscattered_escapes: false,
     };
     // cos θ / pdf = π.
-    trace_tallied(world, origin, wi, start, wl, sampler, stats, &mut |_, _| {})
-        * std::f32::consts::PI
+    receiver_path(world, at, n, start, wl, sampler, stats, &mut |_, _| {}) * std::f32::consts::PI
+}
+
+/// The radiance a cosine-sampled direction from a receiver brings (zero below its horizon),
+/// the path started as `start(p, n, pdf)` says.
+#[allow(clippy::too_many_arguments)]
+fn receiver_path<T: FnMut(Vec3, SampledSpectrum)>(
+    world: &World,
+    at: &RayStart,
+    n: Vec3,
+    start: impl Fn(Vec3, Vec3, f32) -> PathStart,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+    tally: &mut T,
+) -> SampledSpectrum {
+    let local = crate::sampling::cosine_hemisphere(sampler.get2d());
+    if local.z <= 0.0 {
+        return SampledSpectrum::ZERO;
+    }
+    let wi = Frame::from_normal(n).to_world(local);
+    let origin = offset_ray_origin(at.p, at.error, at.ng, wi);
+    stats.bounce_rays += 1;
+    let start = start(at.p, n, crate::sampling::cosine_hemisphere_pdf(local.z));
+    trace_tallied(world, origin, wi, start, wl, sampler, stats, tally)
 }
