@@ -4,6 +4,7 @@
 //! are given in, so the merged sums, and every output, are the same bit for bit.
 
 use super::files::{check_exposure, check_output_dir, film_layers, output_stem, write_png};
+use super::shard::ShardSummary;
 use crate::output::{self, with_suffix};
 use crate::state::RenderState;
 use anyhow::{bail, Context, Result};
@@ -18,26 +19,6 @@ pub struct MergeOptions {
     /// Merge the shards present even if some are missing or unfinished (the estimate of the
     /// samples they hold); without it such a merge is refused.
     pub partial: bool,
-}
-
-/// What the shards of a merged render were: written to OUT.report.json and printed.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct ShardSummary {
-    /// Shards of the render (N).
-    pub count: u32,
-    /// Samples per pixel of each finished shard.
-    pub spp_per_shard: u32,
-    /// Indices (0-based) of the shards merged.
-    pub merged: Vec<u32>,
-    /// Indices of the shards not given.
-    pub missing: Vec<u32>,
-    /// Indices of the merged shards that had not finished (a checkpoint).
-    pub unfinished: Vec<u32>,
-    /// Whether the estimate lacks samples of the render (missing or unfinished shards).
-    pub partial: bool,
-    /// Indices of the merged shards that measured their share of the meters and grid points
-    /// (finished shards): the merged meters hold their samples.
-    pub meter_shards: Vec<u32>,
 }
 
 /// What a merge wrote.

@@ -15,8 +15,9 @@ use files::{
     check_output_dir, check_outputs, output_stem, state_bytes_at_least, write_exr, write_hdr,
     write_png, Planned,
 };
-pub use merge::{merge, merge_with, MergeOptions, MergeOutputs, ShardSummary};
+pub use merge::{merge, merge_with, MergeOptions, MergeOutputs};
 pub use shard::Shard;
+pub use shard::ShardSummary;
 
 use crate::film::Film;
 use crate::meter::{Estimate, GridStats};

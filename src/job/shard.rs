@@ -7,11 +7,30 @@
 //! samples of one render at N·S samples per pixel, each exactly once.
 
 use super::invalid_option;
-use super::merge::ShardSummary;
 use crate::meter::MeterSums;
 use crate::state::{RenderState, ShardInfo, MAX_SHARDS};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
+
+/// What the shards of a merged render were: written to OUT.report.json and printed.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ShardSummary {
+    /// Shards of the render (N).
+    pub count: u32,
+    /// Samples per pixel of each finished shard.
+    pub spp_per_shard: u32,
+    /// Indices (0-based) of the shards merged.
+    pub merged: Vec<u32>,
+    /// Indices of the shards not given.
+    pub missing: Vec<u32>,
+    /// Indices of the merged shards that had not finished (a checkpoint).
+    pub unfinished: Vec<u32>,
+    /// Whether the estimate lacks samples of the render (missing or unfinished shards).
+    pub partial: bool,
+    /// Indices of the merged shards that measured their share of the meters and grid points
+    /// (finished shards): the merged meters hold their samples.
+    pub meter_shards: Vec<u32>,
+}
 
 /// A shard of a render: `index` of `count`, 0-based.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
