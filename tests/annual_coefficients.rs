@@ -13,24 +13,13 @@ use candela::meter::measure_all;
 use common::world;
 use glam::Vec3;
 
-/// A 4 × 4 m room, 3 m high, grey (ρ = 0.5) inside, with a 2 × 1.2 m window in its south wall
-/// (z = 2, +z is south in the default site frame), sill at 0.9 m.
-const ROOM: &str = r#"
-    materials: {"grey": Diffuse(reflectance: Constant(0.5))},
-    objects: [
-        (material: "grey", shape: Quad(origin: (-2, 0, -2), edge_u: (0, 0, 4), edge_v: (4, 0, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 3, -2), edge_u: (4, 0, 0), edge_v: (0, 0, 4))),
-        (material: "grey", shape: Quad(origin: (-2, 0, -2), edge_u: (4, 0, 0), edge_v: (0, 3, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 0, -2), edge_u: (0, 3, 0), edge_v: (0, 0, 4))),
-        (material: "grey", shape: Quad(origin: (2, 0, -2), edge_u: (0, 0, 4), edge_v: (0, 3, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 0, 2), edge_u: (0, 0.9, 0), edge_v: (4, 0, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 2.1, 2), edge_u: (0, 0.9, 0), edge_v: (4, 0, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (1, 0, 0))),
-        (material: "grey", shape: Quad(origin: (1, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (1, 0, 0))),
-    ]"#;
-const PORTAL: &str = "portals: [(origin: (-1, 0.9, 2), edge_u: (2, 0, 0), edge_v: (0, 1.2, 0))]";
-const CAMERA: &str =
-    "camera: (position: (0, 1, 0), look_at: (0, 1, 1), vfov_deg: 30, resolution: (1, 1))";
+/// The side-lit room (tests/common), grey (ρ = 0.5) inside, its window open.
+const ROOM: &str = concat!(
+    r#"materials: {"grey": Diffuse(reflectance: Constant(0.5))}, objects: ["#,
+    crate::side_lit_room_walls!(),
+    "]"
+);
+use common::{SIDE_LIT_CAMERA as CAMERA, SIDE_LIT_PORTAL as PORTAL};
 
 /// Work-plane points (0.8 m) near the window, mid-room and at the back.
 const POINTS: [[f32; 3]; 3] = [[0.0, 0.8, 1.2], [-0.8, 0.8, 0.0], [0.5, 0.8, -1.5]];

@@ -19,26 +19,15 @@ use candela::meter::measure_all;
 use common::world;
 use glam::Vec3;
 
-/// A 4 × 4 m room, 3 m high, grey (ρ = 0.5) inside, with a 2 × 1.2 m window in its south
-/// wall (z = 2; +z is south in the default site frame), sill at 0.9 m, glazed with a clear
+/// The side-lit room (tests/common), grey (ρ = 0.5) inside, its window glazed with a clear
 /// pane of index 1.5.
-const ROOM: &str = r#"
-    materials: {"grey": Diffuse(reflectance: Constant(0.5)), "pane": ThinDielectric(ior: Constant(1.5))},
-    objects: [
-        (material: "grey", shape: Quad(origin: (-2, 0, -2), edge_u: (0, 0, 4), edge_v: (4, 0, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 3, -2), edge_u: (4, 0, 0), edge_v: (0, 0, 4))),
-        (material: "grey", shape: Quad(origin: (-2, 0, -2), edge_u: (4, 0, 0), edge_v: (0, 3, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 0, -2), edge_u: (0, 3, 0), edge_v: (0, 0, 4))),
-        (material: "grey", shape: Quad(origin: (2, 0, -2), edge_u: (0, 0, 4), edge_v: (0, 3, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 0, 2), edge_u: (0, 0.9, 0), edge_v: (4, 0, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 2.1, 2), edge_u: (0, 0.9, 0), edge_v: (4, 0, 0))),
-        (material: "grey", shape: Quad(origin: (-2, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (1, 0, 0))),
-        (material: "grey", shape: Quad(origin: (1, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (1, 0, 0))),
-        (material: "pane", shape: Quad(origin: (-1, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (2, 0, 0))),
-    ]"#;
-const PORTAL: &str = "portals: [(origin: (-1, 0.9, 2), edge_u: (2, 0, 0), edge_v: (0, 1.2, 0))]";
-const CAMERA: &str =
-    "camera: (position: (0, 1, 0), look_at: (0, 1, 1), vfov_deg: 30, resolution: (1, 1))";
+const ROOM: &str = concat!(
+    r#"materials: {"grey": Diffuse(reflectance: Constant(0.5)), "pane": ThinDielectric(ior: Constant(1.5))},
+    objects: ["#,
+    crate::side_lit_room_walls!(),
+    r#"(material: "pane", shape: Quad(origin: (-1, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (2, 0, 0)))]"#
+);
+use common::{SIDE_LIT_CAMERA as CAMERA, SIDE_LIT_PORTAL as PORTAL};
 
 /// Work-plane points (0.8 m): in the sun patch of the high sun near the window, mid-room, at
 /// the back.
@@ -318,32 +307,22 @@ fn a_year_of_uniform_skies_gives_daylight_autonomy_from_the_configuration_factor
 
 #[test]
 fn sun_coefficients_need_a_unit_sun() {
-    let mut w = unit_sky_world(ROOM, PORTAL);
-    assert!(sun_coefficients(
-        &mut w,
-        &[(Vec3::Y, Vec3::Y)],
-        &[[0.0, 0.0, 1.0]],
-        &site(),
-        45.0,
-        16,
-        16,
-        &mut |_, _| {}
-    )
-    .is_err());
-    let mut w = world(&format!(
+    let sun_of_2_lx = world(&format!(
         "({CAMERA}, {ROOM}, lights: [Sun(sun: (altitude_deg: 45.0, azimuth_deg: 180.0), \
          amount: NormalIlluminance(2.0))])"
     ));
-    assert!(matches!(w.lights[0], Light::Sun(_)));
-    assert!(sun_coefficients(
-        &mut w,
-        &[(Vec3::Y, Vec3::Y)],
-        &[[0.0, 0.0, 1.0]],
-        &site(),
-        45.0,
-        16,
-        16,
-        &mut |_, _| {}
-    )
-    .is_err());
+    assert!(matches!(sun_of_2_lx.lights[0], Light::Sun(_)));
+    for mut w in [unit_sky_world(ROOM, PORTAL), sun_of_2_lx] {
+        let r = sun_coefficients(
+            &mut w,
+            &[(Vec3::Y, Vec3::Y)],
+            &[[0.0, 0.0, 1.0]],
+            &site(),
+            45.0,
+            16,
+            16,
+            &mut |_, _| {},
+        );
+        assert!(r.is_err());
+    }
 }

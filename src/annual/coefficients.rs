@@ -23,16 +23,14 @@ use crate::world::World;
 use glam::Vec3;
 use rayon::prelude::*;
 
-/// Coefficients of `receivers` × patches, lx per cd/m²: their means over [`BATCHES`]
-/// independent batches, and the batch means themselves, so that any sky's illuminance gets the
+/// Coefficients of `receivers` × patches, lx per cd/m², as the means of [`BATCHES`]
+/// independent batches (their estimate is the batches' mean), so that any sky's illuminance gets the
 /// standard error of its own linear combination (the patches' errors are correlated: one path
 /// credits several patches).
 #[derive(Clone, Debug)]
 pub struct Coefficients {
     pub patches: SkyPatches,
     pub receivers: usize,
-    /// Receiver-major: `mean[r * patches + i]`.
-    pub mean: Vec<f64>,
     /// `batches[(r * BATCHES + b) * patches + i]`.
     pub batches: Vec<f64>,
     /// Samples per receiver.
@@ -55,11 +53,21 @@ impl Coefficients {
         (mu, (var / k as f64).sqrt())
     }
 
+    /// Coefficient `i` of receiver `r` (lx per cd/m²): the mean of its batches.
+    pub fn mean(&self, r: usize, i: usize) -> f64 {
+        let n = self.patches.len();
+        let k = BATCHES as usize;
+        (0..k)
+            .map(|b| self.batches[(r * k + b) * n + i])
+            .sum::<f64>()
+            / k as f64
+    }
+
     /// The standard error of coefficient `i` of receiver `r` (lx per cd/m²).
     pub fn stderr(&self, r: usize, i: usize) -> f64 {
         let n = self.patches.len();
         let k = BATCHES as usize;
-        let mu = self.mean[r * n + i];
+        let mu = self.mean(r, i);
         let var = (0..k)
             .map(|b| (self.batches[(r * k + b) * n + i] - mu).powi(2))
             .sum::<f64>()
@@ -103,7 +111,7 @@ pub fn sky_coefficients(
     let frame = sky.frame;
     let n = patches.len();
     let per_batch = samples.div_ceil(BATCHES as u64).max(1);
-    let rows: Vec<(Vec<f64>, Vec<f64>)> = receivers
+    let rows: Vec<Vec<f64>> = receivers
         .par_iter()
         .enumerate()
         .map(|(r, &(p, normal))| {
@@ -139,23 +147,16 @@ pub fn sky_coefficients(
             for v in sums.iter_mut() {
                 *v /= per_batch as f64;
             }
-            let mean: Vec<f64> = (0..n)
-                .map(|i| {
-                    (0..BATCHES as usize).map(|b| sums[b * n + i]).sum::<f64>() / BATCHES as f64
-                })
-                .collect();
-            (mean, sums)
+            sums
         })
         .collect();
     let mut c = Coefficients {
         patches: patches.clone(),
         receivers: receivers.len(),
-        mean: Vec::with_capacity(receivers.len() * n),
         batches: Vec::with_capacity(receivers.len() * n * BATCHES as usize),
         samples: per_batch * BATCHES as u64,
     };
-    for (m, b) in rows {
-        c.mean.extend(m);
+    for b in rows {
         c.batches.extend(b);
     }
     Ok(c)

@@ -211,14 +211,15 @@ pub fn summary(run: &AnnualRun) -> String {
     s
 }
 
-/// NAME.annual.json and NAME.annual.csv for `out` (an output name, a directory or `None`: the
+/// The output stem NAME (heat maps are NAME.annual.grid-…png), NAME.annual.json and
+/// NAME.annual.csv for `out` (an output name, a directory or `None`: the
 /// scene's name in the current directory); refused when the directory does not exist or an
 /// output would replace an input.
 pub fn output_paths(
     out: Option<&Path>,
     scene: &Path,
     weather: Option<&Path>,
-) -> anyhow::Result<(PathBuf, PathBuf)> {
+) -> anyhow::Result<(PathBuf, PathBuf, PathBuf)> {
     use crate::job::files;
     let name = scene
         .file_stem()
@@ -236,7 +237,7 @@ pub fn output_paths(
             )));
         }
     }
-    Ok((json, csv))
+    Ok((stem, json, csv))
 }
 
 /// The heat maps of each grid: daylight autonomy and useful daylight illuminance (%, on a
@@ -248,16 +249,7 @@ pub fn write_heatmaps(stem: &Path, run: &AnnualRun) -> Result<Vec<PathBuf>, Outp
     let t = &run.settings.thresholds;
     let mut written = Vec::new();
     for (g, r) in run.grids.iter().zip(&run.results) {
-        let size = |p: &[glam::Vec3], n: usize, step: usize| -> f64 {
-            // The grid's extent: the span of its cell centres plus one cell.
-            if n < 2 {
-                return 1.0;
-            }
-            let d = (p[(n - 1) * step] - p[0]).length() as f64;
-            d * n as f64 / (n - 1) as f64
-        };
         let (nx, ny) = (g.nx as usize, g.ny as usize);
-        let size_m = (size(&g.points, nx, 1), size(&g.points, ny, nx));
         // (file key, title, unit, values, scale maximum)
         #[allow(clippy::type_complexity)]
         let maps: [(&str, String, &str, Vec<f64>, Option<f64>); 3] = [
@@ -310,7 +302,7 @@ pub fn write_heatmaps(stem: &Path, run: &AnnualRun) -> Result<Vec<PathBuf>, Outp
                 ny,
                 values,
                 stderr: Vec::new(),
-                size_m,
+                size_m: g.size_m,
             };
             let settings = FalsecolourSettings {
                 min: Some(0.0),

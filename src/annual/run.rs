@@ -80,6 +80,8 @@ pub struct GridLayout {
     /// Cell centres (m), `j * nx + i`.
     pub points: Vec<Vec3>,
     pub normal: Vec3,
+    /// Lengths of the grid's two edges, m.
+    pub size_m: (f64, f64),
 }
 
 /// Everything an annual calculation found.
@@ -130,13 +132,8 @@ fn scene_sky(scene: &SceneFile) -> (SceneSky, usize) {
                 ground_reflectance,
                 portals,
                 ..
-            } => {
-                sky.spectrum = spectrum.clone();
-                sky.ground_reflectance = ground_reflectance.unwrap_or(0.2);
-                sky.portals = portals.clone();
             }
-            LightDesc::Weather {
-                file,
+            | LightDesc::Weather {
                 spectrum,
                 ground_reflectance,
                 portals,
@@ -145,7 +142,9 @@ fn scene_sky(scene: &SceneFile) -> (SceneSky, usize) {
                 sky.spectrum = spectrum.clone();
                 sky.ground_reflectance = ground_reflectance.unwrap_or(0.2);
                 sky.portals = portals.clone();
-                sky.weather = Some(file.clone());
+                if let LightDesc::Weather { file, .. } = l {
+                    sky.weather = Some(file.clone());
+                }
             }
             LightDesc::Sun { .. } => {}
             _ => electric += 1,
@@ -233,12 +232,13 @@ pub fn run(
             ny: g.ny,
             points,
             normal: g.normal,
+            size_m: (g.edge_u.length() as f64, g.edge_v.length() as f64),
         });
     }
     let sunny: Vec<usize> = (0..year.len()).filter(|&h| year[h].has_sun()).collect();
     let daylight_n = year.iter().filter(|h| h.is_daylight()).count();
     let n_p = patches.len() as u64;
-    let need = receivers.len() as u64 * n_p * (crate::meter::BATCHES as u64 + 1) * 8
+    let need = receivers.len() as u64 * n_p * crate::meter::BATCHES as u64 * 8
         + sun_coefficient_bytes(sunny.len(), receivers.len())
         + hourly_bytes(year.len(), daylight_n, receivers.len());
     crate::limits::check_memory(

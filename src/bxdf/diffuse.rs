@@ -60,17 +60,22 @@ pub fn lambert_eval(r: SampledSpectrum, wo: Vec3, wi: Vec3) -> SampledSpectrum {
     r * FRAC_1_PI
 }
 
-/// Cosine-weighted sample of the Lambertian of reflectance `r`.
+/// A cosine-weighted direction on `wo`'s side of the surface and its density (None where the
+/// density vanishes): the sampling of every diffuse lobe.
 #[inline]
-pub fn lambert_sample(r: SampledSpectrum, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+pub fn cosine_direction(wo: Vec3, u: Vec2) -> Option<(Vec3, f32)> {
     let mut wi = crate::sampling::cosine_hemisphere(u);
     if wo.z < 0.0 {
         wi.z = -wi.z;
     }
     let pdf = crate::sampling::cosine_hemisphere_pdf(wi.z.abs());
-    if pdf <= 0.0 {
-        return None;
-    }
+    (pdf > 0.0).then_some((wi, pdf))
+}
+
+/// Cosine-weighted sample of the Lambertian of reflectance `r`.
+#[inline]
+pub fn lambert_sample(r: SampledSpectrum, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+    let (wi, pdf) = cosine_direction(wo, u)?;
     Some(BsdfSample {
         wi,
         f: r * FRAC_1_PI,

@@ -81,14 +81,7 @@ impl OrenNayar {
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<BsdfSample> {
-        let mut wi = crate::sampling::cosine_hemisphere(u);
-        if wo.z < 0.0 {
-            wi.z = -wi.z;
-        }
-        let pdf = crate::sampling::cosine_hemisphere_pdf(wi.z.abs());
-        if pdf <= 0.0 {
-            return None;
-        }
+        let (wi, pdf) = super::diffuse::cosine_direction(wo, u)?;
         Some(BsdfSample {
             wi,
             f: self.eval(wo, wi, wl),

@@ -114,12 +114,7 @@ pub fn settings(a: &AnnualArgs) -> Result<AnnualSettings> {
             a.ase_hours
         )));
     }
-    if a.draws == 1 || a.draws > 100_000 {
-        return Err(super::usage(format!(
-            "--draws must be 0 (no intervals) or 2 … 100 000, got {}",
-            a.draws
-        )));
-    }
+    super::check_draws(a.draws)?;
     for (flag, v) in [
         ("--sky-samples", a.sky_samples),
         ("--sun-samples", a.sun_samples),
@@ -157,7 +152,7 @@ pub fn run(a: &AnnualArgs) -> Result<String> {
     if let Some(n) = a.threads {
         candela::job::check_threads("--threads", n)?;
     }
-    let (json, csv) =
+    let (stem, json, csv) =
         candela::annual::output::output_paths(a.out.as_deref(), &a.scene, a.weather.as_deref())?;
     let bar = if a.quiet {
         ProgressBar::hidden()
@@ -192,11 +187,6 @@ pub fn run(a: &AnnualArgs) -> Result<String> {
     let out = out?;
     candela::annual::output::write_json(&json, &out)?;
     candela::annual::output::write_csv(&csv, &out)?;
-    let stem = PathBuf::from(
-        json.to_string_lossy()
-            .strip_suffix(".annual.json")
-            .unwrap_or_default(),
-    );
     let maps = candela::annual::output::write_heatmaps(&stem, &out)?;
     Ok(format!(
         "{}wrote {}, {} and {} heat maps ({:.1} s sky, {:.1} s sun, {:.1} s metrics)\n",

@@ -67,12 +67,7 @@ pub fn run(args: &GlareArgs) -> anyhow::Result<String> {
             args.search_angle
         )));
     }
-    if args.draws == 1 || args.draws > 100_000 {
-        return Err(super::usage(format!(
-            "--draws must be 0 (no intervals) or 2 … 100 000, got {}",
-            args.draws
-        )));
-    }
+    super::check_draws(args.draws)?;
     opt.detect.search_angle_rad = args.search_angle;
     if args.no_peaks {
         opt.detect.peak_limit_cd_m2 = None;

@@ -38,6 +38,17 @@ pub fn printable_json(text: &str) -> String {
     out
 }
 
+/// `--draws` of the commands that draw replicates for their intervals: 0 (no intervals) or
+/// 2 … 100 000.
+pub fn check_draws(draws: usize) -> anyhow::Result<()> {
+    if draws == 1 || draws > 100_000 {
+        return Err(usage(format!(
+            "--draws must be 0 (no intervals) or 2 … 100 000, got {draws}"
+        )));
+    }
+    Ok(())
+}
+
 /// An error in the command line found after clap parsed it (an option's value that no input
 /// can make valid, options that exclude each other): exit code 2, as clap's own.
 pub fn usage(message: impl Into<String>) -> anyhow::Error {

@@ -304,3 +304,31 @@ pub fn python_json(
     );
     serde_json::from_slice(&out.stdout).unwrap()
 }
+
+/// The walls, floor and ceiling of the side-lit room of the annual-daylight tests (RON
+/// objects of material "grey", without the brackets): 4 × 4 m, 3 m high, with a 2 × 1.2 m
+/// window x ∈ [−1, 1], y ∈ [0.9, 2.1] in its south wall z = 2 (+z is south in the default
+/// site frame).
+#[macro_export]
+macro_rules! side_lit_room_walls {
+    () => {
+        r#"
+        (material: "grey", shape: Quad(origin: (-2, 0, -2), edge_u: (0, 0, 4), edge_v: (4, 0, 0))),
+        (material: "grey", shape: Quad(origin: (-2, 3, -2), edge_u: (4, 0, 0), edge_v: (0, 0, 4))),
+        (material: "grey", shape: Quad(origin: (-2, 0, -2), edge_u: (4, 0, 0), edge_v: (0, 3, 0))),
+        (material: "grey", shape: Quad(origin: (-2, 0, -2), edge_u: (0, 3, 0), edge_v: (0, 0, 4))),
+        (material: "grey", shape: Quad(origin: (2, 0, -2), edge_u: (0, 0, 4), edge_v: (0, 3, 0))),
+        (material: "grey", shape: Quad(origin: (-2, 0, 2), edge_u: (0, 0.9, 0), edge_v: (4, 0, 0))),
+        (material: "grey", shape: Quad(origin: (-2, 2.1, 2), edge_u: (0, 0.9, 0), edge_v: (4, 0, 0))),
+        (material: "grey", shape: Quad(origin: (-2, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (1, 0, 0))),
+        (material: "grey", shape: Quad(origin: (1, 0.9, 2), edge_u: (0, 1.2, 0), edge_v: (1, 0, 0))),
+"#
+    };
+}
+
+/// The side-lit room's window as a sky portal (RON `portals` field).
+pub const SIDE_LIT_PORTAL: &str =
+    "portals: [(origin: (-1, 0.9, 2), edge_u: (2, 0, 0), edge_v: (0, 1.2, 0))]";
+/// A one-pixel camera inside the side-lit room.
+pub const SIDE_LIT_CAMERA: &str =
+    "camera: (position: (0, 1, 0), look_at: (0, 1, 1), vfov_deg: 30, resolution: (1, 1))";
