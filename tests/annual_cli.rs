@@ -173,6 +173,97 @@ fn a_year_on_the_shoebox_is_consistent_with_its_hourly_csv() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The view's annual glare (`--view`) on scenes/annual-glare.ron: the hourly CSV holds every
+/// occupied hour with daylight, and the JSON's fractions of hours above the DGP limits and the
+/// DGP exceeded in 5 % of the occupied hours follow from it (the dark occupied hours count as
+/// without glare).
+#[test]
+fn a_year_of_glare_on_the_view_is_consistent_with_its_csv() {
+    let dir = tmp("view");
+    let epw = dir.join("year.epw");
+    synthetic_year(&epw);
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/annual-glare.ron");
+    let (code, out, err) = cli(
+        &[
+            "annual",
+            scene.to_str().unwrap(),
+            "--weather",
+            epw.to_str().unwrap(),
+            "--out",
+            dir.join("g").to_str().unwrap(),
+            "--mf",
+            "1",
+            "--sky-samples",
+            "128",
+            "--sun-samples",
+            "64",
+            "--direct-samples",
+            "4",
+            "--view",
+            "--view-resolution",
+            "24",
+            "--view-sky-samples",
+            "64",
+            "--view-sun-samples",
+            "16",
+            "--draws",
+            "20",
+            "-q",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 0, "{out}\n{err}");
+    println!("{out}");
+    assert!(out.contains("DGP ≥ 0.40 (disturbing)"), "{out}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("g.annual.json")).unwrap()).unwrap();
+    let v = &json["view"];
+    assert_eq!(v["width"], 24);
+    let csv = std::fs::read_to_string(dir.join("g.annual-glare.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "month,day,hour,dgp,ev_lx,ev_stderr_lx,ev_sun_disk_lx,sources"
+    );
+    let mut dgps = Vec::new();
+    let mut disk_hours = 0;
+    for line in lines {
+        let f: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        assert!((9.0..=18.0).contains(&f[2]), "{line}");
+        assert!(
+            (0.0..=1.0).contains(&f[3]) && f[4] > 0.0 && f[5] >= 0.0,
+            "{line}"
+        );
+        assert!(f[6] >= 0.0 && f[6] <= f[4], "{line}");
+        if f[6] > 0.0 {
+            disk_hours += 1;
+            // The sun's disk in view (thousands of cd/m² over a pixel) is a glare source.
+            assert!(f[7] >= 1.0, "{line}");
+        }
+        dgps.push(f[3]);
+    }
+    let occupied = 3650.0;
+    assert!(dgps.len() > 3000 && dgps.len() <= 3650, "{}", dgps.len());
+    // The south window faces the eye: the low winter sun is in view for some hours.
+    assert!(disk_hours > 20, "{disk_hours} hours with the sun in view");
+    for (k, limit) in [0.35, 0.40, 0.45].iter().enumerate() {
+        let n = dgps.iter().filter(|&&d| d >= *limit).count() as f64;
+        let j = v["hours_dgp_at_least"][k]["value"].as_f64().unwrap();
+        // The CSV holds 6 decimals.
+        assert!(
+            (j - n / occupied).abs() <= 0.5 / occupied,
+            "DGP ≥ {limit}: {j} vs {n}"
+        );
+    }
+    dgps.sort_by(|a, b| b.total_cmp(a));
+    let p95 = dgps[(0.05 * occupied) as usize];
+    let j = v["dgp_5_percent"]["value"].as_f64().unwrap();
+    assert!((j - p95).abs() < 1e-6, "{j} vs {p95}");
+    let ci = v["dgp_5_percent"]["ci95"].as_array().unwrap();
+    assert!(ci[0].as_f64().unwrap() <= j + 1e-12 && j <= ci[1].as_f64().unwrap() + 1e-12);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn bad_input_is_refused_with_a_message() {
     let dir = tmp("bad");
@@ -224,6 +315,11 @@ fn bad_input_is_refused_with_a_message() {
             vec!["annual", s, "--weather", "w.epw", "--da", "nan"],
             2,
             "--da",
+        ),
+        (
+            vec!["annual", s, "--weather", "w.epw", "--view-resolution", "4"],
+            2,
+            "--view-resolution",
         ),
         (
             vec!["annual", s, "--weather", "w.epw", "--sky-samples", "0"],

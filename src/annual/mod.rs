@@ -8,4 +8,5 @@ pub mod output;
 pub mod results;
 pub mod run;
 pub mod sun;
+pub mod view;
 pub mod year;

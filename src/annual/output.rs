@@ -92,6 +92,48 @@ pub fn json_report(run: &AnnualRun) -> Value {
         "seconds": {"sky": run.seconds.0, "sun": run.seconds.1, "metrics": run.seconds.2},
         "notes": run.notes,
         "grids": grids,
+        "view": run.view.as_ref().map(view_json),
+    })
+}
+
+fn view_json(v: &super::run::ViewRun) -> Value {
+    let r = &v.result;
+    json!({
+        "width": v.width,
+        "height": v.height,
+        "projection": v.projection,
+        "sky_samples_per_pixel": v.sky_samples,
+        "sun_samples_per_pixel_and_node": v.sun_samples,
+        "daylight_hours_evaluated": v.hours.len(),
+        "dgp_limits": super::view::DGP_LIMITS,
+        "hours_dgp_at_least": [est(&r.hours_above[0]), est(&r.hours_above[1]), est(&r.hours_above[2])],
+        "dgp_5_percent": est(&r.dgp_5_percent),
+        "en17037_glare_protection": super::view::en17037_glare_level(r.dgp_5_percent.value),
+        "seconds": {"coefficients": v.seconds.0, "glare": v.seconds.1},
+    })
+}
+
+/// Writes the view's hourly glare: one row per occupied hour with daylight, `month,day,hour`
+/// (the EPW record hour), DGP, E_v and its standard error (lx), the sun disk's part of E_v (lx)
+/// and the number of glare sources.
+pub fn write_glare_csv(path: &Path, run: &AnnualRun) -> Result<(), OutputError> {
+    let Some(v) = &run.view else {
+        return Ok(());
+    };
+    crate::output::write_atomic(path, |w| {
+        writeln!(
+            w,
+            "month,day,hour,dgp,ev_lx,ev_stderr_lx,ev_sun_disk_lx,sources"
+        )?;
+        for g in &v.hours {
+            let hs = &run.year[g.hour];
+            writeln!(
+                w,
+                "{},{},{},{:.6},{:.6},{:.6},{:.6},{}",
+                hs.month, hs.day, hs.hour, g.dgp, g.ev_lx, g.ev_stderr_lx, g.ev_disk_lx, g.sources
+            )?;
+        }
+        Ok(())
     })
 }
 
@@ -203,6 +245,33 @@ pub fn summary(run: &AnnualRun) -> String {
             "  mean DA {:.0} lx           {:5.1} %\n",
             t.da_lx,
             100.0 * mean_da
+        );
+    }
+    if let Some(v) = &run.view {
+        let r = &v.result;
+        s += &format!(
+            "view ({} × {} {}), occupied hours with daylight glare, 95 % intervals in brackets:\n",
+            v.width, v.height, v.projection
+        );
+        for (k, name) in ["perceptible", "disturbing", "intolerable"]
+            .iter()
+            .enumerate()
+        {
+            s += &format!(
+                "  DGP ≥ {:.2} ({name}){}  {}\n",
+                super::view::DGP_LIMITS[k],
+                " ".repeat(12 - name.len()),
+                pct(&r.hours_above[k])
+            );
+        }
+        let d = &r.dgp_5_percent;
+        s += &format!(
+            "  DGP exceeded in 5 % of hours  {:.3}{}   (EN 17037 glare protection: {})\n",
+            d.value,
+            d.ci95
+                .map(|(lo, hi)| format!("  [{lo:.3}, {hi:.3}]"))
+                .unwrap_or_default(),
+            super::view::en17037_glare_level(d.value)
         );
     }
     for n in &run.notes {

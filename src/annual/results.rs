@@ -227,7 +227,7 @@ fn values(
 
 /// Standard normal multipliers for draw `d`: a fixed hash of (`seed`, d, b) through the
 /// inverse error function, so the intervals are reproducible.
-fn multipliers(seed: u64, d: usize) -> Vec<f64> {
+pub(super) fn multipliers(seed: u64, d: usize) -> Vec<f64> {
     (0..BATCHES as u64)
         .map(|b| {
             let x = crate::sampling::mix64(seed ^ crate::sampling::mix64(((d as u64) << 8) | b));

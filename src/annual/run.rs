@@ -10,12 +10,16 @@ use super::coefficients::{sky_coefficients, Coefficients};
 use super::metrics::{Schedule, Thresholds};
 use super::results::{hourly, hourly_bytes, metrics, GridResult, Hourly};
 use super::sun::{sun_coefficient_bytes, sun_coefficients, SunCoefficients};
+use super::view::{
+    view_bytes, view_camera, view_coefficients, view_metrics, HourGlare, ViewResult, ViewSettings,
+};
 use super::year::{hourly_skies, HourSky};
 use crate::daylight::epw::{Site, Weather};
 use crate::daylight::patches::SkyPatches;
 use crate::description::schema::{
     Amount, LightDesc, SceneFile, SkyModelDesc, SpectrumDesc, SunDesc,
 };
+use crate::glare::GlareOptions;
 use crate::light::Light;
 use crate::scene::build::Overrides;
 use anyhow::{anyhow, bail, Result};
@@ -42,6 +46,10 @@ pub struct AnnualSettings {
     pub draws: usize,
     /// Overrides the scene's seed.
     pub seed: Option<u64>,
+    /// Annual glare of the scene's camera view, and how finely (None: no view).
+    pub view: Option<ViewSettings>,
+    /// Glare evaluation of the view's hourly images.
+    pub glare: GlareOptions,
 }
 
 impl Default for AnnualSettings {
@@ -56,6 +64,8 @@ impl Default for AnnualSettings {
             thresholds: Thresholds::default(),
             draws: 200,
             seed: None,
+            view: None,
+            glare: GlareOptions::default(),
         }
     }
 }
@@ -69,6 +79,8 @@ pub enum Stage {
     Sun,
     /// Hourly illuminances and the metrics with their replicate years.
     Metrics,
+    /// The view: sky coefficients, the sun's nodes, then the hourly images' glare.
+    View,
 }
 
 /// A grid's layout, as the scene gives it.
@@ -82,6 +94,23 @@ pub struct GridLayout {
     pub normal: Vec3,
     /// Lengths of the grid's two edges, m.
     pub size_m: (f64, f64),
+}
+
+/// The annual glare of the scene's camera view.
+#[derive(Clone, Debug)]
+pub struct ViewRun {
+    /// Image size (pixels) and projection of the view's hourly images.
+    pub width: usize,
+    pub height: usize,
+    pub projection: String,
+    /// Camera paths per pixel for the sky, and per pixel and sun node for the sun.
+    pub sky_samples: u64,
+    pub sun_samples: u64,
+    /// Occupied hours with daylight, each with its DGP and E_v.
+    pub hours: Vec<HourGlare>,
+    pub result: ViewResult,
+    /// Seconds for the coefficients and for the hourly glare and its metrics.
+    pub seconds: (f64, f64),
 }
 
 /// Everything an annual calculation found.
@@ -105,6 +134,7 @@ pub struct AnnualRun {
     pub sun_nodes: usize,
     /// Sky and sun passes, seconds.
     pub seconds: (f64, f64, f64),
+    pub view: Option<ViewRun>,
     pub notes: Vec<String>,
 }
 
@@ -238,9 +268,27 @@ pub fn run(
     let sunny: Vec<usize> = (0..year.len()).filter(|&h| year[h].has_sun()).collect();
     let daylight_n = year.iter().filter(|h| h.is_daylight()).count();
     let n_p = patches.len() as u64;
+    let view_cam = settings
+        .view
+        .map(|v| view_camera(&world.camera, v.resolution));
+    let view_need = match (&view_cam, &settings.view) {
+        (Some(c), Some(v)) => {
+            if !(8..=1024).contains(&v.resolution) {
+                return Err(crate::job::invalid_option(format!(
+                    "--view-resolution {} must be 8 to 1024",
+                    v.resolution
+                )));
+            }
+            // Nodes are at most one per sunny hour.
+            view_bytes(c.width * c.height, patches.len(), sunny.len(), sunny.len())
+                + year.len() as u64 * 160
+        }
+        _ => 0,
+    };
     let need = receivers.len() as u64 * n_p * crate::meter::BATCHES as u64 * 8
         + sun_coefficient_bytes(sunny.len(), receivers.len())
-        + hourly_bytes(year.len(), daylight_n, receivers.len());
+        + hourly_bytes(year.len(), daylight_n, receivers.len())
+        + view_need;
     crate::limits::check_memory(
         need,
         "the annual calculation's coefficients and hourly illuminances",
@@ -251,7 +299,16 @@ pub fn run(
     progress(Stage::Sky, 0, 1);
     let sky_c: Coefficients = sky_coefficients(&world, &receivers, &patches, settings.sky_samples)?;
     progress(Stage::Sky, 1, 1);
-    let t1 = std::time::Instant::now();
+    let view_t = std::time::Instant::now();
+    let view_m = match (&view_cam, &settings.view) {
+        (Some(camera), Some(v)) => {
+            progress(Stage::View, 0, 1);
+            Some(view_coefficients(&world, camera, &patches, v)?)
+        }
+        _ => None,
+    };
+    let view_sky_s = view_t.elapsed().as_secs_f64();
+    let t1 = view_t;
 
     let sun_light = {
         let ctx = crate::description::context::Context {
@@ -312,6 +369,42 @@ pub fn run(
     progress(Stage::Metrics, 1, 1);
     let t3 = std::time::Instant::now();
 
+    let view = match (&view_cam, &settings.view, view_m) {
+        (Some(camera), Some(v), Some(mut vm)) => {
+            vm.add_sun(
+                &mut sun_world,
+                camera,
+                &frame,
+                &to_sun,
+                weather.site.latitude_deg,
+                v,
+                &mut |d, n| progress(Stage::View, 1 + d, n + 2),
+            );
+            let t4 = std::time::Instant::now();
+            let mut sun_index = vec![usize::MAX; year.len()];
+            for (i, &h) in sunny.iter().enumerate() {
+                sun_index[h] = i;
+            }
+            let hours = vm.glare(&year, &occupied.hours, &sun_index, &settings.glare);
+            let result = view_metrics(&hours, &occupied, &settings.glare, settings.draws, seed);
+            progress(Stage::View, 1, 1);
+            Some(ViewRun {
+                width: camera.width,
+                height: camera.height,
+                projection: crate::camera::describe(camera.projection()),
+                sky_samples: vm.sky_samples,
+                sun_samples: vm.sun_samples,
+                hours,
+                result,
+                seconds: (
+                    view_sky_s + (t4 - t3).as_secs_f64(),
+                    t4.elapsed().as_secs_f64(),
+                ),
+            })
+        }
+        _ => None,
+    };
+
     let mut notes = Vec::new();
     if electric > 0 {
         notes.push(format!(
@@ -345,9 +438,10 @@ pub fn run(
         year,
         seconds: (
             (t1 - t0).as_secs_f64(),
-            (t2 - t1).as_secs_f64(),
+            (t2 - t1).as_secs_f64() - view_sky_s,
             (t3 - t2).as_secs_f64(),
         ),
+        view,
         notes,
     })
 }

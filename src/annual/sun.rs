@@ -78,13 +78,13 @@ fn equatorial(latitude_deg: f64) -> (DVec3, DVec3, DVec3) {
 }
 
 /// (δ, ω) in radians of unit direction `d` (east, north, up).
-fn declination_hour_angle(d: DVec3, latitude_deg: f64) -> (f64, f64) {
+pub(super) fn declination_hour_angle(d: DVec3, latitude_deg: f64) -> (f64, f64) {
     let (p, q, w) = equatorial(latitude_deg);
     (d.dot(p).clamp(-1.0, 1.0).asin(), d.dot(w).atan2(d.dot(q)))
 }
 
 /// The direction (east, north, up) of (δ, ω), raised to 1° altitude if below it.
-fn node_direction(delta: f64, omega: f64, latitude_deg: f64) -> DVec3 {
+pub(super) fn node_direction(delta: f64, omega: f64, latitude_deg: f64) -> DVec3 {
     let (p, q, w) = equatorial(latitude_deg);
     let d = (q * omega.cos() + w * omega.sin()) * delta.cos() + p * delta.sin();
     let min = 1f64.to_radians().sin();
@@ -101,15 +101,21 @@ fn node_direction(delta: f64, omega: f64, latitude_deg: f64) -> DVec3 {
 }
 
 /// A regular (δ, ω) grid over the hours' suns and, per hour, its cell and weights.
-struct Grid {
+#[derive(Clone, Debug)]
+pub(super) struct Grid {
     delta0: f64,
     omega0: f64,
     step: (f64, f64),
-    n: (usize, usize),
+    pub(super) n: (usize, usize),
 }
 
 impl Grid {
-    fn over(dw: &[(f64, f64)]) -> Self {
+    pub(super) fn over(dw: &[(f64, f64)]) -> Self {
+        Self::with_step(dw, MAX_STEP_DEG)
+    }
+
+    /// A grid over `dw` with nodes at most `max_step_deg` (δ, ω) apart.
+    pub(super) fn with_step(dw: &[(f64, f64)], max_step_deg: (f64, f64)) -> Self {
         let (mut d0, mut d1, mut w0, mut w1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         for &(d, w) in dw {
             d0 = d0.min(d);
@@ -120,7 +126,7 @@ impl Grid {
         let cells = |lo: f64, hi: f64, max_deg: f64| {
             (((hi - lo) / max_deg.to_radians()).ceil() as usize).max(1)
         };
-        let (cd, cw) = (cells(d0, d1, MAX_STEP_DEG.0), cells(w0, w1, MAX_STEP_DEG.1));
+        let (cd, cw) = (cells(d0, d1, max_step_deg.0), cells(w0, w1, max_step_deg.1));
         Grid {
             delta0: d0,
             omega0: w0,
@@ -133,7 +139,7 @@ impl Grid {
     }
 
     /// The four nodes around (δ, ω) and their bilinear weights.
-    fn corners(&self, (d, w): (f64, f64)) -> [(usize, f64); 4] {
+    pub(super) fn corners(&self, (d, w): (f64, f64)) -> [(usize, f64); 4] {
         let fd = ((d - self.delta0) / self.step.0).clamp(0.0, (self.n.0 - 1) as f64);
         let fw = ((w - self.omega0) / self.step.1).clamp(0.0, (self.n.1 - 1) as f64);
         // The grid has at least 2 × 2 nodes.
@@ -152,7 +158,7 @@ impl Grid {
         ]
     }
 
-    fn node(&self, k: usize) -> (f64, f64) {
+    pub(super) fn node(&self, k: usize) -> (f64, f64) {
         let (i, j) = (k / self.n.1, k % self.n.1);
         (
             self.delta0 + i as f64 * self.step.0,
@@ -161,7 +167,7 @@ impl Grid {
     }
 }
 
-fn set_sun(world: &mut World, to_sun: Vec3) {
+pub(super) fn set_sun(world: &mut World, to_sun: Vec3) {
     if let Light::Sun(s) = &mut world.lights[0] {
         s.to_sun = to_sun.normalize();
     }

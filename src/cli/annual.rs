@@ -54,6 +54,19 @@ pub struct AnnualArgs {
     /// Replicate years drawn for the 95 % intervals (0: none; else 2 … 100 000).
     #[arg(long, default_value_t = 200)]
     pub draws: usize,
+    /// Also compute the annual glare (DGP every occupied hour) of the scene's camera view,
+    /// meant for a 180° fisheye at eye height; writes OUT.annual-glare.csv.
+    #[arg(long)]
+    pub view: bool,
+    /// Pixels along the view's longer side for --view, 8–1024.
+    #[arg(long, default_value_t = 64)]
+    pub view_resolution: usize,
+    /// Camera paths per pixel for the view's sky coefficients.
+    #[arg(long, default_value_t = 256)]
+    pub view_sky_samples: u64,
+    /// Camera paths per pixel and sun-position node for the sun on the view's surfaces.
+    #[arg(long, default_value_t = 16)]
+    pub view_sun_samples: u64,
     /// Seed (default: the scene's).
     #[arg(long)]
     pub seed: Option<u64>,
@@ -119,10 +132,18 @@ pub fn settings(a: &AnnualArgs) -> Result<AnnualSettings> {
         ("--sky-samples", a.sky_samples),
         ("--sun-samples", a.sun_samples),
         ("--direct-samples", a.direct_samples),
+        ("--view-sky-samples", a.view_sky_samples),
+        ("--view-sun-samples", a.view_sun_samples),
     ] {
         if v == 0 || v > 1 << 32 {
             return Err(super::usage(format!("{flag} must be 1 … 2^32, got {v}")));
         }
+    }
+    if !(8..=1024).contains(&a.view_resolution) {
+        return Err(super::usage(format!(
+            "--view-resolution must be 8 to 1024, got {}",
+            a.view_resolution
+        )));
     }
     if !(1..=8).contains(&a.mf) {
         return Err(super::usage(format!("--mf must be 1 to 8, got {}", a.mf)));
@@ -143,6 +164,12 @@ pub fn settings(a: &AnnualArgs) -> Result<AnnualSettings> {
         },
         draws: a.draws,
         seed: a.seed,
+        view: a.view.then_some(candela::annual::view::ViewSettings {
+            resolution: a.view_resolution,
+            sky_samples: a.view_sky_samples,
+            sun_samples: a.view_sun_samples,
+        }),
+        glare: Default::default(),
     })
 }
 
@@ -170,6 +197,7 @@ pub fn run(a: &AnnualArgs) -> Result<String> {
             Stage::Sky => "sky coefficients",
             Stage::Sun => "sunny hours",
             Stage::Metrics => "hourly illuminance and metrics",
+            Stage::View => "view: coefficients and hourly glare",
         };
         if done == 0 {
             bar.reset();
@@ -187,9 +215,22 @@ pub fn run(a: &AnnualArgs) -> Result<String> {
     let out = out?;
     candela::annual::output::write_json(&json, &out)?;
     candela::annual::output::write_csv(&csv, &out)?;
+    let glare_csv = PathBuf::from(format!("{}.annual-glare.csv", stem.display()));
+    if out.view.is_some() {
+        candela::annual::output::write_glare_csv(&glare_csv, &out)?;
+    }
     let maps = candela::annual::output::write_heatmaps(&stem, &out)?;
+    let view = match &out.view {
+        Some(v) => format!(
+            "wrote {} ({:.1} s view coefficients, {:.1} s hourly glare)\n",
+            glare_csv.display(),
+            v.seconds.0,
+            v.seconds.1
+        ),
+        None => String::new(),
+    };
     Ok(format!(
-        "{}wrote {}, {} and {} heat maps ({:.1} s sky, {:.1} s sun, {:.1} s metrics)\n",
+        "{}wrote {}, {} and {} heat maps ({:.1} s sky, {:.1} s sun, {:.1} s metrics)\n{view}",
         candela::annual::output::summary(&out),
         json.display(),
         csv.display(),
