@@ -89,6 +89,7 @@ fn a_year_on_the_shoebox_is_consistent_with_its_hourly_csv() {
             "16",
             "--draws",
             "20",
+            "--coefficients",
             "-q",
         ],
         &dir,
@@ -96,6 +97,7 @@ fn a_year_on_the_shoebox_is_consistent_with_its_hourly_csv() {
     assert_eq!(code, 0, "{out}\n{err}");
     println!("{out}");
     assert!(out.contains("sDA 300 lx / 50 %") && out.contains("ASE 1000 lx, 250 h"));
+    sky_coefficients_sum_to_a_uniform_sky(&dir, &scene);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("sb.annual.json")).unwrap())
             .unwrap();
@@ -171,6 +173,79 @@ fn a_year_on_the_shoebox_is_consistent_with_its_hourly_csv() {
     // The window row sees the sun for hundreds of hours; the back of the room never.
     assert!(ase > 0 && ase < 35, "ASE {ase} of 35");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The sky coefficients of NAME.annual-sky-dc.csv: their sum over the patches (ground
+/// included) is the illuminance under a sky of 1 cd/m² everywhere with a ground of 1 cd/m²
+/// (a uniform sky over a white ground: ρ E_h / π = 1), which a direct render of the scene under
+/// that sky measures. The sum's standard error is taken as √Σ se², an upper bound here (a path
+/// credits one patch or another, so the patches' errors are not positively correlated).
+fn sky_coefficients_sum_to_a_uniform_sky(dir: &Path, scene: &Path) {
+    let text = std::fs::read_to_string(dir.join("sb.annual-sky-dc.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "grid,i,j,patch,altitude_deg,azimuth_deg,solid_angle_sr,lx_per_cd_m2,stderr_lx_per_cd_m2"
+    );
+    let mut sum = [[0.0f64; 2]; 35];
+    let mut omega = 0.0;
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let (i, j): (usize, usize) = (f[1].parse().unwrap(), f[2].parse().unwrap());
+        let (c, se): (f64, f64) = (f[7].parse().unwrap(), f[8].parse().unwrap());
+        assert!(c >= 0.0 && se >= 0.0, "{line}");
+        sum[j * 5 + i][0] += c;
+        sum[j * 5 + i][1] += se * se;
+        if i == 0 && j == 0 && f[3] != "0" {
+            omega += f[6].parse::<f64>().unwrap();
+        }
+    }
+    // MF 1: 145 sky patches covering the hemisphere.
+    assert!((omega - 2.0 * std::f64::consts::PI).abs() < 1e-6, "{omega}");
+    let uniform = dir.join("uniform.ron");
+    let text = std::fs::read_to_string(scene).unwrap();
+    let a = text.find("Sky(model: CieOvercast").unwrap();
+    let b = a + text[a..].find("portals").unwrap();
+    std::fs::write(
+        &uniform,
+        format!(
+            "{}Sky(model: Uniform, amount: ZenithLuminance(1.0), ground_reflectance: 1.0, {}",
+            &text[..a],
+            &text[b..]
+        ),
+    )
+    .unwrap();
+    let (code, out, err) = cli(
+        &[
+            "render",
+            uniform.to_str().unwrap(),
+            "--out",
+            dir.join("u").to_str().unwrap(),
+            "--spp",
+            "1",
+            "--quiet",
+        ],
+        dir,
+    );
+    assert_eq!(code, 0, "{out}\n{err}");
+    let grid = std::fs::read_to_string(dir.join("u.grid-work-plane.csv")).unwrap();
+    let mut worst = 0.0f64;
+    for line in grid
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with('i'))
+    {
+        let f: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let (i, j, e, se) = (f[0] as usize, f[1] as usize, f[5], f[6]);
+        let [c, v] = sum[j * 5 + i];
+        let z = (c - e) / (v + se * se).sqrt();
+        worst = worst.max(z.abs());
+        assert!(
+            z.abs() < 4.0,
+            "point ({i}, {j}): coefficients {c} ± {}, render {e} ± {se}",
+            v.sqrt()
+        );
+    }
+    println!("sky coefficients against a uniform sky: worst {worst:.2} σ");
 }
 
 /// The view's annual glare (`--view`) on scenes/annual-glare.ron: the hourly CSV holds every

@@ -113,6 +113,79 @@ fn view_json(v: &super::run::ViewRun) -> Value {
     })
 }
 
+/// Writes the grid points' coefficients, when the run kept them: `sky` gets one row per point
+/// and sky patch (`grid,i,j,patch,altitude_deg,azimuth_deg,solid_angle_sr,lx_per_cd_m2,
+/// stderr_lx_per_cd_m2`; patch 0 is the ground, without a direction), `sun` one row per sunny
+/// hour and point (`month,day,hour,grid,i,j,total_lx_per_lx,total_stderr,direct_lx_per_lx,
+/// direct_stderr`: the illuminance per lx of direct-normal illuminance, in total and of the
+/// direct sun alone).
+pub fn write_coefficients(sky: &Path, sun: &Path, run: &AnnualRun) -> Result<(), OutputError> {
+    let Some((c, sc)) = &run.coefficients else {
+        return Ok(());
+    };
+    let points: Vec<(String, usize, usize)> = run
+        .grids
+        .iter()
+        .flat_map(|g| {
+            let name = g.name.replace([',', '"', '\n', '\r'], "_");
+            (0..g.points.len()).map(move |k| (name.clone(), k % g.nx as usize, k / g.nx as usize))
+        })
+        .collect();
+    crate::output::write_atomic(sky, |w| {
+        writeln!(
+            w,
+            "grid,i,j,patch,altitude_deg,azimuth_deg,solid_angle_sr,lx_per_cd_m2,stderr_lx_per_cd_m2"
+        )?;
+        for (r, (g, i, j)) in points.iter().enumerate() {
+            for p in 0..c.patches.len() {
+                let dir = match c.patches.patch(p) {
+                    Some(pt) => {
+                        let d = pt.centre();
+                        let alt = d[2].clamp(-1.0, 1.0).asin().to_degrees();
+                        let az = d[0].atan2(d[1]).to_degrees().rem_euclid(360.0);
+                        format!("{alt:.4},{az:.4},{:.8}", pt.solid_angle_sr)
+                    }
+                    None => ",,".into(),
+                };
+                writeln!(
+                    w,
+                    "{g},{i},{j},{p},{dir},{:.9e},{:.4e}",
+                    c.mean(r, p),
+                    c.stderr(r, p)
+                )?;
+            }
+        }
+        Ok(())
+    })?;
+    crate::output::write_atomic(sun, |w| {
+        writeln!(
+            w,
+            "month,day,hour,grid,i,j,total_lx_per_lx,total_stderr,direct_lx_per_lx,direct_stderr"
+        )?;
+        let sunny = run.year.iter().filter(|h| h.has_sun());
+        for (h, hs) in sunny.enumerate() {
+            for (r, (g, i, j)) in points.iter().enumerate() {
+                let (t, d) = sc.batches(h, r);
+                let (tm, ts) = mean_se(t);
+                let (dm, ds) = mean_se(d);
+                writeln!(
+                    w,
+                    "{},{},{},{g},{i},{j},{tm:.9e},{ts:.4e},{dm:.9e},{ds:.4e}",
+                    hs.month, hs.day, hs.hour
+                )?;
+            }
+        }
+        Ok(())
+    })
+}
+
+fn mean_se(b: &[f64]) -> (f64, f64) {
+    let k = b.len() as f64;
+    let m = b.iter().sum::<f64>() / k;
+    let var = b.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (k - 1.0);
+    (m, (var / k).sqrt())
+}
+
 /// Writes the view's hourly glare: one row per occupied hour with daylight, `month,day,hour`
 /// (the EPW record hour), DGP, E_v and its standard error (lx), the sun disk's part of E_v (lx)
 /// and the number of glare sources.
@@ -298,7 +371,10 @@ pub fn output_paths(
     files::check_output_dir(&stem)?;
     let json = PathBuf::from(format!("{}.annual.json", stem.display()));
     let csv = PathBuf::from(format!("{}.annual.csv", stem.display()));
-    for p in [&json, &csv] {
+    // The optional outputs (glare, coefficients) share the stem.
+    let extra = ["annual-glare.csv", "annual-sky-dc.csv", "annual-sun-dc.csv"]
+        .map(|e| PathBuf::from(format!("{}.{e}", stem.display())));
+    for p in [&json, &csv].into_iter().chain(&extra) {
         if files::would_replace(p, scene) || weather.is_some_and(|w| files::would_replace(p, w)) {
             return Err(crate::job::invalid_option(format!(
                 "{} would replace an input",

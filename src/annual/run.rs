@@ -50,6 +50,8 @@ pub struct AnnualSettings {
     pub view: Option<ViewSettings>,
     /// Glare evaluation of the view's hourly images.
     pub glare: GlareOptions,
+    /// Keep the grid points' sky and sun coefficients in [`AnnualRun::coefficients`].
+    pub keep_coefficients: bool,
 }
 
 impl Default for AnnualSettings {
@@ -66,6 +68,7 @@ impl Default for AnnualSettings {
             seed: None,
             view: None,
             glare: GlareOptions::default(),
+            keep_coefficients: false,
         }
     }
 }
@@ -135,6 +138,9 @@ pub struct AnnualRun {
     /// Sky and sun passes, seconds.
     pub seconds: (f64, f64, f64),
     pub view: Option<ViewRun>,
+    /// The grid points' sky and sun coefficients (with `keep_coefficients`); the sun's are
+    /// those of the year's sunny hours, in order.
+    pub coefficients: Option<(Coefficients, SunCoefficients)>,
     pub notes: Vec<String>,
 }
 
@@ -442,6 +448,7 @@ pub fn run(
             (t3 - t2).as_secs_f64(),
         ),
         view,
+        coefficients: settings.keep_coefficients.then_some((sky_c, sun_c)),
         notes,
     })
 }

@@ -67,6 +67,11 @@ pub struct AnnualArgs {
     /// Camera paths per pixel and sun-position node for the sun on the view's surfaces.
     #[arg(long, default_value_t = 16)]
     pub view_sun_samples: u64,
+    /// Also write the grid points' daylight coefficients: OUT.annual-sky-dc.csv (per point
+    /// and sky patch, lx per cd/m²) and OUT.annual-sun-dc.csv (per sunny hour and point, lx
+    /// per lx of direct-normal illuminance), each with its standard error.
+    #[arg(long)]
+    pub coefficients: bool,
     /// Seed (default: the scene's).
     #[arg(long)]
     pub seed: Option<u64>,
@@ -170,6 +175,7 @@ pub fn settings(a: &AnnualArgs) -> Result<AnnualSettings> {
             sun_samples: a.view_sun_samples,
         }),
         glare: Default::default(),
+        keep_coefficients: a.coefficients,
     })
 }
 
@@ -219,6 +225,13 @@ pub fn run(a: &AnnualArgs) -> Result<String> {
     if out.view.is_some() {
         candela::annual::output::write_glare_csv(&glare_csv, &out)?;
     }
+    let dc = [
+        PathBuf::from(format!("{}.annual-sky-dc.csv", stem.display())),
+        PathBuf::from(format!("{}.annual-sun-dc.csv", stem.display())),
+    ];
+    if out.coefficients.is_some() {
+        candela::annual::output::write_coefficients(&dc[0], &dc[1], &out)?;
+    }
     let maps = candela::annual::output::write_heatmaps(&stem, &out)?;
     let view = match &out.view {
         Some(v) => format!(
@@ -228,6 +241,10 @@ pub fn run(a: &AnnualArgs) -> Result<String> {
             v.seconds.1
         ),
         None => String::new(),
+    } + &if out.coefficients.is_some() {
+        format!("wrote {} and {}\n", dc[0].display(), dc[1].display())
+    } else {
+        String::new()
     };
     Ok(format!(
         "{}wrote {}, {} and {} heat maps ({:.1} s sky, {:.1} s sun, {:.1} s metrics)\n{view}",
