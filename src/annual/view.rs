@@ -44,7 +44,9 @@ use crate::world::World;
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
-/// Shadow rays over the sun's disk per hour, each with its own wavelengths.
+/// Shadow rays over the sun's disk per hour and batch (stratified over the disk, each with its
+/// own wavelengths): a disk mostly hidden behind a window's edge is resolved to 1/1024 of its
+/// light, and each batch's own points give the disk's part of E_v its standard error.
 const DISK_POINTS: u32 = 64;
 
 /// Largest sun-node spacing in declination and hour angle (degrees) for the sun on the view's
@@ -107,7 +109,7 @@ pub fn view_bytes(pixels: usize, patches: usize, nodes: usize, sunny: usize) -> 
         + 4 * p * nodes as u64
         + 8 * BATCHES as u64 * (patches + nodes) as u64
         + 40 * p
-        + sunny as u64 * 64
+        + sunny as u64 * (64 + 8 * BATCHES as u64)
 }
 
 /// A view's coefficients.
@@ -136,7 +138,7 @@ pub struct ViewMatrix {
     /// luminance per lx) and the disk's E_v per lx.
     sun_dw: Vec<(f64, f64)>,
     disk: Vec<Vec<(u32, f32)>>,
-    disk_ev: Vec<f64>,
+    disk_ev: Vec<[f64; BATCHES as usize]>,
     pub sky_samples: u64,
     pub sun_samples: u64,
     pub nodes: usize,
@@ -407,7 +409,7 @@ impl ViewMatrix {
             index_of[i] = q as u32;
         }
         let world = &*sun_world;
-        let disks: Vec<(Vec<(u32, f32)>, f64)> = to_sun_enu
+        let disks: Vec<(Vec<(u32, f32)>, [f64; BATCHES as usize])> = to_sun_enu
             .par_iter()
             .enumerate()
             .map(|(h, d)| {
@@ -416,7 +418,7 @@ impl ViewMatrix {
             })
             .collect();
         progress(steps, steps);
-        let (disk, disk_ev) = disks.into_iter().unzip();
+        let (disk, disk_ev): (Vec<_>, Vec<_>) = disks.into_iter().unzip();
         self.grid = grid;
         self.node_slot = node_slot;
         self.sun = sun;
@@ -431,10 +433,11 @@ impl ViewMatrix {
 
 /// The sun's disk toward `to_sun` (world must be lit by one sun of 1 lx) as seen from the
 /// camera: per pixel it falls in (inside index), the luminance it adds there per lx of
-/// direct-normal illuminance, and its E_v per lx. Each of [`DISK_POINTS`] directions over
-/// the disk carries E_n T / [`DISK_POINTS`] (T the panes' transmittance from the eye); its
-/// pixel's luminance is set so that the pixel's share of E_v is E cos θ of the direction
-/// itself (the pixel's centre would be off by the cosine's change across the pixel).
+/// direct-normal illuminance, and its E_v per lx in each batch. Each of the [`DISK_POINTS`]
+/// directions of a batch carries E_n T / [`DISK_POINTS`] of that batch's estimate (T the panes'
+/// transmittance from the eye); its pixel's luminance is set so that the pixel's share of E_v
+/// is E cos θ of the direction itself (the pixel's centre would be off by the cosine's change
+/// across the pixel).
 fn sun_disk(
     world: &World,
     camera: &Camera,
@@ -442,54 +445,59 @@ fn sun_disk(
     index_of: &[u32],
     cos_w: &[f64],
     hour: usize,
-) -> (Vec<(u32, f32)>, f64) {
+) -> (Vec<(u32, f32)>, [f64; BATCHES as usize]) {
+    let mut ev = [0.0; BATCHES as usize];
     let Light::Sun(sun) = &world.lights[0] else {
-        return (Vec::new(), 0.0);
+        return (Vec::new(), ev);
     };
     let mut sun = sun.clone();
     sun.to_sun = to_sun.normalize();
     let (forward, _, _) = camera.frame();
     let mut out: Vec<(u32, f32)> = Vec::new();
-    let mut ev = 0.0;
     let side = (DISK_POINTS as f64).sqrt() as u32;
-    for j in 0..DISK_POINTS {
-        let mut sampler =
-            Sampler::new(world.settings.seed, ((hour as u64 + 1) << 24) | 7, j as u64);
-        let wl = SampledWavelengths::sample_visible((j as f32 + 0.5) / DISK_POINTS as f32);
-        // Stratified over the disk.
-        let jitter = sampler.get2d();
-        let u = Vec2::new(
-            ((j % side) as f32 + jitter.x) / side as f32,
-            ((j / side) as f32 + jitter.y) / side as f32,
-        );
-        let Some(ls) = sun.sample_li(u, &wl) else {
-            continue;
-        };
-        let Some((fx, fy)) = camera.film_position(ls.wi) else {
-            continue;
-        };
-        let (x, y) = (fx.floor(), fy.floor());
-        if x < 0.0 || y < 0.0 || x >= camera.width as f64 || y >= camera.height as f64 {
-            continue;
-        }
-        let pix = y as usize * camera.width + x as usize;
-        let q = index_of[pix];
-        if q == u32::MAX || ls.pdf <= 0.0 {
-            continue;
-        }
-        let Some(tr) = transmittance(world, camera.position, ls.wi, f32::INFINITY, &wl) else {
-            continue;
-        };
-        let e = luminance(&(tr * ls.li * (1.0 / ls.pdf)), &wl) / DISK_POINTS as f64;
-        let cos = ls.wi.dot(forward) as f64;
-        if e <= 0.0 || cos <= 0.0 || cos_w[q as usize] <= 0.0 {
-            continue;
-        }
-        ev += e * cos;
-        let l = e * cos / cos_w[q as usize];
-        match out.iter_mut().find(|(p, _)| *p == q) {
-            Some((_, v)) => *v += l as f32,
-            None => out.push((q, l as f32)),
+    let n = DISK_POINTS as f64;
+    for (b, ev_b) in ev.iter_mut().enumerate() {
+        let stream = batch_stream(((hour as u64 + 1) << 24) | 7, b as u32);
+        for j in 0..DISK_POINTS {
+            let mut sampler = Sampler::new(world.settings.seed, stream, j as u64);
+            // Stratified over the disk and, in another order, over the wavelengths.
+            let jitter = sampler.get2d();
+            let u = Vec2::new(
+                ((j % side) as f32 + jitter.x) / side as f32,
+                ((j / side) as f32 + jitter.y) / side as f32,
+            );
+            let wl = SampledWavelengths::sample_visible(
+                ((j * 29 % DISK_POINTS) as f32 + sampler.get1d()) / DISK_POINTS as f32,
+            );
+            let Some(ls) = sun.sample_li(u, &wl) else {
+                continue;
+            };
+            let Some((fx, fy)) = camera.film_position(ls.wi) else {
+                continue;
+            };
+            let (x, y) = (fx.floor(), fy.floor());
+            if x < 0.0 || y < 0.0 || x >= camera.width as f64 || y >= camera.height as f64 {
+                continue;
+            }
+            let q = index_of[y as usize * camera.width + x as usize];
+            if q == u32::MAX || ls.pdf <= 0.0 {
+                continue;
+            }
+            let Some(tr) = transmittance(world, camera.position, ls.wi, f32::INFINITY, &wl) else {
+                continue;
+            };
+            let e = luminance(&(tr * ls.li * (1.0 / ls.pdf)), &wl) / n;
+            let cos = ls.wi.dot(forward) as f64;
+            if e <= 0.0 || cos <= 0.0 || cos_w[q as usize] <= 0.0 {
+                continue;
+            }
+            *ev_b += e * cos;
+            // The image holds the mean over the batches.
+            let l = e * cos / cos_w[q as usize] / BATCHES as f64;
+            match out.iter_mut().find(|(p, _)| *p == q) {
+                Some((_, v)) => *v += l as f32,
+                None => out.push((q, l as f32)),
+            }
         }
     }
     (out, ev)
@@ -553,9 +561,10 @@ impl ViewMatrix {
             for &(q, l) in &self.disk[s] {
                 lum[self.inside[q as usize]] += en * l as f64;
             }
-            disk_ev = en * self.disk_ev[s];
-            for e in ev.iter_mut() {
-                *e += disk_ev;
+            let d = &self.disk_ev[s];
+            disk_ev = en * d.iter().sum::<f64>() / k as f64;
+            for (e, d) in ev.iter_mut().zip(d) {
+                *e += en * d;
             }
         }
         (lum, ev, disk_ev)
