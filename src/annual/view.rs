@@ -61,6 +61,9 @@ const NODE_STEP_DEG: (f64, f64) = (3.0, 3.75);
 /// in 5 % of the occupied hours (high, medium, minimum).
 pub const DGP_LIMITS: [f64; 3] = [0.35, 0.40, 0.45];
 
+/// The sun disk's E_v per lx of direct-normal illuminance, per batch.
+type DiskEv = [f64; BATCHES as usize];
+
 /// How finely a view is computed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewSettings {
@@ -138,7 +141,7 @@ pub struct ViewMatrix {
     /// luminance per lx) and the disk's E_v per lx.
     sun_dw: Vec<(f64, f64)>,
     disk: Vec<Vec<(u32, f32)>>,
-    disk_ev: Vec<[f64; BATCHES as usize]>,
+    disk_ev: Vec<DiskEv>,
     pub sky_samples: u64,
     pub sun_samples: u64,
     pub nodes: usize,
@@ -409,7 +412,7 @@ impl ViewMatrix {
             index_of[i] = q as u32;
         }
         let world = &*sun_world;
-        let disks: Vec<(Vec<(u32, f32)>, [f64; BATCHES as usize])> = to_sun_enu
+        let disks: Vec<(Vec<(u32, f32)>, DiskEv)> = to_sun_enu
             .par_iter()
             .enumerate()
             .map(|(h, d)| {
@@ -445,7 +448,7 @@ fn sun_disk(
     index_of: &[u32],
     cos_w: &[f64],
     hour: usize,
-) -> (Vec<(u32, f32)>, [f64; BATCHES as usize]) {
+) -> (Vec<(u32, f32)>, DiskEv) {
     let mut ev = [0.0; BATCHES as usize];
     let Light::Sun(sun) = &world.lights[0] else {
         return (Vec::new(), ev);
