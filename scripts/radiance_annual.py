@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Annual daylight of the shoebox (scenes/annual-shoebox.ron) by Radiance's matrix method.
 
-    python scripts/radiance_annual.py WEATHER.epw [--mf 2] [--ab 6] [--ad 65536] [--lw 1e-7]
+    python scripts/radiance_annual.py WEATHER.epw [--mf 2] [--ab 12] [--ad 65536] [--lw 1e-7]
+        [--sun-ad 1024] [--sun-disk 37] [--sun-ir hourly|patches]
         [--nproc 2] [--work DIR] > out.json
 
 Needs Radiance 6 on PATH with RAYPATH set (pyradiance's wheel: bin/ and lib/; bench/annual.sh sets
@@ -12,28 +13,34 @@ Frame. candela's scene is y up, +z south, +x east. Radiance's skies (gendaymtx, 
 (X, Y, Z) = (x, -z, y), a proper rotation (det +1). The south window (candela z = 6) is at
 Y = -6 facing -Y = south; the sensors are at Z = 0.8 facing +Z.
 
-Method: daylight coefficients for the sky, sun coefficients for the inter-reflected sun and
-one exact sun per sunny hour for the direct sun (the decomposition of the five-phase method,
-without a window matrix since the pane is specular):
+Method: daylight coefficients for the sky; for the sun, each sunny hour's own sun, traced once
+for its inter-reflected light and once, as sub-suns over its disk, for its direct light:
 
-    E_total = DC_sky(ab N) . sky  +  (S(ab N) - S(ab 0)) . sun patches  +  suns(ab 0)
+    E_total = DC_sky(ab N) . sky  +  (suns(ab N) - suns(ab 0))  +  disk suns(ab 0)
 
-- sky, sun patches: gendaymtx -m MF -O0 (-O0 is visible radiance, W sr^-1 m^-2 at 179 lm/W;
-  -O1 would be full-spectrum solar radiance), -s (sky only; patch 0 the ground, reflectance 0.2,
-  lit by sky and sun) and -d (sun only, spread over the 4 patches nearest the sun).
+- sky: gendaymtx -m MF -O0 -s (-O0 is visible radiance, W sr^-1 m^-2 at 179 lm/W; -O1 would
+  be full-spectrum solar radiance; sky only; patch 0 the ground, reflectance 0.2, lit by sky
+  and sun).
 - DC_sky: rfluxmtx, the sensors as sender rays (-I), the receiver the ground hemisphere (h=u)
   then the Reinhart sky (h=rMF, u=+Y), gendaymtx's patch order.
-- S: rcontrib with a 0.533-degree sun at the centre of each patch the year's sun reaches, at
-  -ab N and at -ab 0. Both compute the direct part with the same deterministic shadow rays
-  (-dj 0 -dc 1 -dt 0), so their difference is the inter-reflected sun alone, exactly free of
-  the direct part (subtracting a one-bounce DC from an N-bounce one, as honeybee's recipe does,
-  leaves the two runs' sampling noise of the sun patches seen through the pane, several times
-  the inter-reflected part near the window). Each hour weights the patches as gendaymtx -d does.
-- suns: rcontrib -ab 0, one `light` per sunny hour (gendaymtx -D: the direct-normal illuminance
-  of gendaymtx's Perez efficacy) at the hour's sun position (by default ladybug's NOAA position
-  with refraction, as candela's, within about 0.05 degrees; gendaymtx's own formula is up to 1
-  degree off), one modifier per sun: the direct sun alone, for ASE (LM-83: direct sun, no
-  inter-reflection) and added to the total.
+- suns: one `light` per sunny hour (gendaymtx -D: the direct-normal illuminance of gendaymtx's
+  Perez efficacy; hours without beam dropped) at the hour's sun position (by default ladybug's
+  NOAA position with refraction, as candela's, within about 0.05 degrees; gendaymtx's own
+  formula is up to 1 degree off), one modifier per sun.
+- Inter-reflected sun (--sun-ir hourly, the default): rcontrib with the suns at -ab N and at
+  -ab 0. Both compute the direct part with the same deterministic shadow ray (-dj 0 -dc 1
+  -dt 0), so their difference is the inter-reflected sun alone, free of the direct part's
+  noise (subtracting a one-bounce DC from an N-bounce one, as honeybee's recipe does, leaves
+  the two runs' sampling noise of the sun seen through the pane, several times the
+  inter-reflected part near the window). --sun-ir patches instead traces one sun at the centre
+  of each sky patch the year's sun reaches and weights them per hour as gendaymtx -d spreads
+  the hour's sun over the 4 nearest patches: cheaper for a long year, but an interpolation
+  (about 3 % RMS in sunny hours against the hourly suns).
+- Direct sun (ASE, LM-83: direct sun, no inter-reflection; and part of the total): each sun as
+  --sun-disk N sub-suns (default 37: the centre and rings of 6, 12, 18) spread over the
+  0.533-degree disk with equal shares of its solid angle, rcontrib -ab 0 -dj 0: one shadow ray
+  to each, so a disk partly hidden by the window's edge gives part of its light, as candela's
+  integral over the disk does. --sun-disk 1 is one ray to the disk's centre.
 - dctimestep applies DC_sky to the sky matrix; rmtxop -c 47.4 119.9 11.6 turns RGB irradiance
   into illuminance (lx).
 
