@@ -500,7 +500,7 @@ def main():
         "settings": {"photometric_wea": args.photometric, "reused_dc": args.reuse_dc,
                      "sun_positions": "gendaymtx" if args.radiance_sun_positions else "ladybug NOAA",
                      "mf": args.mf, "ab": args.ab, "ad": args.ad, "sun_ad": args.sun_ad, "lw": args.lw,
-                     "sun_patches": len(used),
+                     "sun_patches": len(used) if args.sun_ir == "patches" else None,
                      "nproc": args.nproc, "sun_suns": len(sun_mods), "sun_disk": args.sun_disk,
                      "sun_ir": args.sun_ir,
                      "sda_fraction": args.sda_fraction, "ase_hours": args.ase_hours},
