@@ -113,9 +113,9 @@ fn candela_hours(path: &Path, npts: usize) -> [Vec<Vec<f64>>; 3] {
         let f: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
         let (m, d, h) = (f[0] as usize, f[1] as usize, f[2] as usize);
         let t = (month_start[m - 1] + d - 1) * 24 + h - 1;
-        for p in 0..npts {
-            for k in 0..3 {
-                out[k][p][t] = f[3 + 3 * p + k];
+        for (p, point) in f[3..].chunks(3).enumerate() {
+            for (o, v) in out.iter_mut().zip(point) {
+                o[p][t] = *v;
             }
         }
     }
@@ -283,12 +283,12 @@ fn annual_metrics_and_hours_match_radiance_matrix_method() {
             if (weather[t].0 > 0.0) != sunny {
                 continue;
             }
-            for p in 0..npts {
+            for (p, (zp, rp)) in z.iter_mut().zip(rel.iter_mut()).enumerate() {
                 let (c, r) = (ce[p][t], re[p][t]);
                 if r > 50.0 {
                     let sigma = (cse[p][t].powi(2) + (s_r * r).powi(2)).sqrt();
-                    z[p].push((c - r) / sigma);
-                    rel[p].push((c - r) / r);
+                    zp.push((c - r) / sigma);
+                    rp.push((c - r) / r);
                 }
             }
         }
