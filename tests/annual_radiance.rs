@@ -22,6 +22,9 @@
 //! (both beyond 4 standard errors; |z| > 4 in 4.2 % of the overcast point-hours); 3 % lower,
 //! +1.3 ± 0.2 and +0.82 ± 0.08: the test fails either way.
 //!
+//! CPU time: candela 32 s, Radiance 86 s (78 s of it the hourly suns' inter-reflected light),
+//! about a minute on 2 cores.
+//!
 //! Asserts:
 //! - sDA and ASE within 2 percentage points (one point of 35 is 2.9 points, so ASE must count
 //!   the same points);
