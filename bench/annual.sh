@@ -8,6 +8,10 @@
 #   bash bench/annual.sh --epw FILE.epw           # another weather file
 #   bash bench/annual.sh --candela PATH           # candela binary (default target/release/candela)
 #   bash bench/annual.sh --candela-args "--sky-samples 8192" --radiance-args "--ad 32768"
+#   bash bench/annual.sh --radiance-args "--sun-ir patches"   # inter-reflected sun from patch suns
+#
+# Radiance's defaults: the direct sun as 37 sub-suns over the disk (--sun-disk 37), each sunny
+# hour's own sun for the inter-reflected sun (--sun-ir hourly, the costlier part on a full year).
 #
 # Needs the Python venv of scripts/setup_python.sh (ladybug-core for the synthetic year,
 # pyradiance for Radiance's binaries, numpy). Results in target/bench/annual/: every run's

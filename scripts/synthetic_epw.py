@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write a deterministic synthetic weather year (EPW, 8760 hourly records) for a Lyon-like site.
 
-    python scripts/synthetic_epw.py OUT.epw [--seed N]
+    python scripts/synthetic_epw.py OUT.epw [--seed N] [--every K]
 
 Site: latitude 45.72 N, longitude 4.93 E, time zone +1 h, elevation 200 m. Each day is clear,
 intermediate or overcast, drawn from a seeded Markov chain whose clear-day share peaks in summer,
@@ -18,6 +18,10 @@ Perez et al. (1990) luminous efficacy model (ladybug.skymodel), the one gendaymt
 use, so a reader that takes either kind of field sees the same sky. The sun position is taken at
 the middle of each record's hour: the EPW record of hour h covers (h-1):00-h:00 local standard
 time. Needs ladybug-core (target/venv).
+
+--every K keeps the daylight of every K-th day only (1 January, then every K days) and makes the
+other days dark (no irradiance): the same weather on the kept days, a K times cheaper year for
+tests, still 8760 records. Metrics over such a file count the dark days' occupied hours as dark.
 """
 
 import argparse
@@ -63,7 +67,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out", help="EPW path to write")
     ap.add_argument("--seed", type=int, default=20260101)
+    ap.add_argument("--every", type=int, default=1,
+                    help="keep the daylight of every K-th day only, the others dark")
     args = ap.parse_args()
+    if args.every < 1:
+        ap.error("--every must be at least 1")
     rng = random.Random(args.seed)
 
     epw = EPW.from_missing_values(is_leap_year=False)
@@ -114,6 +122,9 @@ def main():
                         dh = cdh + 0.35 * (1.0 - trans) * cdn * s
                     else:
                         dn, dh = 0.0, rng.uniform(0.20, 0.45) * (cdn * s + cdh)
+                    if doy % args.every != 0:
+                        # Drawn all the same, so the kept days are those of the full year.
+                        dn = dh = 0.0
                     dni[i], dhi[i] = round(dn), round(dh)
                     ghi[i] = round(dni[i] * s + dhi[i])
                     ext_dn[i] = round(e0)
