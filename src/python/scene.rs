@@ -476,10 +476,12 @@ fn check_scene_text(text: &str, name: &str) -> PyResult<()> {
 /// read); returns the image size (width, height) in pixels.
 #[pyfunction]
 fn check_scene_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<(usize, usize)> {
-    let world = py
-        .detach(|| crate::scene::load_world(&path, &crate::scene::Overrides::default()))
-        .map_err(|e| error_msg(e.to_string()))?;
-    Ok((world.camera.width, world.camera.height))
+    py.detach(|| {
+        crate::scene::load_world(&path, &crate::scene::Overrides::default())
+            .map(|world| (world.camera.width, world.camera.height))
+            .map_err(|e| e.to_string())
+    })
+    .map_err(error_msg)
 }
 
 pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
