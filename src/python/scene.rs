@@ -340,7 +340,9 @@ impl<'de> de::Deserializer<'de> for Ron<'_> {
                 let f = n.as_f64().unwrap_or(f64::NAN);
                 // `{:?}` always writes a decimal point, which RON needs for a float.
                 write!(self.out, "{f:?}").expect("writes to a String");
-                visitor.visit_f64(f).map_err(|e| e.at(&self.path))
+                visitor
+                    .visit_f64(f)
+                    .map_err(|e: DictError| e.at(&self.path))
             }
             _ => Err(self.expected("a number")),
         }

@@ -60,7 +60,7 @@ def test_xyz_agrees_with_colour_science(observer):
         assert rel_dev(astm[i], ref_astm) < 1e-10
         assert rel_dev(relative[i], ref_rel) < 1e-10
     # One spectrum (W,) gives one XYZ (3,).
-    assert np.array_equal(cc.sd_to_xyz(WL, s[0]), absolute[0])
+    assert np.array_equal(cc.sd_to_xyz(WL, s[0], observer=observer), absolute[0])
 
 
 def test_chromaticity_and_cct_agree_with_colour_science():
