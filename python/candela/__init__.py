@@ -2,7 +2,7 @@
 
 Every image is a calibrated photometric quantity: ``Y`` is luminance in cd/m², ``E``
 illuminance in lx. :func:`render` runs exactly the job of ``candela render`` (the same library
-call and settings), so for the same scene and seed it writes the same files, bit for bit, and
+call and settings), so for the same scene and seed it writes the same images, bit for bit, and
 returns the image as numpy arrays with the report as a dict. See docs/python.md.
 
 Errors candela reports (a bad scene, a bad option, a damaged file) raise :class:`CandelaError`
