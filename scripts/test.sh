@@ -19,4 +19,4 @@ cargo test --all-targets "$@"
 # has just compiled (only candela itself and pyo3 are compiled again), installed into the venv
 # without touching its pinned packages, then its tests (finding none, pytest exits 5: a failure).
 VIRTUAL_ENV="$PWD/target/venv" target/venv/bin/maturin develop --quiet --profile test
-target/venv/bin/python -m pytest -q tests/python
+target/venv/bin/python -m pytest -q -p no:cacheprovider -p no:warnings tests/python
