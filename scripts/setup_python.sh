@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Create the Python virtual environment used to regenerate data/ and to run the
-# colour-science validation test (tests/colour_science.rs) and the Radiance sky comparison
-# and EPW comparisons (tests/daylight_peers.rs).
+# Create the Python virtual environment used to regenerate data/, to build and test the Python
+# package (tests/python/), and to run the colour-science validation test
+# (tests/colour_science.rs) and the Radiance sky and EPW comparisons (tests/daylight_peers.rs).
 #
 #   scripts/setup_python.sh            # creates <repo>/target/venv if missing, installs pins
 #   PYTHON=python3.11 scripts/setup_python.sh
@@ -18,7 +18,8 @@ PYTHON="${PYTHON:-python3}"
 # 0.44.62 (EPW weather files) for the daylight tests; luxpy 1.12.5 (CIE S 026 alpha-opic
 # quantities, CIE 191 mesopic photometry; tests/colour_health.rs and data/alpha-opic-*.csv),
 # which imports scipy and matplotlib at start-up. numpy stays below 2.4: luxpy 1.12.5 calls
-# float() on 1-element arrays, which numpy 2.4 refuses.
+# float() on 1-element arrays, which numpy 2.4 refuses. maturin 1.16.0 builds the Python
+# package into this venv and pytest 9.2.0 runs its tests (tests/python/).
 PINS=(
   "colour-science==0.4.7"
   "numpy==2.3.5"
@@ -28,6 +29,8 @@ PINS=(
   "pyradiance==1.3.1"
   "ladybug-core==0.44.62"
   "ladybug-geometry==1.35.6"
+  "maturin==1.16.0"
+  "pytest==9.2.0"
 )
 
 if [ ! -x "$VENV/bin/python" ]; then

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The one command that runs every test on a fresh machine:
 #   bash scripts/test.sh
-# It installs the Python reference (colour-science, pinned) into target/venv when missing, then
-# runs the whole Rust test suite (optimised: [profile.test] opt-level = 3).
+# It installs the Python reference (colour-science, pinned) into target/venv when missing, runs
+# the whole Rust test suite (optimised: [profile.test] opt-level = 3), then builds the Python
+# package into target/venv and runs its tests (tests/python/).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup_python.sh
@@ -14,3 +15,10 @@ if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null && ! command -v slurmctld
 fi
 export CANDELA_PYTHON="${CANDELA_PYTHON:-$PWD/target/venv/bin/python}"
 cargo test --all-targets "$@"
+# The Python package, built with the test profile into the same target directory (its
+# dependencies that cargo test compiled with the same features are reused; pyo3's macros turn on
+# two more features of syn, so the derive macros and the crates using them are compiled again),
+# installed into the venv (numpy, its one requirement, is among the pins), then its tests
+# (finding none, pytest exits 5: a failure).
+VIRTUAL_ENV="$PWD/target/venv" target/venv/bin/maturin develop --quiet --profile test
+target/venv/bin/python -m pytest -q -p no:cacheprovider -p no:warnings tests/python

@@ -23,6 +23,8 @@ pub mod luminaire;
 pub mod meter;
 pub mod output;
 pub mod photometry;
+#[cfg(feature = "python")]
+mod python;
 pub mod render;
 pub mod report;
 pub mod sampling;

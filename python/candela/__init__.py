@@ -1,0 +1,304 @@
+"""candela — a spectral path tracer whose output is measured light, from Python.
+
+Every image is a calibrated photometric quantity: ``Y`` is luminance in cd/m², ``E``
+illuminance in lx. :func:`render` runs exactly the job of ``candela render`` (the same library
+call and settings), so for the same scene and seed it writes the same images, bit for bit, and
+returns the image as numpy arrays with the report as a dict. See docs/python.md.
+
+Errors candela reports (a bad scene, a bad option, a damaged file) raise :class:`CandelaError`
+whose message is candela's own: it names the file, the line:column or the field path.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Dict, List, Mapping, Optional, Union
+
+import numpy as np
+
+from . import _candela
+from ._candela import Cancelled, CandelaError, __version__
+from . import colour
+
+__all__ = [
+    "CandelaError",
+    "Cancelled",
+    "Scene",
+    "RenderResult",
+    "render",
+    "read_exr",
+    "read_state",
+    "colour",
+    "__version__",
+]
+
+Progress = Callable[[int, int, float], Optional[bool]]
+"""``progress(samples_done, samples_total, elapsed_s)``: called when the render starts and
+after every pass; returning ``False`` (exactly) cancels the render."""
+
+
+def _jsonable(o: Any) -> Any:
+    """numpy scalars and arrays in a scene dict, as plain numbers and lists."""
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, np.generic):
+        return o.item()
+    raise TypeError(f"a scene dict holds a {type(o).__name__}, which has no RON form")
+
+
+class Scene:
+    """A scene: a RON file, RON text or a Python dict (checked for syntax, types and unknown
+    fields on creation; values are checked when it renders, or by :meth:`check`).
+
+    A dict has the shape serde gives the scene format in JSON: a struct is a dict of its
+    fields, an enum variant a one-key dict ``{"Variant": content}`` (``{"Blackbody": 3000.0}``,
+    ``{"Diffuse": {"reflectance": {"Constant": 0.7}}}``) or, if it has no content, the string
+    ``"Variant"``; tuples and vectors are lists. Field names and units are those of
+    docs/scene-format.md.
+
+    A scene from text or a dict is written to the output directory as ``NAME.ron`` before it
+    renders, so files it refers to (meshes, spectra, luminaires) need absolute paths.
+    """
+
+    def __init__(self, *, path: Optional[Path] = None, text: Optional[str] = None,
+                 name: str = "scene") -> None:
+        self.path = path
+        self.text = text
+        self.name = name
+
+    @classmethod
+    def from_file(cls, path: Union[str, os.PathLike]) -> "Scene":
+        """A scene file (RON); raises CandelaError naming the file and line:column."""
+        p = Path(path)
+        try:
+            text = p.read_text(encoding="utf-8")
+        except OSError as e:
+            raise CandelaError(f"cannot read scene file {p}: {e}") from None
+        _candela.check_scene_text(text, str(p))
+        return cls(path=p, name=p.stem)
+
+    @classmethod
+    def from_ron(cls, text: str, name: str = "scene") -> "Scene":
+        """RON text of a scene; ``name`` names the outputs (``NAME.exr``, …)."""
+        _candela.check_scene_text(text, f"{name}.ron")
+        return cls(text=text, name=name)
+
+    @classmethod
+    def from_dict(cls, scene: Mapping[str, Any], name: str = "scene") -> "Scene":
+        """A scene as a dict (see the class doc); raises CandelaError naming the field path."""
+        text = _candela.scene_dict_to_ron(json.dumps(scene, default=_jsonable))
+        return cls(text=text, name=name)
+
+    @property
+    def ron(self) -> str:
+        """The scene's RON text."""
+        if self.text is not None:
+            return self.text
+        assert self.path is not None
+        return self.path.read_text(encoding="utf-8")
+
+    def check(self) -> tuple:
+        """Builds the scene as a render would (every value checked, referenced files read);
+        returns the image size ``(width, height)`` in pixels."""
+        if self.path is not None:
+            return _candela.check_scene_file(str(self.path))
+        with tempfile.TemporaryDirectory(prefix="candela-") as d:
+            return _candela.check_scene_file(self._write(Path(d)))
+
+    def _write(self, directory: Path) -> str:
+        p = directory / f"{self.name}.ron"
+        p.write_text(self.ron, encoding="utf-8")
+        return str(p)
+
+    def __repr__(self) -> str:
+        return f"Scene(path={str(self.path)!r})" if self.path else f"Scene(name={self.name!r}, text=…)"
+
+
+def _scene(scene: Union["Scene", str, os.PathLike, Mapping[str, Any]]) -> Scene:
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, Mapping):
+        return Scene.from_dict(scene)
+    return Scene.from_file(scene)
+
+
+@dataclass
+class RenderResult:
+    """A finished render. Images are float32 arrays of shape (height, width), row 0 at the top,
+    exactly the EXR's channels."""
+
+    X: np.ndarray
+    """CIE 1931 X, same scale as Y."""
+    Y: np.ndarray
+    """Luminance, cd/m² (absolute CIE 1931 Y)."""
+    Z: np.ndarray
+    """CIE 1931 Z, same scale as Y."""
+    Y_stderr: np.ndarray
+    """Standard error of each pixel's Y, cd/m² (0: unknown, fewer than 2 samples)."""
+    E: Optional[np.ndarray]
+    """Illuminance on the surface seen through each pixel, lx; -1 where E_mask is 0 (with
+    ``illuminance=True``, else None)."""
+    E_stderr: Optional[np.ndarray]
+    """Standard error of E, lx."""
+    E_mask: Optional[np.ndarray]
+    """Fraction of the pixel's samples that saw a receiving surface (E defined where > 0)."""
+    channels: Dict[str, np.ndarray]
+    """Every EXR channel by name (``X``, ``Y``, ``Z``, ``stderr.Y``, ``E``, ``stderr.E``, ``mask.E``)."""
+    report: Dict[str, Any]
+    """NAME.report.json as a dict (schema: docs/report-json.md)."""
+    meters: Dict[str, Dict[str, Any]]
+    """The report's meters by name: ``value``, ``stderr``, ``ci95_low``, ``ci95_high`` in
+    ``unit`` (lx or cd/m² in SI units), …"""
+    grids: Dict[str, Dict[str, Any]]
+    """The report's grids by name, with ``values`` and ``stderr`` as (ny, nx) float64 arrays
+    in ``unit`` (lx in SI units); row j, column i is the point at
+    origin + (i+½)/nx·edge_u + (j+½)/ny·edge_v."""
+    exr_path: Path
+    png_path: Path
+    report_path: Path
+    outputs: List[str]
+    """Every file written at the end."""
+    samples_per_pixel: float
+    elapsed_s: float
+    """Render time of this run, s (the meters and grids excluded)."""
+    samples_per_second: float
+    warnings: List[str] = field(default_factory=list)
+    """Checkpoints that could not be written, and paths cut short at a finite max depth."""
+
+
+def render(
+    scene: Union[Scene, str, os.PathLike, Mapping[str, Any]],
+    *,
+    out: Union[str, os.PathLike, None] = None,
+    spp: Optional[int] = None,
+    seed: Optional[int] = None,
+    max_depth: Optional[int] = None,
+    threads: Optional[int] = None,
+    illuminance: bool = False,
+    caustics: Optional[str] = None,
+    exposure_ev: Optional[float] = None,
+    units: str = "si",
+    target_error: Optional[float] = None,
+    target_fraction: float = 1.0,
+    target_floor_cd_m2: Optional[float] = None,
+    max_spp: Optional[int] = None,
+    max_time_s: Optional[float] = None,
+    checkpoint_interval_s: Optional[float] = None,
+    resume: bool = False,
+    overwrite: bool = False,
+    save_state: bool = False,
+    falsecolour: bool = False,
+    progress: Optional[Progress] = None,
+    cancel: Any = None,
+) -> RenderResult:
+    """Render a scene as ``candela render`` does and return the image and report.
+
+    ``scene`` is a :class:`Scene`, a scene file path or a scene dict. ``out`` is what
+    ``--out`` is (an existing directory, or ``NAME``/``NAME.exr``); None: a new temporary
+    directory, kept (the result's paths name it). A scene from text or a dict needs a
+    directory (or None). The other arguments are the command's options: ``spp`` (samples per
+    pixel), ``seed``, ``max_depth``, ``threads`` (the image does not depend on it),
+    ``illuminance`` (E in lx per pixel), ``caustics`` (``"light-tracing"`` or
+    ``"path-tracing"``), ``exposure_ev`` (PNG only), ``units`` (``"si"`` or ``"imperial"``,
+    for the report), ``target_error`` (a fraction, 0.01 = 1 %, with ``target_fraction`` and
+    ``target_floor_cd_m2``), ``max_spp``, ``max_time_s`` and ``checkpoint_interval_s``
+    (seconds; no checkpoints by default), ``resume``, ``overwrite``, ``save_state`` and
+    ``falsecolour``.
+
+    ``progress(samples_done, samples_total, elapsed_s)`` is called at the start and after
+    every pass; returning ``False`` cancels. ``cancel`` is anything with ``is_set()`` (a
+    ``threading.Event``) checked every 50 ms. A cancelled render raises :class:`Cancelled`
+    at the end of the pass in progress, saying what was written (a checkpoint, as Ctrl-C
+    leaves from the command line); Ctrl-C stops it the same way and raises KeyboardInterrupt.
+    """
+    s = _scene(scene)
+    if s.path is not None:
+        scene_path = str(s.path)
+        out_arg = out
+    else:
+        directory = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="candela-"))
+        if not directory.is_dir():
+            raise CandelaError(
+                f"out {directory} is not an existing directory: a scene from text or a dict "
+                "is written there as NAME.ron, next to its outputs"
+            )
+        scene_path = s._write(directory)
+        out_arg = directory
+    if out_arg is None:
+        out_arg = tempfile.mkdtemp(prefix="candela-")
+    r = _candela.render(
+        scene_path,
+        os.fspath(out_arg),
+        spp=spp,
+        seed=seed,
+        max_depth=max_depth,
+        threads=threads,
+        illuminance=illuminance,
+        caustics=caustics,
+        exposure_ev=exposure_ev,
+        units=units,
+        target_error=target_error,
+        target_fraction=target_fraction,
+        target_floor_cd_m2=target_floor_cd_m2,
+        max_spp=max_spp,
+        max_time_s=max_time_s,
+        checkpoint_interval_s=checkpoint_interval_s,
+        resume=resume,
+        overwrite=overwrite,
+        save_state=save_state,
+        falsecolour=falsecolour,
+        progress=progress,
+        cancel=cancel,
+    )
+    ch = r["channels"]
+    report = json.loads(r["report_json"])
+    grids = {}
+    for g in report.get("grids", []):
+        g = dict(g)
+        for k in ("values", "stderr"):
+            g[k] = np.asarray(g[k], dtype=np.float64).reshape(g["ny"], g["nx"])
+        grids[g["name"]] = g
+    warnings = list(r["warnings"])
+    if r["truncation"]:
+        warnings.append(r["truncation"])
+    return RenderResult(
+        X=ch["X"],
+        Y=ch["Y"],
+        Z=ch["Z"],
+        Y_stderr=ch["stderr.Y"],
+        E=ch.get("E"),
+        E_stderr=ch.get("stderr.E"),
+        E_mask=ch.get("mask.E"),
+        channels=dict(ch),
+        report=report,
+        meters={m["name"]: m for m in report.get("meters", [])},
+        grids=grids,
+        exr_path=Path(r["exr_path"]),
+        png_path=Path(r["png_path"]),
+        report_path=Path(r["report_path"]),
+        outputs=list(r["outputs"]),
+        samples_per_pixel=r["samples_per_pixel"],
+        elapsed_s=r["elapsed_s"],
+        samples_per_second=r["samples_per_second"],
+        warnings=warnings,
+    )
+
+
+def read_exr(path: Union[str, os.PathLike]) -> Dict[str, Any]:
+    """An EXR file: ``width``, ``height``, ``channels`` (name → float32 array of shape
+    (height, width); for a candela render ``X``, ``Y``, ``Z``, ``stderr.Y`` in cd/m² and, with
+    illuminance, ``E``, ``stderr.E`` in lx and ``mask.E``) and ``attributes`` (name → text:
+    ``units``, ``scene``, ``spp``, ``projection``, …)."""
+    return _candela.read_exr(os.fspath(path))
+
+
+def read_state(path: Union[str, os.PathLike]) -> Dict[str, Any]:
+    """A render state (NAME.state; checksum and values checked as for ``--resume``): ``scene``,
+    ``seed``, ``merged_seeds``, ``max_depth`` (None: unlimited), ``illuminance``, ``width``,
+    ``height``, ``adaptive``, ``total_samples``, ``samples_per_pixel``, ``shard`` ((index,
+    count, spp) or None), and ``channels``: the estimate it holds, as its EXR would have it."""
+    return _candela.read_state(os.fspath(path))

@@ -1,0 +1,278 @@
+//! `render`: the job of `candela render` ([`crate::job::run`], the same call and settings, so
+//! the same files bit for bit) on a worker thread, while the calling thread, holding the
+//! interpreter only between waits, calls the progress callback, watches the cancel event and
+//! lets Python see Ctrl-C. A stop request ends the pass in progress, as Ctrl-C does for the
+//! command line.
+
+use super::{error, error_msg, Cancelled};
+use crate::job::{self, ImageDone, Outcome, Progress, RenderJob};
+use crate::render::{PassStatus, TargetError};
+use crate::report::units::UnitSystem;
+use crate::scene::Overrides;
+use numpy::ndarray::Array2;
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Mutex};
+use std::time::{Duration, Instant};
+
+/// What the job reports to the calling thread.
+enum Event {
+    Start(u64),
+    Pass(PassStatus),
+    Rendered,
+    Warning(String),
+}
+
+/// A [`Progress`] that forwards to the calling thread.
+struct Forward(mpsc::Sender<Event>);
+
+impl Progress for Forward {
+    fn start(&mut self, max_samples: u64) -> anyhow::Result<()> {
+        let _ = self.0.send(Event::Start(max_samples));
+        Ok(())
+    }
+    fn pass(&mut self, status: &PassStatus) {
+        let _ = self.0.send(Event::Pass(*status));
+    }
+    fn rendered(&mut self, _image: &ImageDone) {
+        let _ = self.0.send(Event::Rendered);
+    }
+    fn warning(&mut self, message: &str) {
+        let _ = self.0.send(Event::Warning(message.to_string()));
+    }
+}
+
+/// How often the calling thread wakes while the job runs (for Ctrl-C and the cancel event).
+const POLL: Duration = Duration::from_millis(50);
+
+fn seconds(what: &str, s: Option<f64>) -> PyResult<Option<Duration>> {
+    s.map(|s| {
+        Duration::try_from_secs_f64(s)
+            .map_err(|_| error_msg(format!("{what} must be a duration ≥ 0 in seconds, got {s}")))
+    })
+    .transpose()
+}
+
+/// Renders a scene file as `candela render` does; see `candela.render` (python/candela) for
+/// the arguments and the result.
+#[pyfunction]
+#[pyo3(signature = (scene, out, *, spp=None, seed=None, max_depth=None, threads=None,
+    illuminance=false, caustics=None, exposure_ev=None, units="si", target_error=None,
+    target_fraction=1.0, target_floor_cd_m2=None, max_spp=None, max_time_s=None,
+    checkpoint_interval_s=None, resume=false, overwrite=false, save_state=false,
+    falsecolour=false, progress=None, cancel=None))]
+#[allow(clippy::too_many_arguments)]
+fn render<'py>(
+    py: Python<'py>,
+    scene: PathBuf,
+    out: PathBuf,
+    spp: Option<u32>,
+    seed: Option<u64>,
+    max_depth: Option<u32>,
+    threads: Option<usize>,
+    illuminance: bool,
+    caustics: Option<&str>,
+    exposure_ev: Option<f64>,
+    units: &str,
+    target_error: Option<f64>,
+    target_fraction: f64,
+    target_floor_cd_m2: Option<f64>,
+    max_spp: Option<u32>,
+    max_time_s: Option<f64>,
+    checkpoint_interval_s: Option<f64>,
+    resume: bool,
+    overwrite: bool,
+    save_state: bool,
+    falsecolour: bool,
+    progress: Option<Bound<'py, PyAny>>,
+    cancel: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let caustics = match caustics {
+        None => None,
+        Some("light-tracing") => Some(crate::world::Caustics::LightTracing),
+        Some("path-tracing") => Some(crate::world::Caustics::PathTracing),
+        Some(c) => {
+            return Err(error_msg(format!(
+                "caustics must be \"light-tracing\" or \"path-tracing\", got {c:?}"
+            )))
+        }
+    };
+    let units = match units {
+        "si" => UnitSystem::Si,
+        "imperial" => UnitSystem::Imperial,
+        u => {
+            return Err(error_msg(format!(
+                "units must be \"si\" or \"imperial\", got {u:?}"
+            )))
+        }
+    };
+    if let Some(t) = target_error {
+        if !(t > 0.0 && t < 1.0) {
+            return Err(error_msg(format!(
+                "target_error must lie strictly between 0 and 1 (a fraction: 0.01 = 1 %), got {t}"
+            )));
+        }
+    }
+    let job = RenderJob {
+        scene,
+        overrides: Overrides {
+            spp,
+            seed,
+            max_depth,
+            illuminance,
+            caustics,
+        },
+        out: Some(out),
+        threads,
+        exposure_ev,
+        units,
+        target: target_error.map(|relative| TargetError {
+            relative,
+            fraction: target_fraction,
+            floor_cd_m2: target_floor_cd_m2,
+        }),
+        max_spp,
+        max_time: seconds("max_time_s", max_time_s)?,
+        checkpoint_interval: seconds("checkpoint_interval_s", checkpoint_interval_s)?
+            .filter(|d| !d.is_zero()),
+        resume,
+        overwrite,
+        save_state,
+        falsecolour,
+        shard: None,
+    };
+    let stop = AtomicBool::new(false);
+    let (tx, rx) = mpsc::channel();
+    // A Mutex makes the receiver shareable with the interpreter released (it is never contended).
+    let rx = Mutex::new(rx);
+    let t0 = Instant::now();
+    let mut warnings: Vec<String> = Vec::new();
+    // Why the caller stopped the job: a Python exception to raise (Ctrl-C, a failing callback)
+    // or a cancellation.
+    let mut raised: Option<PyErr> = None;
+    let mut cancelled = false;
+    let result = std::thread::scope(|s| {
+        let worker = s.spawn(|| job::run(&job, &mut Forward(tx), &stop));
+        let mut total = 0u64;
+        loop {
+            let event = py.detach(|| {
+                rx.lock()
+                    .expect("only this thread locks it")
+                    .recv_timeout(POLL)
+            });
+            let ask_stop = match event {
+                Ok(Event::Start(n)) => {
+                    total = n;
+                    call(&progress, 0, total, t0)
+                }
+                Ok(Event::Pass(st)) => call(&progress, st.samples, total.max(st.max_samples), t0),
+                Ok(Event::Rendered) => Ok(false),
+                Ok(Event::Warning(w)) => {
+                    warnings.push(w);
+                    Ok(false)
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => Ok(false),
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            };
+            let ask_stop = ask_stop.and_then(|s| Ok(s || is_set(&cancel)?));
+            let ask_stop = ask_stop.and_then(|s| py.check_signals().map(|()| s));
+            match ask_stop {
+                Ok(false) => {}
+                Ok(true) => {
+                    cancelled = true;
+                    stop.store(true, Ordering::SeqCst);
+                }
+                Err(e) => {
+                    raised.get_or_insert(e);
+                    stop.store(true, Ordering::SeqCst);
+                }
+            }
+        }
+        // The job ends soon after a stop request: at the end of its pass or measurement.
+        py.detach(|| worker.join())
+    });
+    let outputs = match result {
+        Ok(r) => r.map_err(error)?,
+        Err(panic) => std::panic::resume_unwind(panic),
+    };
+    if let Some(e) = raised {
+        return Err(e);
+    }
+    if outputs.outcome != Outcome::Finished {
+        let what = match outputs.outcome {
+            Outcome::InterruptedBeforeFirstPass => {
+                "before its first pass ended: nothing was written".to_string()
+            }
+            Outcome::InterruptedRender => format!(
+                "during the render: a checkpoint was written ({}, {})",
+                outputs.exr_path.display(),
+                outputs.state_path.display()
+            ),
+            _ => format!(
+                "during the meters and grids: the images were written ({}), no report",
+                outputs.exr_path.display()
+            ),
+        };
+        let why = if cancelled { "cancelled" } else { "stopped" };
+        return Err(Cancelled::new_err(format!("render {why} {what}")));
+    }
+    result_dict(py, &job, &outputs, warnings)
+}
+
+/// Calls `progress(samples_done, samples_total, elapsed_s)`; true if it returned False.
+fn call(progress: &Option<Bound<'_, PyAny>>, done: u64, total: u64, t0: Instant) -> PyResult<bool> {
+    let Some(p) = progress else {
+        return Ok(false);
+    };
+    let r = p.call1((done, total, t0.elapsed().as_secs_f64()))?;
+    // Only an explicit False stops: a callback that returns nothing goes on.
+    Ok(r.is_instance_of::<pyo3::types::PyBool>() && !r.is_truthy()?)
+}
+
+/// Whether the cancel event (anything with `is_set()`, e.g. `threading.Event`) is set.
+fn is_set(cancel: &Option<Bound<'_, PyAny>>) -> PyResult<bool> {
+    match cancel {
+        None => Ok(false),
+        Some(c) => c.call_method0("is_set")?.is_truthy(),
+    }
+}
+
+/// The result: the EXR's channels as (height, width) float32 arrays, the report and paths.
+fn result_dict<'py>(
+    py: Python<'py>,
+    job: &RenderJob,
+    outputs: &job::RenderOutputs,
+    warnings: Vec<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let film = &outputs.render.film;
+    let layers = job::files::film_layers(&job.scene.display().to_string(), film, film.e.is_some());
+    let channels = PyDict::new(py);
+    for (name, values) in &layers.channels {
+        let a = Array2::from_shape_vec((layers.height, layers.width), values.clone())
+            .map_err(|e| error_msg(e.to_string()))?;
+        channels.set_item(name, a.into_pyarray(py))?;
+    }
+    let d = PyDict::new(py);
+    d.set_item("channels", channels)?;
+    let report = std::fs::read_to_string(&outputs.report_path)
+        .map_err(|e| error_msg(format!("{}: {e}", outputs.report_path.display())))?;
+    d.set_item("report_json", report)?;
+    d.set_item("exr_path", &outputs.exr_path)?;
+    d.set_item("png_path", &outputs.png_path)?;
+    d.set_item("report_path", &outputs.report_path)?;
+    d.set_item("outputs", &outputs.outputs)?;
+    d.set_item("warnings", warnings)?;
+    d.set_item("truncation", &outputs.truncation)?;
+    d.set_item("samples_per_pixel", film.samples_per_pixel())?;
+    d.set_item("elapsed_s", outputs.render.elapsed.as_secs_f64())?;
+    d.set_item("samples_per_second", outputs.samples_per_second())?;
+    Ok(d)
+}
+
+pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(render, m)?)?;
+    Ok(())
+}
