@@ -245,7 +245,8 @@ pub fn write_exr(path: &Path, layers: &Layers) -> Result<(), OutputError> {
     // The encoder needs `Seek`, so encode in memory and then write the bytes atomically.
     let mut bytes = Cursor::new(Vec::new());
     image.write().to_buffered(&mut bytes).map_err(exr_err)?;
-    let bytes = bytes.into_inner();
+    let mut bytes = bytes.into_inner();
+    super::exr_header::sort_header_attributes(&mut bytes);
     write_atomic(path, |w| w.write_all(&bytes))
 }
 

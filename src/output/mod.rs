@@ -11,6 +11,7 @@
 //!   never leaves a half-written output behind.
 
 pub mod draw;
+mod exr_header;
 mod exr_io;
 mod hdr;
 mod png;
