@@ -87,8 +87,8 @@ pub struct RenderOpts {
     #[arg(long)]
     mesopic: bool,
     /// Also keep N spectral bands (1 to 64) of equal width over 380–780 nm per pixel and write NAME.spectral.exr (spectral radiance, Fichet et al. 2021 layout). Not with --resume or --shard.
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64).map(|v| v as usize))]
-    spectral_bands: usize,
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
+    spectral_bands: u16,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -175,7 +175,7 @@ impl RenderOpts {
             health: candela::film::HealthChannels {
                 melanopic: self.alpha_opic,
                 mesopic: self.mesopic,
-                spectral_bands: self.spectral_bands,
+                spectral_bands: self.spectral_bands as usize,
             },
         })
     }
