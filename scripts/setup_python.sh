@@ -17,9 +17,10 @@ PYTHON="${PYTHON:-python3}"
 # pyradiance 1.3.1 (Radiance 6's binaries: gensky, gendaylit, rtrace) and ladybug-core
 # 0.44.62 (EPW weather files) for the daylight tests; luxpy 1.12.5 (CIE S 026 alpha-opic
 # quantities, CIE 191 mesopic photometry; tests/colour_health.rs and data/alpha-opic-*.csv),
-# which imports scipy and matplotlib at start-up. numpy stays below 2.4: luxpy 1.12.5 calls
-# float() on 1-element arrays, which numpy 2.4 refuses. maturin 1.16.0 builds the Python
-# package into this venv and pytest 9.2.0 runs its tests (tests/python/).
+# which imports scipy and matplotlib at start-up; OpenImageIO 3.2.2.0, through which
+# colour-science reads spectral OpenEXR files (tests/health_render.rs). numpy stays below 2.4:
+# luxpy 1.12.5 calls float() on 1-element arrays, which numpy 2.4 refuses. maturin 1.16.0 builds
+# the Python package into this venv and pytest 9.2.0 runs its tests (tests/python/).
 PINS=(
   "colour-science==0.4.7"
   "numpy==2.3.5"
@@ -31,6 +32,7 @@ PINS=(
   "ladybug-geometry==1.35.6"
   "maturin==1.16.0"
   "pytest==9.2.0"
+  "openimageio==3.2.2.0"
 )
 
 if [ ! -x "$VENV/bin/python" ]; then

@@ -10,7 +10,16 @@ use crate::photometry::K_M;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, DENSE_LEN, LAMBDA_MIN, N_LAMBDA};
 use std::sync::LazyLock;
 
+mod health;
+mod health_output;
 mod illuminance;
+pub use health::{
+    melanopic_edi as health_melanopic_edi, HealthChannels, HealthFilm, HealthPixel, PixelValue,
+    BANDS_END_NM, BANDS_START_NM, MAX_SPECTRAL_BANDS,
+};
+pub use health_output::{
+    add_health_layers, fichet_channel_name, read_spectral_bands, spectral_layers,
+};
 pub use illuminance::{IlluminanceSums, PixelE};
 
 /// The CIE 1931 2° colour-matching functions as f32 tables for the hot path (from the colour
@@ -392,6 +401,10 @@ pub struct Film {
     pub e: Option<Vec<IlluminanceSums>>,
     #[serde(default)]
     pub decision_e: Option<Vec<IlluminanceSums>>,
+    /// Light-and-health channels of the image buffer, when asked for; render states do not
+    /// carry them.
+    #[serde(skip)]
+    pub health: Option<HealthFilm>,
 }
 
 impl Film {
@@ -404,6 +417,7 @@ impl Film {
             light_paths: [0; 2],
             e: None,
             decision_e: None,
+            health: None,
         }
     }
     /// Allocate the illuminance sums of every buffer that lacks them (zero: for a film that
@@ -445,6 +459,8 @@ impl Film {
     }
     /// Combine another film of the same size (independent samples: a different seed).
     pub fn merge(&mut self, o: &Film) {
+        // Health channels are kept only by the render that made them.
+        self.health = None;
         self.light_paths[0] += o.light_paths[0];
         self.light_paths[1] += o.light_paths[1];
         // Illuminance first: its batches continue the pixel's numbering before the merge.

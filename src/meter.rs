@@ -89,6 +89,10 @@ fn sample_meter(
     let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
     let v = match kind {
         MeterKind::Illuminance { position, normal }
+        | MeterKind::Melanopic {
+            position,
+            direction: normal,
+        }
         | MeterKind::Ugr {
             position,
             direction: normal,
@@ -395,6 +399,9 @@ fn jobs(world: &World) -> Vec<(MeterKind, u64)> {
 #[derive(Clone, Debug, Default)]
 pub struct Measurements {
     pub meters: Vec<Estimate>,
+    /// Per meter, the melanopic quantities of a `Melanopic` meter (None for other kinds; empty
+    /// for a shard, whose merge reports E_v only).
+    pub melanopic: Vec<Option<MelanopicEstimate>>,
     /// Per grid, row-major (j·nx + i).
     pub grids: Vec<Vec<Estimate>>,
     pub stats: RayStats,
@@ -415,7 +422,107 @@ pub fn measure_all_until(world: &World, stop: &AtomicBool) -> Option<Measurement
             Some((e, stats))
         })
         .collect::<Option<_>>()?;
-    Some(collect(world, results))
+    let mut out = collect(world, results);
+    for (k, m) in world.meters.iter().enumerate() {
+        let v = match m.kind {
+            MeterKind::Melanopic {
+                position,
+                direction,
+            } => {
+                let stream = mix64(0x6d65_7465_7200 ^ k as u64);
+                Some(measure_melanopic(
+                    world,
+                    position,
+                    direction,
+                    stream,
+                    &world.measure,
+                    stop,
+                )?)
+            }
+            _ => None,
+        };
+        out.melanopic.push(v);
+    }
+    Some(out)
+}
+
+/// A `Melanopic` meter's result: vertical illuminance and melanopic EDI at the eye, both in lx
+/// from the same samples, and their ratio (the melanopic DER of the light reaching the eye).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MelanopicEstimate {
+    pub illuminance_lx: Estimate,
+    pub m_edi_lx: Estimate,
+    /// m-EDI / E_v (dimensionless) and its standard error from the batches (the ratio
+    /// estimator's √(Σᵦ (mᵦ − R eᵦ)² / (K(K−1))) / ē over the batch means mᵦ, eᵦ).
+    pub ratio: f64,
+    pub ratio_stderr: f64,
+}
+
+/// Measure a `Melanopic` meter: E_v and m-EDI on the receiver at `position` facing
+/// `direction`, from [`BATCHES`] batches of [`batch_size`]`(settings.samples)` samples each of
+/// the meter's stream (the budget without a target's doubling). None once `stop` is set.
+pub fn measure_melanopic(
+    world: &World,
+    position: Vec3,
+    direction: Vec3,
+    stream: u64,
+    settings: &MeasureSettings,
+    stop: &AtomicBool,
+) -> Option<MelanopicEstimate> {
+    let per = batch_size(settings.samples);
+    let k = BATCHES as usize;
+    let (mut ev, mut mel, mut non_finite) = (vec![0.0f64; k], vec![0.0f64; k], 0u64);
+    let mut stats = RayStats::default();
+    for b in 0..k {
+        for s in 0..per {
+            if s % POLL == 0 && stop.load(Ordering::Relaxed) {
+                return None;
+            }
+            let mut sampler = Sampler::new(world.settings.seed, batch_stream(stream, b as u32), s);
+            let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
+            let at = RayStart::free(position);
+            let e = irradiance(
+                world,
+                &at,
+                direction,
+                false,
+                &mut wl,
+                &mut sampler,
+                &mut stats,
+            );
+            let (v, m) = (
+                radiance_to_xyz(&e, &wl)[1],
+                crate::film::health_melanopic_edi(&e, &wl),
+            );
+            if v.is_finite() && m.is_finite() {
+                ev[b] += v;
+                mel[b] += m;
+            } else {
+                non_finite += 1;
+            }
+        }
+    }
+    let (e, m) = (
+        from_batches(&ev, per, non_finite),
+        from_batches(&mel, per, non_finite),
+    );
+    let ratio = if e.mean > 0.0 { m.mean / e.mean } else { 0.0 };
+    let ss: f64 = ev
+        .iter()
+        .zip(&mel)
+        .map(|(e, m)| ((m - ratio * e) / per as f64).powi(2))
+        .sum();
+    let ratio_stderr = if e.mean > 0.0 {
+        (ss / (k * (k - 1)) as f64).sqrt() / e.mean
+    } else {
+        0.0
+    };
+    Some(MelanopicEstimate {
+        illuminance_lx: e,
+        m_edi_lx: m,
+        ratio,
+        ratio_stderr,
+    })
 }
 
 /// Samples of a grid's points that were not finite (see [`Estimate::non_finite`]).

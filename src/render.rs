@@ -1,7 +1,9 @@
 //! Rendering an image: tiles in parallel (rayon), every sample regenerated from
 //! (seed, pixel, sample index), so the result does not depend on the number of threads.
 
-use crate::film::{radiance_to_xyz, Film, IlluminanceSums, PixelE, PixelSums, PIXEL_BATCHES};
+use crate::film::{
+    radiance_to_xyz, Film, HealthPixel, IlluminanceSums, PixelE, PixelSums, PIXEL_BATCHES,
+};
 use crate::integrator::{trace, PathStart, RayStats};
 use crate::sampling::{batch_stream, Sampler};
 use crate::spectrum::SampledWavelengths;
@@ -30,7 +32,8 @@ impl RenderResult {
 }
 
 /// Render one pixel's samples `first..first+count` of the random stream `seed` into `sums`,
-/// and their illuminance into `e` (which the film has when the render estimates illuminance).
+/// and their illuminance into `e` (which the film has when the render estimates illuminance),
+/// and their light-and-health channels into `health` (when the film keeps them).
 #[allow(clippy::too_many_arguments)]
 pub fn render_pixel(
     world: &World,
@@ -41,6 +44,7 @@ pub fn render_pixel(
     count: u64,
     sums: &mut PixelSums,
     mut e: Option<&mut IlluminanceSums>,
+    mut health: Option<HealthPixel>,
     stats: &mut RayStats,
 ) {
     let cam = &world.camera;
@@ -74,11 +78,18 @@ pub fn render_pixel(
             stats,
         );
         if let Some(e) = e.as_deref_mut() {
-            let v = surface_illuminance(world, seed, ray.origin, ray.dir, batch, index, stats);
-            e.add(sums.count, v);
+            let mel = health.as_ref().is_some_and(|h| h.wants_irradiance());
+            let v = surface_illuminance(world, seed, ray.origin, ray.dir, batch, index, mel, stats);
+            if let (Some(h), Some((_, m))) = (health.as_mut(), v) {
+                h.add_edi(sums.count, m);
+            }
+            e.add(sums.count, v.map(|v| v.0));
         }
         let xyz = radiance_to_xyz(&l, &wl);
-        if xyz.iter().all(|v| v.is_finite()) {
+        if xyz.iter().all(|v| v.is_finite()) && (health.is_none() || l.is_finite()) {
+            if let Some(h) = health.as_mut() {
+                h.add_radiance(sums.count, &l, &wl);
+            }
             sums.add(xyz);
         } else {
             stats.non_finite += 1;
@@ -102,7 +113,9 @@ const ILLUMINANCE_STREAM: u64 = 0x11_1c_e5_7a_u64 << 20;
 /// Illuminance (lx) on the surface a camera ray sees, or None if it sees no receiving surface
 /// (nothing, the sky, or an emitter). `seed` is the buffer's stream (the decision buffer of
 /// adaptive mode has its own), so each buffer's illuminance samples are independent; `pixel`
-/// and `sample` are the camera sample's batch stream and index in it ([`pixel_batch`]).
+/// and `sample` are the camera sample's batch stream and index in it ([`pixel_batch`]). With
+/// `melanopic`, the second value is the melanopic EDI (lx) of the same estimate, else 0.
+#[allow(clippy::too_many_arguments)]
 fn surface_illuminance(
     world: &World,
     seed: u64,
@@ -110,8 +123,9 @@ fn surface_illuminance(
     dir: glam::Vec3,
     pixel: u64,
     sample: u64,
+    melanopic: bool,
     stats: &mut RayStats,
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     let hit = world.geometry.intersect(origin, dir, f32::INFINITY)?;
     stats.camera_rays += 1;
     if world.objects[hit.object as usize].light.is_some() {
@@ -130,11 +144,16 @@ fn surface_illuminance(
     let e =
         crate::integrator::irradiance(world, &at, n, light_traced, &mut wl, &mut sampler, stats);
     let lux = radiance_to_xyz(&e, &wl)[1];
-    if lux.is_finite() {
-        Some(lux)
+    let m = if melanopic {
+        crate::film::health_melanopic_edi(&e, &wl)
+    } else {
+        0.0
+    };
+    if lux.is_finite() && m.is_finite() {
+        Some((lux, m))
     } else {
         stats.non_finite += 1;
-        Some(0.0)
+        Some((0.0, 0.0))
     }
 }
 
@@ -313,6 +332,17 @@ pub fn render_progressive(
             "does not estimate"
         }
     );
+    if let Some(h) = &film.health {
+        // Light-traced caustics splat XYZ and E only: the health channels would miss them.
+        anyhow::ensure!(
+            world.caustics.is_none(),
+            "the light-and-health channels (--alpha-opic, --mesopic, --spectral-bands) include no light-traced caustics: render this scene with --caustics path-tracing"
+        );
+        anyhow::ensure!(
+            h.illuminance == film.e.is_some() && h.sums.len() == film.pixels.len() * h.stride(),
+            "the film's light-and-health sums do not match its pixels"
+        );
+    }
     let tiles_x = w.div_ceil(TILE);
     let n_tiles = tiles_x * h.div_ceil(TILE);
     let start = Instant::now();
@@ -358,6 +388,12 @@ pub fn render_progressive(
                             let mut dec = film_ref.decision.as_ref().map(|d| d[i]);
                             let mut est_e = film_ref.e.as_ref().map(|e| e[i]);
                             let mut dec_e = film_ref.decision_e.as_ref().map(|e| e[i]);
+                            let mut hp = film_ref.health.as_ref().map(|h| h.pixel(i).to_vec());
+                            let hv = film_ref
+                                .health
+                                .as_ref()
+                                .zip(hp.as_deref_mut())
+                                .map(|(h, s)| h.view(s));
                             let seed = world.settings.seed;
                             match dec.as_mut() {
                                 // Independent streams: the image's samples continue its own
@@ -374,6 +410,7 @@ pub fn render_progressive(
                                         half,
                                         &mut est,
                                         est_e.as_mut(),
+                                        hv,
                                         &mut r.stats,
                                     );
                                     let first = prog.first_sample + d.count;
@@ -386,6 +423,7 @@ pub fn render_progressive(
                                         half,
                                         d,
                                         dec_e.as_mut(),
+                                        None,
                                         &mut r.stats,
                                     );
                                 }
@@ -400,6 +438,7 @@ pub fn render_progressive(
                                         plan[i],
                                         &mut est,
                                         est_e.as_mut(),
+                                        hv,
                                         &mut r.stats,
                                     );
                                 }
@@ -408,6 +447,7 @@ pub fn render_progressive(
                             r.decision.extend(dec);
                             r.e.extend(est_e);
                             r.decision_e.extend(dec_e);
+                            r.health.extend(hp.into_iter().flatten());
                         }
                     }
                     Some(r)
@@ -462,6 +502,10 @@ pub fn render_progressive(
                 if let Some(e) = film.decision_e.as_mut() {
                     e[i] = r.decision_e[k];
                 }
+                if let Some(h) = film.health.as_mut() {
+                    let s = h.stride();
+                    h.sums[i * s..(i + 1) * s].copy_from_slice(&r.health[k * s..(k + 1) * s]);
+                }
             }
         }
         for (b, sums, paths) in light {
@@ -514,6 +558,8 @@ struct TileResult {
     decision: Vec<PixelSums>,
     e: Vec<IlluminanceSums>,
     decision_e: Vec<IlluminanceSums>,
+    /// The pixels' light-and-health sums, when the film keeps them, one pixel after another.
+    health: Vec<f64>,
     stats: RayStats,
 }
 

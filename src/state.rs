@@ -489,6 +489,7 @@ impl RenderState {
             light_paths,
             e,
             decision_e,
+            health: None,
         };
         film.check(p.illuminance)?;
         Ok(Self {

@@ -432,6 +432,7 @@ fn meters_and_grids_with_non_finite_samples_are_flagged_in_the_report() {
         meters: vec![e(0.0, 900), e(5.0, 0)],
         grids: vec![vec![e(1.0, 0), e(0.5, 3)]],
         stats: Default::default(),
+        melanopic: Vec::new(),
     };
     let render = candela::render::RenderResult {
         film: candela::film::Film::new(4, 4),

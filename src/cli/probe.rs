@@ -50,13 +50,103 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<String> {
     // Flatten to one line: the messages already name the file and their cause.
     let r = probe_file(&args.exr, args.x, args.y, args.radius, args.units)
         .map_err(|e| anyhow!("{e}"))?;
+    let spectrum = spectral_rendition(&args.exr, r.x, r.y)?;
     if args.json {
         let mut v = r.to_json();
         v["file"] = json!(args.exr.display().to_string());
+        if let Some(sp) = &spectrum {
+            v["spectrum"] = sp.to_json();
+        }
         Ok(serde_json::to_string_pretty(&v)? + "\n")
     } else {
-        Ok(text(&r, &args.exr.display().to_string()))
+        let mut t = text(&r, &args.exr.display().to_string());
+        if let Some(sp) = &spectrum {
+            t += &sp.text();
+        }
+        Ok(t)
     }
+}
+
+/// Colour rendition of one pixel's spectrum from the spectral image beside the EXR.
+struct SpectrumProbe {
+    file: String,
+    bands: usize,
+    rendition: Option<candela::colour::tm30::ColourRendition>,
+    ra: f64,
+}
+
+impl SpectrumProbe {
+    fn text(&self) -> String {
+        let tm30 = match &self.rendition {
+            Some(c) => format!("TM-30 Rf {:.1}, Rg {:.1}", c.rf, c.rg),
+            None => "TM-30 undefined (black or outside the CCT range)".to_string(),
+        };
+        format!(
+            "  {:<13} {tm30}; CIE Ra {:.1}   (the pixel's spectrum as a relative SPD, {} bands of {})\n",
+            "rendition", self.ra, self.bands, self.file
+        )
+    }
+    fn to_json(&self) -> serde_json::Value {
+        json!({
+            "file": self.file,
+            "bands": self.bands,
+            "relative_spd": true,
+            "tm30_rf": self.rendition.as_ref().map(|c| c.rf),
+            "tm30_rg": self.rendition.as_ref().map(|c| c.rg),
+            "cri_ra": self.ra,
+        })
+    }
+}
+
+/// With `NAME.spectral.exr` beside `NAME.exr` (`candela render --spectral-bands`), TM-30 and
+/// CRI of pixel (x, y)'s spectrum, taken as a relative SPD: band values linearly
+/// interpolated between the band centres onto 1 nm, held at the end bands' values out to
+/// 380 and 780 nm, 0 outside.
+fn spectral_rendition(
+    exr: &std::path::Path,
+    x: usize,
+    y: usize,
+) -> anyhow::Result<Option<SpectrumProbe>> {
+    let name = exr.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    let Some(stem) = name.strip_suffix(".exr") else {
+        return Ok(None);
+    };
+    let path = exr.with_file_name(format!("{stem}.spectral.exr"));
+    if stem.ends_with(".spectral") || !path.is_file() {
+        return Ok(None);
+    }
+    let layers = candela::output::read_exr(&path).map_err(|e| anyhow!("{e}"))?;
+    let (nm, values) = candela::film::read_spectral_bands(&layers);
+    if nm.len() < 2 || x >= layers.width || y >= layers.height {
+        return Ok(None);
+    }
+    let i = y * layers.width + x;
+    let v: Vec<f64> = values.iter().map(|b| b[i].max(0.0) as f64).collect();
+    let mut table = [0.0f64; candela::colour::grid::LEN];
+    for (k, t) in table.iter_mut().enumerate() {
+        let l = 360.0 + k as f64;
+        if !(candela::film::BANDS_START_NM..=candela::film::BANDS_END_NM).contains(&l) {
+            continue;
+        }
+        let j = nm.partition_point(|&c| c <= l);
+        *t = if j == 0 {
+            v[0]
+        } else if j == nm.len() {
+            v[nm.len() - 1]
+        } else {
+            let f = (l - nm[j - 1]) / (nm[j] - nm[j - 1]);
+            v[j - 1] * (1.0 - f) + v[j] * f
+        };
+    }
+    if table.iter().all(|&t| t == 0.0) {
+        return Ok(None);
+    }
+    Ok(Some(SpectrumProbe {
+        file: path.display().to_string(),
+        bands: nm.len(),
+        rendition: candela::colour::tm30::colour_rendition(&table),
+        ra: candela::colour::cri::colour_rendering_index(&table).ra,
+    }))
 }
 
 fn fmt3(v: [f64; 3], digits: usize) -> String {

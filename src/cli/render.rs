@@ -80,6 +80,15 @@ pub struct RenderOpts {
     /// Render shard I of N (0-based): samples I·spp … (I+1)·spp − 1 of every pixel, so N shards at --spp S merge (`candela merge`) into the render at N·S spp. Writes NAME.shard-I-of-N.state (always) and images; rerunning the same command continues its state. `auto` takes I and N from a Slurm array (SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN, SLURM_ARRAY_TASK_COUNT); `auto/N` takes I from SLURM_ARRAY_TASK_ID, AWS_BATCH_JOB_ARRAY_INDEX or JOB_COMPLETION_INDEX (Kubernetes). See docs/cluster.md.
     #[arg(long, value_name = "I/N|auto|auto/N")]
     shard: Option<String>,
+    /// Also keep the melanopic equivalent daylight luminance per pixel (EXR channels melanopic.EDL, stderr.melanopic.EDL, cd/m²; CIE S 026) and, with --illuminance, the melanopic EDI (melanopic.EDI, stderr.melanopic.EDI, lx). Not with --resume or --shard.
+    #[arg(long)]
+    alpha_opic: bool,
+    /// Also keep the scotopic luminance per pixel and write the CIE 191 mesopic luminance (EXR channels scotopic.L, mesopic.L, stderr.mesopic.L, mesopic.m). Not with --resume or --shard.
+    #[arg(long)]
+    mesopic: bool,
+    /// Also keep N spectral bands (1 to 64) of equal width over 380–780 nm per pixel and write NAME.spectral.exr (spectral radiance, Fichet et al. 2021 layout). Not with --resume or --shard.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
+    spectral_bands: u16,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -163,6 +172,11 @@ impl RenderOpts {
                 .as_deref()
                 .map(job::shard::parse_from_env)
                 .transpose()?,
+            health: candela::film::HealthChannels {
+                melanopic: self.alpha_opic,
+                mesopic: self.mesopic,
+                spectral_bands: self.spectral_bands as usize,
+            },
         })
     }
 }
@@ -289,7 +303,9 @@ pub fn render(a: &RenderOpts) -> Result<()> {
     let units = job.units;
     for m in &out.meters {
         let q = match m.kind {
-            MeterKind::Illuminance { .. } | MeterKind::Ugr { .. } => Quantity::Illuminance,
+            MeterKind::Illuminance { .. } | MeterKind::Ugr { .. } | MeterKind::Melanopic { .. } => {
+                Quantity::Illuminance
+            }
             MeterKind::Luminance { .. } => Quantity::Luminance,
         };
         let (k, unit) = (units.from_si(q, 1.0), units.symbol(q));
@@ -310,6 +326,18 @@ pub fn render(a: &RenderOpts) -> Result<()> {
                 u.ugr_interval.1,
                 u.background_cd_m2,
                 u.luminaires.len()
+            );
+        }
+        if let Some(me) = &m.melanopic {
+            say!(
+                "meter {:?}: m-EDI {:.4} ± {:.4} {unit}, E_v {:.4} ± {:.4} {unit}, m-EDI/E_v {:.4} ± {:.4} (95 %)",
+                m.name,
+                me.m_edi_lx.mean * k,
+                me.m_edi_lx.ci95() * k,
+                me.illuminance_lx.mean * k,
+                me.illuminance_lx.ci95() * k,
+                me.ratio,
+                candela::meter::t95(candela::meter::BATCHES - 1) * me.ratio_stderr
             );
         }
         if e.non_finite > 0 {

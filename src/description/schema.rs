@@ -129,6 +129,14 @@ pub enum MeterDesc {
         #[serde(default)]
         up: Option<V3>,
     },
+    /// Vertical illuminance E_v (lx) and melanopic EDI (lx, CIE S 026) at an eye at
+    /// `position` looking along `direction` (the receiver faces the direction of gaze), with
+    /// their ratio, the melanopic DER of the light reaching the eye.
+    Melanopic {
+        name: String,
+        position: V3,
+        direction: V3,
+    },
 }
 
 #[derive(Debug, Clone, Deserialize)]

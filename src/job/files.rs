@@ -290,6 +290,7 @@ pub fn film_layers(scene: &str, film: &Film, illuminance: bool) -> Layers {
             ),
         ));
     }
+    crate::film::add_health_layers(film, &mut layers);
     layers
 }
 

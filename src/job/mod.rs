@@ -72,6 +72,9 @@ pub struct RenderJob {
     /// every pixel, outputs named NAME.shard-I-of-N.*, the state always written, and an existing
     /// state of the shard continued (a requeued job picks up where it stopped).
     pub shard: Option<Shard>,
+    /// Light-and-health channels to keep per pixel (m-EDL/m-EDI, mesopic, spectral bands);
+    /// not carried by render states, so refused with `resume` and `shard`.
+    pub health: crate::film::HealthChannels,
 }
 
 impl RenderJob {
@@ -94,6 +97,7 @@ impl RenderJob {
             save_state: false,
             falsecolour: false,
             shard: None,
+            health: Default::default(),
         }
     }
 }
@@ -134,6 +138,8 @@ pub struct MeterResult {
     pub estimate: Estimate,
     /// The UGR of a `Ugr` meter (whose estimate is the vertical illuminance at the eye).
     pub ugr: Option<crate::glare::luminaires::UgrResult>,
+    /// E_v, m-EDI and their ratio of a `Melanopic` meter.
+    pub melanopic: Option<crate::meter::MelanopicEstimate>,
 }
 
 /// One grid's result: its size and statistics in SI units (lx).
@@ -284,6 +290,17 @@ fn check_job(job: &RenderJob) -> Result<()> {
             "--shard splits a fixed number of samples per pixel among the shards; --target-error decides it pixel by pixel as the render goes, which separate shards cannot share: give --shard with --spp",
         ));
     }
+    if job.health.any() && (job.resume || job.shard.is_some()) {
+        return Err(invalid_option(
+            "--alpha-opic, --mesopic and --spectral-bands keep per-pixel sums that render states do not carry: they cannot be combined with --resume or --shard (render with more --spp instead)",
+        ));
+    }
+    if job.health.spectral_bands > crate::film::MAX_SPECTRAL_BANDS {
+        return Err(invalid_option(format!(
+            "--spectral-bands must be at most {}",
+            crate::film::MAX_SPECTRAL_BANDS
+        )));
+    }
     if job.resume && job.overwrite {
         return Err(invalid_option(
             "--resume continues NAME.state and --overwrite replaces it: give one of them",
@@ -386,6 +403,9 @@ fn planned_outputs(job: &RenderJob, world: &World, stem: &Path) -> Vec<Planned> 
             planned.push(plan(".illuminance.png", "the illuminance false-colour map"));
         }
     }
+    if job.health.spectral_bands > 0 {
+        planned.push(plan(".spectral.exr", "the spectral EXR image"));
+    }
     planned
 }
 
@@ -480,6 +500,12 @@ pub fn run(
     let mut film = initial_film(&resume_job, &world, hash, shard_info, &state_path)?;
     let resumed_samples = film.total_samples();
     let illuminance = world.settings.illuminance;
+    if job.health.any() {
+        let h = crate::film::HealthFilm::new(job.health, illuminance, w * h)
+            .map_err(anyhow::Error::msg)?;
+        film.health = Some(h);
+    }
+    let spectral_path = with_suffix(&stem, ".spectral.exr");
     // The images before the state: on a nearly full disk the small files still get written.
     let write_images = |film: &Film, writes: &mut Writes| {
         writes.attempt(&exr_path, || {
@@ -488,6 +514,12 @@ pub fn run(
         writes.attempt(&hdr_path, || write_hdr(film, &world.camera, &hdr_path));
         // The PNG too, so that the image pair on disk is always of the same estimate.
         writes.attempt(&png_path, || write_png(film, &png_path, job.exposure_ev));
+        if let Some(layers) = crate::film::spectral_layers(film, &scene_path.display().to_string())
+        {
+            writes.attempt(&spectral_path, || {
+                Ok(crate::output::write_exr(&spectral_path, &layers)?)
+            });
+        }
     };
     let write_state = |film: &Film, meters: &[crate::meter::MeterSums], writes: &mut Writes| {
         writes.attempt(&state_path, || {
@@ -627,11 +659,13 @@ pub fn run(
         .meters
         .iter()
         .zip(&measurements.meters)
-        .map(|(m, e)| MeterResult {
+        .enumerate()
+        .map(|(k, (m, e))| MeterResult {
             name: m.name.clone(),
             kind: m.kind.clone(),
             estimate: *e,
             ugr: m.ugr(&world, e),
+            melanopic: measurements.melanopic.get(k).copied().flatten(),
         })
         .collect();
     outputs.grids = world

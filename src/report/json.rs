@@ -175,6 +175,34 @@ pub fn report_json(r: &ReportInput) -> Value {
                 v["ugr"] = json!(m.ugr(w, e));
                 v
             }
+            MeterKind::Melanopic {
+                position,
+                direction,
+            } => {
+                // The estimate is the vertical illuminance at the eye.
+                let mut v = estimate(e, ke);
+                v["name"] = json!(m.name);
+                v["kind"] = json!("melanopic");
+                v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
+                v["position"] = v3(*position);
+                v["direction"] = v3(*direction);
+                let k = w.meters.iter().position(|x| std::ptr::eq(x, m));
+                let mel = k.and_then(|k| r.measurements.melanopic.get(k).copied().flatten());
+                v["melanopic"] = match mel {
+                    Some(me) => json!({
+                        "illuminance": estimate(&me.illuminance_lx, ke),
+                        "m_edi": estimate(&me.m_edi_lx, ke),
+                        "m_edi_over_illuminance": {
+                            "value": me.ratio,
+                            "stderr": me.ratio_stderr,
+                            "ci95_half_width": crate::meter::t95(crate::meter::BATCHES - 1) * me.ratio_stderr,
+                        },
+                        "equivalent_melanopic_lux": crate::colour::alpha_opic::equivalent_melanopic_lux(me.m_edi_lx.mean) * ke,
+                    }),
+                    None => Value::Null,
+                };
+                v
+            }
         })
         .collect();
     let grids: Vec<Value> = w

@@ -29,6 +29,10 @@ pub enum MeterKind {
         direction: Vec3,
         up: Vec3,
     },
+    /// Melanopic EDI (lx) and vertical illuminance at an eye at `position` (m) looking along
+    /// the unit `direction`; its Monte Carlo estimate is the illuminance (lx), and
+    /// [`crate::meter::measure_melanopic`] gives both.
+    Melanopic { position: Vec3, direction: Vec3 },
 }
 
 /// A named meter of the scene.
@@ -182,6 +186,17 @@ impl Meter {
                     },
                 )
             }
+            MeterDesc::Melanopic {
+                name,
+                position,
+                direction,
+            } => (
+                name,
+                MeterKind::Melanopic {
+                    position: ctx.vec3(&format!("{field}.position"), *position)?,
+                    direction: ctx.unit(&format!("{field}.direction"), *direction)?,
+                },
+            ),
         };
         if !names.insert(name.clone()) {
             return Err(ctx.err(
