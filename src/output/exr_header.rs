@@ -24,9 +24,12 @@ pub(super) fn sort_header_attributes(bytes: &mut [u8]) {
     bytes[8..end].copy_from_slice(&joined);
 }
 
-/// The attributes from `at` up to the header's terminating null byte: (start, end of name,
-/// end) of each, and the offset of the terminator.
-fn attributes(bytes: &[u8], mut at: usize) -> Option<(Vec<(usize, usize, usize)>, usize)> {
+/// Byte offsets of one attribute: its start, the end of its name, its end.
+type Span = (usize, usize, usize);
+
+/// The attributes from `at` up to the header's terminating null byte, and the offset of the
+/// terminator.
+fn attributes(bytes: &[u8], mut at: usize) -> Option<(Vec<Span>, usize)> {
     let mut spans = Vec::new();
     let nul = |from: usize| -> Option<usize> {
         bytes.get(from..)?.iter().position(|&b| b == 0).map(|p| from + p)
