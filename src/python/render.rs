@@ -143,6 +143,7 @@ fn render<'py>(
         save_state,
         falsecolour,
         shard: None,
+        health: Default::default(),
     };
     let stop = AtomicBool::new(false);
     let (tx, rx) = mpsc::channel();
