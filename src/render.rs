@@ -2,6 +2,7 @@
 //! (seed, pixel, sample index), so the result does not depend on the number of threads.
 
 use crate::film::{radiance_to_xyz, Film, IlluminanceSums, PixelE, PixelSums, PIXEL_BATCHES};
+use crate::integrator::sun_view::SunInView;
 use crate::integrator::{trace, PathStart, RayStats};
 use crate::sampling::{batch_stream, Sampler};
 use crate::spectrum::SampledWavelengths;
@@ -42,9 +43,13 @@ pub fn render_pixel(
     sums: &mut PixelSums,
     mut e: Option<&mut IlluminanceSums>,
     stats: &mut RayStats,
+    sun: Option<&SunInView>,
 ) {
     let cam = &world.camera;
     let pixel = (y * cam.width + x) as u64;
+    // The directly seen sun, the same for every sample (see `SunInView`).
+    let deposit = sun.and_then(|s| s.at(pixel)).unwrap_or([0.0; 3]);
+    let with_sun = |v: [f64; 3]| [v[0] + deposit[0], v[1] + deposit[1], v[2] + deposit[2]];
     for s in first..first + count {
         // Sample s is sample s / 16 of batch s mod 16, whose independently scrambled sequence
         // makes the batch means independent (the pixel's standard error is their spread).
@@ -59,11 +64,14 @@ pub fn render_pixel(
         let mut wl = SampledWavelengths::sample_visible(u_wl);
         let Some(ray) = cam.try_ray(x as f32 + 0.5 + off.x, y as f32 + 0.5 + off.y, u_lens) else {
             // Film outside a fisheye's image circle sees nothing.
-            sums.add([0.0; 3]);
+            sums.add(with_sun([0.0; 3]));
             continue;
         };
         stats.camera_rays += 1;
-        let start = PathStart::image(world, ray.origin);
+        let start = PathStart {
+            sun_deposited: sun.is_some(),
+            ..PathStart::image(world, ray.origin)
+        };
         let l = trace(
             world,
             ray.origin,
@@ -79,10 +87,10 @@ pub fn render_pixel(
         }
         let xyz = radiance_to_xyz(&l, &wl);
         if xyz.iter().all(|v| v.is_finite()) {
-            sums.add(xyz);
+            sums.add(with_sun(xyz));
         } else {
             stats.non_finite += 1;
-            sums.add([0.0; 3]);
+            sums.add(with_sun([0.0; 3]));
         }
     }
 }
@@ -313,6 +321,7 @@ pub fn render_progressive(
             "does not estimate"
         }
     );
+    let sun = SunInView::new(world);
     let tiles_x = w.div_ceil(TILE);
     let n_tiles = tiles_x * h.div_ceil(TILE);
     let start = Instant::now();
@@ -375,6 +384,7 @@ pub fn render_progressive(
                                         &mut est,
                                         est_e.as_mut(),
                                         &mut r.stats,
+                                        sun.as_ref(),
                                     );
                                     let first = prog.first_sample + d.count;
                                     render_pixel(
@@ -387,6 +397,7 @@ pub fn render_progressive(
                                         d,
                                         dec_e.as_mut(),
                                         &mut r.stats,
+                                        sun.as_ref(),
                                     );
                                 }
                                 None => {
@@ -401,6 +412,7 @@ pub fn render_progressive(
                                         &mut est,
                                         est_e.as_mut(),
                                         &mut r.stats,
+                                        sun.as_ref(),
                                     );
                                 }
                             }
