@@ -224,12 +224,24 @@ fn case(name: &str, scene_text: &str) {
         assert_eq!(code, 0, "{err}");
         let ours: Value = serde_json::from_str(&out).unwrap();
         let os = std::ffi::OsStr::new;
-        let args = [hdr_path.as_os_str(), os("-T"), os("80"), os("60"), os("0.6")];
+        let args = [
+            hdr_path.as_os_str(),
+            os("-T"),
+            os("80"),
+            os("60"),
+            os("0.6"),
+        ];
         let eg_t = python_json("glare/evalglare_file.py", &args, None);
         println!("{name}, task zone: candela {ours}, evalglare {eg_t}");
         for (k, tol) in [("dgp", 0.01), ("ugr", 0.5), ("dgi", 0.5)] {
-            let (a, b) = (ours[k]["value"].as_f64().unwrap(), eg_t[k].as_f64().unwrap());
-            assert!((a - b).abs() <= tol, "--task: {k}: candela {a}, evalglare {b}");
+            let (a, b) = (
+                ours[k]["value"].as_f64().unwrap(),
+                eg_t[k].as_f64().unwrap(),
+            );
+            assert!(
+                (a - b).abs() <= tol,
+                "--task: {k}: candela {a}, evalglare {b}"
+            );
         }
         assert_eq!(
             ours["sources"].as_array().unwrap().len() as f64,
@@ -274,7 +286,15 @@ fn merge_writes_the_radiance_picture_with_the_view() {
     for seed in ["1", "2"] {
         let out = format!("r{seed}.exr");
         let args = [
-            "render", "room.ron", "--quiet", "--spp", "8", "--seed", seed, "--out", &out,
+            "render",
+            "room.ron",
+            "--quiet",
+            "--spp",
+            "8",
+            "--seed",
+            seed,
+            "--out",
+            &out,
             "--save-state",
         ];
         let (code, _, err) = common::cli(&args, &dir);
@@ -285,8 +305,13 @@ fn merge_writes_the_radiance_picture_with_the_view() {
     let exr = candela::output::read_image(&dir.join("m.exr")).unwrap();
     let hdr = candela::output::read_image(&dir.join("m.hdr")).unwrap();
     let view = candela::output::read_image(&dir.join("r1.hdr")).unwrap();
-    assert_eq!(hdr.attribute("radiance_view"), view.attribute("radiance_view"));
-    assert!(hdr.attribute("radiance_view").is_some_and(|v| v.contains("-vta")));
+    assert_eq!(
+        hdr.attribute("radiance_view"),
+        view.attribute("radiance_view")
+    );
+    assert!(hdr
+        .attribute("radiance_view")
+        .is_some_and(|v| v.contains("-vta")));
     assert!(exr.attribute("projection").is_some());
     let (a, b) = (exr.channel("Y").unwrap(), hdr.channel("Y").unwrap());
     let peak = a.iter().fold(0.0f32, |m, &v| m.max(v));

@@ -42,8 +42,7 @@ fn scene(projection: &str, altitude_deg: f64, extra: &str, filter: &str) -> Stri
     )
 }
 
-const PANE: &str =
-    r#"(material: "pane", shape: Quad(origin: (-5, -5, 1), edge_u: (10, 0, 0), edge_v: (0, 10, 0))),"#;
+const PANE: &str = r#"(material: "pane", shape: Quad(origin: (-5, -5, 1), edge_u: (10, 0, 0), edge_v: (0, 10, 0))),"#;
 
 struct Seen {
     ev: f64,
@@ -164,6 +163,9 @@ fn sun_reflected_in_glass_is_still_found_by_the_paths() {
         .map(|(r, c)| y[r * RES + c] as f64 * world.camera.pixel_solid_angle_sr(c, r))
         .sum();
     let r = 1.0 - common::thin_slab_transmittance(a.to_radians().sin(), 1.52);
-    println!("sun reflected in a glass floor: Σ L ω below the horizon {below:.1} lx, R E_n {:.1}", r * E_N);
+    println!(
+        "sun reflected in a glass floor: Σ L ω below the horizon {below:.1} lx, R E_n {:.1}",
+        r * E_N
+    );
     assert!(below > 0.0, "the reflected sun is seen");
 }

@@ -62,10 +62,7 @@ impl SunInView {
         let filter = &world.settings.filter;
         let r = filter.radius() as f64;
         let (w, h) = (cam.width as i64, cam.height as i64);
-        let wraps = matches!(
-            cam.projection(),
-            crate::camera::Projection::Equirectangular
-        );
+        let wraps = matches!(cam.projection(), crate::camera::Projection::Equirectangular);
         let mut acc: BTreeMap<u64, [f64; 3]> = BTreeMap::new();
         for sun in suns {
             let omega = sun.solid_angle_sr();
