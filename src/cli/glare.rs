@@ -119,7 +119,7 @@ fn parse_task(text: &str) -> anyhow::Result<(usize, usize, f64)> {
         ))
     };
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let [x, y, a] = parts[..] else {
+    let [x, y, a] = parts.as_slice() else {
         return Err(bad());
     };
     let x: usize = x.parse().map_err(|_| bad())?;

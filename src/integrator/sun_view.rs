@@ -30,6 +30,9 @@ const MIN_GRID: usize = 16;
 const MAX_GRID: usize = 64;
 /// Quadrature directions per pixel across the disk's diameter (above [`MIN_GRID`]).
 const PER_PIXEL: f64 = 8.0;
+/// Widest disk deposited, pixels: a wider one (a long lens) is found often enough by the
+/// camera rays themselves, which then keep it.
+const MAX_DIAMETER_PX: f64 = MAX_GRID as f64 / PER_PIXEL;
 
 /// The deterministic XYZ of the directly seen disk, per pixel.
 #[derive(Clone, Debug, Default)]
@@ -40,7 +43,8 @@ pub struct SunInView {
 
 impl SunInView {
     /// The deposit of every sun of `world` seen by its camera: None when the camera has a thin
-    /// lens (its rays keep finding the disk themselves) or the world has no sun. A sun outside
+    /// lens or a disk spans more than [`MAX_DIAMETER_PX`] pixels (the camera rays then keep
+    /// finding the disks themselves), or the world has no sun. A sun outside
     /// the view gives an empty deposit, and its disk is still left to the deposit (a pixel's
     /// filter can reach past the image's edge).
     pub fn new(world: &World) -> Option<Self> {
@@ -71,6 +75,9 @@ impl SunInView {
             let density = cam.solid_angle_density(sun.to_sun);
             let n = if density > 0.0 {
                 let diameter_px = 2.0 * (omega / std::f64::consts::PI / density).sqrt();
+                if diameter_px > MAX_DIAMETER_PX {
+                    return None;
+                }
                 ((PER_PIXEL * diameter_px).ceil() as usize).clamp(MIN_GRID, MAX_GRID)
             } else {
                 MIN_GRID
@@ -91,8 +98,6 @@ impl SunInView {
                     continue;
                 }
                 let k = d_omega / cam.solid_angle_density(dir);
-                let (x0, x1) = ((fx - r - 0.5).floor() as i64, (fx + r - 0.5).ceil() as i64);
-                let (y0, y1) = ((fy - r - 0.5).floor() as i64, (fy + r - 0.5).ceil() as i64);
                 for py in y0.max(0)..=y1.min(h - 1) {
                     for px in x0..=x1 {
                         let off = Vec2::new(
@@ -145,32 +150,33 @@ impl SunInView {
 fn seen_xyz(world: &World, radiance: &crate::spectrum::DenseSpectrum, d: DVec3) -> [f64; 3] {
     let origin = world.camera.position;
     let dir = d.as_vec3();
-    let mut t = [0.0f64; DENSE_LEN];
-    if world.see_through.is_empty() {
+    let t: [f64; DENSE_LEN] = if world.see_through.is_empty() {
         if world.geometry.occluded(origin, dir, f32::INFINITY) {
             return [0.0; 3];
         }
-        t = [1.0; DENSE_LEN];
+        [1.0; DENSE_LEN]
     } else {
+        let mut t = [0.0; DENSE_LEN];
         for first in (0..DENSE_LEN).step_by(N_LAMBDA) {
             let mut wl = SampledWavelengths {
                 lambda: [0.0; N_LAMBDA],
                 pdf: [1.0; N_LAMBDA],
             };
-            for i in 0..N_LAMBDA {
-                wl.lambda[i] = LAMBDA_MIN + (first + i).min(DENSE_LEN - 1) as f32;
+            for (i, l) in wl.lambda.iter_mut().enumerate() {
+                *l = LAMBDA_MIN + (first + i).min(DENSE_LEN - 1) as f32;
             }
             let Some(tr) = super::transmit::transmittance(world, origin, dir, f32::INFINITY, &wl)
             else {
                 return [0.0; 3];
             };
-            for i in 0..N_LAMBDA {
-                if first + i < DENSE_LEN {
-                    t[first + i] = tr.0[i] as f64;
+            for (i, &v) in tr.0.iter().enumerate() {
+                if let Some(x) = t.get_mut(first + i) {
+                    *x = v as f64;
                 }
             }
         }
-    }
+        t
+    };
     let c = cmfs(Observer::Cie1931_2);
     let v: Vec<f64> = (0..DENSE_LEN)
         .map(|i| radiance.values[i] as f64 * t[i])
