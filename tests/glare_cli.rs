@@ -1,6 +1,11 @@
 //! `candela glare` on candela's own fisheye renders (180° angular fisheye): a room with a window
 //! under an overcast sky and a bright ceiling luminaire in view; the same window under a clear
-//! sky with a low sun in view; a windowless office lit by four luminaires, with a `Ugr` meter.
+//! sky with a low sun in view, and under a hazy one (a weak sun, so that DGP stays below 1); a
+//! windowless office lit by four luminaires, with a `Ugr` meter.
+//! - with the sun in view, its disk deposited into its pixels: E_v's interval within 1 %, and
+//!   the clear-sky image trustworthy by `candela glare`'s checks;
+//! - `--task` against evalglare's `-T` with the same zone (overcast);
+//! - `candela merge` writes OUT.hdr with the renders' view.
 //! - E_v of the image (Σ L ∫cos θ dω) equals an illuminance meter at the eye facing the line
 //!   of sight, within their combined standard errors;
 //! - the EXR (with its per-pixel standard errors) and the Radiance picture give the same
@@ -172,13 +177,15 @@ fn case(name: &str, scene_text: &str) {
     // The sun's disk is deposited into its pixels without noise: the image is as trustworthy
     // as the rest of its light makes it.
     if name.contains("sun") {
+        assert!(half < 0.01 * ev, "{name}: E_v ± {half} of {ev} lx");
+    }
+    if name == "sun" {
         assert_eq!(
             exr["trustworthy"],
             Value::Bool(true),
             "{name}: {}",
             exr["warnings"]
         );
-        assert!(half < 0.01 * ev, "{name}: E_v ± {half} of {ev} lx");
     }
     for k in ["dgp", "ev_lx"] {
         let (a, b) = (
