@@ -29,7 +29,6 @@ fn scene(projection: &str, altitude_deg: f64, extra: &str, filter: &str) -> Stri
              projection: {projection}),
     render: (spp: 32, seed: 5{filter}),
     materials: {{
-        "black": Diffuse(reflectance: Constant(0.0)),
         "pane": ThinDielectric(ior: Constant(1.52)),
     }},
     objects: [
