@@ -8,7 +8,8 @@
 //! - every pixel's standard error is zero: the deposit adds the same to every sample;
 //! - a disk seen in a reflection is still found by the camera paths (the deposit is the
 //!   straight line of sight only);
-//! for the angular fisheye and a perspective camera, with the box and a tent pixel filter.
+//!
+//! For the angular fisheye and a perspective camera, with the box and a tent pixel filter.
 
 mod common;
 use candela::camera::vertical_illuminance_lx;
