@@ -4,6 +4,7 @@
 use crate::film::{
     radiance_to_xyz, Film, HealthPixel, IlluminanceSums, PixelE, PixelSums, PIXEL_BATCHES,
 };
+use crate::integrator::sun_view::SunInView;
 use crate::integrator::{trace, PathStart, RayStats};
 use crate::sampling::{batch_stream, Sampler};
 use crate::spectrum::SampledWavelengths;
@@ -46,9 +47,13 @@ pub fn render_pixel(
     mut e: Option<&mut IlluminanceSums>,
     mut health: Option<HealthPixel>,
     stats: &mut RayStats,
+    sun: Option<&SunInView>,
 ) {
     let cam = &world.camera;
     let pixel = (y * cam.width + x) as u64;
+    // The directly seen sun, the same for every sample (see `SunInView`).
+    let deposit = sun.and_then(|s| s.at(pixel)).unwrap_or([0.0; 3]);
+    let with_sun = |v: [f64; 3]| [v[0] + deposit[0], v[1] + deposit[1], v[2] + deposit[2]];
     for s in first..first + count {
         // Sample s is sample s / 16 of batch s mod 16, whose independently scrambled sequence
         // makes the batch means independent (the pixel's standard error is their spread).
@@ -63,11 +68,14 @@ pub fn render_pixel(
         let mut wl = SampledWavelengths::sample_visible(u_wl);
         let Some(ray) = cam.try_ray(x as f32 + 0.5 + off.x, y as f32 + 0.5 + off.y, u_lens) else {
             // Film outside a fisheye's image circle sees nothing.
-            sums.add([0.0; 3]);
+            sums.add(with_sun([0.0; 3]));
             continue;
         };
         stats.camera_rays += 1;
-        let start = PathStart::image(world, ray.origin);
+        let start = PathStart {
+            sun_deposited: sun.is_some(),
+            ..PathStart::image(world, ray.origin)
+        };
         let l = trace(
             world,
             ray.origin,
@@ -90,10 +98,10 @@ pub fn render_pixel(
             if let Some(h) = health.as_mut() {
                 h.add_radiance(sums.count, &l, &wl);
             }
-            sums.add(xyz);
+            sums.add(with_sun(xyz));
         } else {
             stats.non_finite += 1;
-            sums.add([0.0; 3]);
+            sums.add(with_sun([0.0; 3]));
         }
     }
 }
@@ -343,6 +351,13 @@ pub fn render_progressive(
             "the film's light-and-health sums do not match its pixels"
         );
     }
+    // The light-and-health channels weight the spectrum their own way: with them the sun in
+    // view is left to the camera rays, which every channel sees alike.
+    let sun = if film.health.is_some() {
+        None
+    } else {
+        SunInView::new(world)
+    };
     let tiles_x = w.div_ceil(TILE);
     let n_tiles = tiles_x * h.div_ceil(TILE);
     let start = Instant::now();
@@ -412,6 +427,7 @@ pub fn render_progressive(
                                         est_e.as_mut(),
                                         hv,
                                         &mut r.stats,
+                                        sun.as_ref(),
                                     );
                                     let first = prog.first_sample + d.count;
                                     render_pixel(
@@ -425,6 +441,7 @@ pub fn render_progressive(
                                         dec_e.as_mut(),
                                         None,
                                         &mut r.stats,
+                                        sun.as_ref(),
                                     );
                                 }
                                 None => {
@@ -440,6 +457,7 @@ pub fn render_progressive(
                                         est_e.as_mut(),
                                         hv,
                                         &mut r.stats,
+                                        sun.as_ref(),
                                     );
                                 }
                             }

@@ -272,6 +272,18 @@ impl Camera {
         self.map.film(self.to_camera(dir))
     }
 
+    /// Whether every ray of the camera starts at its position (no thin lens): then a direction
+    /// maps to one film position ([`Self::film_position`]).
+    pub fn is_pinhole(&self) -> bool {
+        self.lens_radius <= 0.0
+    }
+
+    /// dω/dA of the pinhole projection at world direction `dir`: steradians per square pixel of
+    /// film, so a direction's share δω of solid angle covers δω / density square pixels.
+    pub fn solid_angle_density(&self, dir: Vec3) -> f64 {
+        self.map.solid_angle_density(self.to_camera(dir))
+    }
+
     /// Solid angle of pixel (x, y), sr: the exact integral over the part of its footprint
     /// that sees the scene (pinhole; a thin lens's pixels see the same directions on average).
     pub fn pixel_solid_angle_sr(&self, x: usize, y: usize) -> f64 {

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use candela::glare::file::read_glare_image;
 use candela::glare::{
-    evaluate_uncertain, GlareOptions, Interval, Threshold, UncertainGlare, UncertainOptions,
+    evaluate_uncertain, GlareOptions, Interval, Task, Threshold, UncertainGlare, UncertainOptions,
 };
 
 /// Arguments of `candela glare`.
@@ -27,6 +27,12 @@ pub struct GlareArgs {
     /// Apply DGP's low-light correction below 1000 lx (evalglare `-C l+`).
     #[arg(long)]
     pub low_light: bool,
+    /// Task zone as evalglare's `-t`/`-T x y angle`: the pixels within half of ANGLE (rad) of
+    /// the direction of pixel (X, Y), X from the left and Y from the bottom row, as evalglare
+    /// counts them; the glare-pixel threshold becomes 5 × the zone's mean luminance (or
+    /// `--threshold` times it, at most 100).
+    #[arg(long, value_name = "X,Y,ANGLE")]
+    pub task: Option<String>,
     /// Perturbed images drawn for the intervals.
     #[arg(long, default_value_t = 64)]
     pub draws: usize,
@@ -44,6 +50,7 @@ impl GlareArgs {
             search_angle: 0.2,
             no_peaks: false,
             low_light: false,
+            task: None,
             draws: 64,
             json: false,
         }
@@ -73,7 +80,24 @@ pub fn run(args: &GlareArgs) -> anyhow::Result<String> {
         opt.detect.peak_limit_cd_m2 = None;
     }
     opt.low_light_correction = args.low_light;
+    let task = args.task.as_deref().map(parse_task).transpose()?;
     let img = read_glare_image(&args.image)?;
+    if let Some((x, y, angle_rad)) = task {
+        if x >= img.width || y >= img.height {
+            return Err(super::usage(format!(
+                "--task: pixel ({x}, {y}) is outside the {}×{} image",
+                img.width, img.height
+            )));
+        }
+        opt.detect.task = Some(Task {
+            col: x,
+            row: img.height - 1 - y,
+            angle_rad,
+        });
+        if args.threshold.is_none() {
+            opt.detect.threshold = Threshold::Multiple { factor: 5.0 };
+        }
+    }
     let u = UncertainOptions {
         draws: args.draws,
         ..Default::default()
@@ -85,6 +109,26 @@ pub fn run(args: &GlareArgs) -> anyhow::Result<String> {
     } else {
         text(&g, img.stderr_cd_m2.is_some())
     })
+}
+
+/// `X,Y,ANGLE`: a pixel (whole numbers) and an opening angle in radians.
+fn parse_task(text: &str) -> anyhow::Result<(usize, usize, f64)> {
+    let bad = || {
+        super::usage(format!(
+            "--task must be X,Y,ANGLE (pixel column and row from the bottom, opening angle in rad), got '{text}'"
+        ))
+    };
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [x, y, a] = parts.as_slice() else {
+        return Err(bad());
+    };
+    let x: usize = x.parse().map_err(|_| bad())?;
+    let y: usize = y.parse().map_err(|_| bad())?;
+    let a: f64 = a.parse().map_err(|_| bad())?;
+    if !(a.is_finite() && a > 0.0 && a <= std::f64::consts::TAU) {
+        return Err(bad());
+    }
+    Ok((x, y, a))
 }
 
 fn interval_json(i: &Interval) -> serde_json::Value {

@@ -1,12 +1,14 @@
 //! Light transport estimators that read a built [`crate::world::World`]: camera paths
 //! ([`path`]: radiance along a ray, irradiance at a point), light paths for caustics
 //! ([`light_path`]), and what both share: straight passage through window panes and the
-//! transmittance of a segment ([`transmit`]), ray counters ([`stats`]) and the Russian
+//! transmittance of a segment ([`transmit`]), the sun's disk seen straight from the camera
+//! ([`sun_view`]), ray counters ([`stats`]) and the Russian
 //! roulette that ends paths ([`survival_probability`]).
 
 pub mod light_path;
 pub mod path;
 pub mod stats;
+pub mod sun_view;
 pub mod transmit;
 
 pub use path::{irradiance, trace, PathStart, RayStart};

@@ -48,6 +48,10 @@ pub struct PathStart {
     /// Lights at infinity reached before the path scatters again count (false: only light
     /// that has scattered at least once more, as [`indirect_irradiance`] needs).
     pub unscattered_escapes: bool,
+    /// A camera ray whose straight view of the sun's disk (no scattering, only passages
+    /// through window panes) [`super::sun_view::SunInView`] deposits in the pixels: the disk
+    /// is left out of such rays.
+    pub sun_deposited: bool,
 }
 
 impl PathStart {
@@ -61,6 +65,7 @@ impl PathStart {
             depth: 0,
             caustics_by_light_tracing: false,
             unscattered_escapes: true,
+            sun_deposited: false,
         }
     }
 
@@ -142,6 +147,12 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
             }
             for &li in &world.infinite_lights {
                 let light = &world.lights[li as usize];
+                if start.sun_deposited
+                    && depth == start.depth
+                    && matches!(light, crate::light::Light::Sun(_))
+                {
+                    continue;
+                }
                 let le = light.escaped(ray_d, wl);
                 if le.is_black() {
                     continue;
@@ -455,6 +466,7 @@ pub fn irradiance_tallied<T: FnMut(Vec3, SampledSpectrum)>(
         depth: 1,
         caustics_by_light_tracing,
         unscattered_escapes: true,
+        sun_deposited: false,
     };
     e += receiver_path(world, at, n, start, wl, sampler, stats, &mut scaled) * PI;
     e
@@ -483,6 +495,7 @@ pub fn indirect_irradiance(
         depth: 1,
         caustics_by_light_tracing: false,
         unscattered_escapes: false,
+        sun_deposited: false,
     };
     // cos θ / pdf = π.
     receiver_path(world, at, n, start, wl, sampler, stats, &mut |_, _| {}) * std::f32::consts::PI

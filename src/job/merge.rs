@@ -26,6 +26,8 @@ pub struct MergeOptions {
 pub struct MergeOutputs {
     pub exr_path: PathBuf,
     pub png_path: PathBuf,
+    /// OUT.hdr, written when an input state has its render's NAME.hdr beside it.
+    pub hdr_path: Option<PathBuf>,
     /// The merged state (not written for a partial merge of shards).
     pub state_path: PathBuf,
     /// Number of state files merged.
@@ -41,7 +43,8 @@ pub struct MergeOutputs {
     pub meters: Vec<crate::meter::MeterSums>,
 }
 
-/// Merges `states` into OUT.exr, OUT.png and OUT.state (`out` names a stem, or an existing
+/// Merges `states` into OUT.exr, OUT.png, OUT.state and, when an input's render wrote a
+/// Radiance picture beside its state, OUT.hdr (`out` names a stem, or an existing
 /// directory for `DIR/merged.*`); refuses to overwrite an input, to mix scenes or settings,
 /// and to count a seed twice. `exposure_ev` sets the PNG's exposure (None: automatic).
 pub fn merge(states: &[PathBuf], out: &Path, exposure_ev: Option<f64>) -> Result<MergeOutputs> {
@@ -64,12 +67,13 @@ pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Res
     let exposure_ev = options.exposure_ev;
     check_exposure(exposure_ev)?;
     // Like `render --out`, a directory gets files named `merged.*`.
-    let stem = output_stem(Some(out), "merged", &["exr", "png", "state"]);
+    let stem = output_stem(Some(out), "merged", &["exr", "hdr", "png", "state"]);
     let exr_path = with_suffix(&stem, ".exr");
     let png_path = with_suffix(&stem, ".png");
+    let hdr_path = with_suffix(&stem, ".hdr");
     let state_path = with_suffix(&stem, ".state");
     check_output_dir(&stem).with_context(|| format!("-o {}", out.display()))?;
-    for output in [&exr_path, &png_path, &state_path] {
+    for output in [&exr_path, &png_path, &hdr_path, &state_path] {
         if let Some(input) = states.iter().find(|s| super::would_replace(output, s)) {
             bail!(
                 "-o {}: refusing to overwrite the input state file {} with the merged {}; choose another output name",
@@ -160,8 +164,45 @@ pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Res
             format!("{:?} of {}", s.merged, s.count),
         ));
     }
+    // The camera is not in the state: its view comes from the Radiance picture a render
+    // writes beside its state (NAME.hdr beside NAME.state), whose VIEW= and projection lines
+    // the merged picture and EXR repeat.
+    let view = loaded
+        .iter()
+        .filter_map(|(p, _)| output::read_hdr(&p.with_extension("hdr")).ok())
+        .find(|h| h.width == film.width && h.height == film.height);
+    if let Some(v) = &view {
+        for (key, value) in [
+            (output::ATTRIBUTE_PROJECTION, &v.projection),
+            (output::ATTRIBUTE_VIEW, &v.view),
+        ] {
+            if let Some(value) = value {
+                layers.attributes.push((key.to_string(), value.clone()));
+            }
+        }
+    }
     output::write_exr(&exr_path, &layers).context("cannot write the EXR")?;
     write_png(&film, &png_path, exposure_ev)?;
+    let hdr_path = match &view {
+        Some(v) => {
+            let extra: Vec<String> = v
+                .projection
+                .iter()
+                .map(|p| format!("CANDELA_PROJECTION={p}"))
+                .collect();
+            output::write_hdr(
+                &hdr_path,
+                film.width,
+                film.height,
+                &film.xyz_image(),
+                v.view.as_deref(),
+                &extra,
+            )
+            .context("cannot write the HDR")?;
+            Some(hdr_path)
+        }
+        None => None,
+    };
     let merged = RenderState {
         seed: seeds[0],
         merged_seeds: seeds[1..].to_vec(),
@@ -188,6 +229,7 @@ pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Res
     Ok(MergeOutputs {
         exr_path,
         png_path,
+        hdr_path,
         state_path,
         renders: loaded.len(),
         samples_per_pixel: merged.film.samples_per_pixel(),

@@ -71,6 +71,24 @@ impl SunLight {
         })
     }
 
+    /// The disk's solid angle Ω, sr.
+    pub fn solid_angle_sr(&self) -> f64 {
+        std::f64::consts::TAU * self.one_minus_cos
+    }
+
+    /// `n × n` directions (unit, world frame) over the disk, one at the centre of each cell of
+    /// an equal-solid-angle n × n grid, so each stands for Ω / n² of it: a deterministic
+    /// quadrature of the disk.
+    pub fn disk_directions(&self, n: usize) -> impl Iterator<Item = DVec3> + '_ {
+        let (x, y, z) = self.frame();
+        (0..n * n).map(move |k| {
+            let (i, j) = (k / n, k % n);
+            let u = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+            let (cos_t, sin_t, phi) = uniform_cone(u.0, u.1, self.one_minus_cos);
+            (x * (sin_t * phi.cos()) + y * (sin_t * phi.sin()) + z * cos_t).normalize()
+        })
+    }
+
     fn inside(&self, wi: Vec3) -> bool {
         1.0 - (wi.as_dvec3().dot(self.to_sun.as_dvec3())) <= self.one_minus_cos
     }

@@ -38,6 +38,9 @@ pub struct HdrImage {
     /// The view options of the `VIEW=` lines, if any (several are joined with spaces, as
     /// Radiance applies them in order).
     pub view: Option<String>,
+    /// candela's description of the camera's projection (its `CANDELA_PROJECTION=` line), if
+    /// the file has one.
+    pub projection: Option<String>,
 }
 
 impl HdrImage {
@@ -47,7 +50,7 @@ impl HdrImage {
     }
 
     /// As [`Layers`]: channels `X`, `Y`, `Z` (no standard error), `units = cd/m^2` and, if the
-    /// file has one, the `radiance_view` attribute.
+    /// file has them, the `radiance_view` and `projection` attributes.
     pub fn to_layers(&self) -> Layers {
         let component = |i: usize| self.xyz.iter().map(|p| p[i]).collect::<Vec<f32>>();
         let mut layers = Layers::new(self.width, self.height);
@@ -64,6 +67,11 @@ impl HdrImage {
             layers
                 .attributes
                 .push((super::ATTRIBUTE_VIEW.to_string(), v.clone()));
+        }
+        if let Some(p) = &self.projection {
+            layers
+                .attributes
+                .push((super::ATTRIBUTE_PROJECTION.to_string(), p.clone()));
         }
         layers
     }
@@ -309,6 +317,7 @@ fn decode(bytes: &[u8]) -> Result<HdrImage, String> {
     let mut primaries = RADIANCE_PRIMARIES;
     let mut xyze = false;
     let mut views: Vec<String> = Vec::new();
+    let mut projection = None;
     loop {
         let end = bytes[pos..]
             .iter()
@@ -367,6 +376,8 @@ fn decode(bytes: &[u8]) -> Result<HdrImage, String> {
             primaries = [[v[0], v[1]], [v[2], v[3]], [v[4], v[5]], [v[6], v[7]]];
         } else if let Some(v) = line.strip_prefix("VIEW=") {
             views.push(v.trim().to_string());
+        } else if let Some(v) = line.strip_prefix("CANDELA_PROJECTION=") {
+            projection = Some(v.trim().to_string());
         }
     }
     // Resolution string.
@@ -436,6 +447,7 @@ fn decode(bytes: &[u8]) -> Result<HdrImage, String> {
         height,
         xyz,
         view: (!views.is_empty()).then(|| views.join(" ")),
+        projection,
     })
 }
 
