@@ -62,7 +62,10 @@ fn the_same_image_is_written_byte_for_byte() {
     for k in 1..12 {
         let p = dir.path().join(format!("{k}.exr"));
         write_exr(&p, &layers).unwrap();
-        assert!(fs::read(&p).unwrap() == bytes, "write {k} differs from the first");
+        assert!(
+            fs::read(&p).unwrap() == bytes,
+            "write {k} differs from the first"
+        );
     }
     assert_eq!(read_exr(&first).unwrap(), sorted(layers));
 }

@@ -20,7 +20,10 @@ pub(super) fn sort_header_attributes(bytes: &mut [u8]) {
         .map(|&(start, name_end, stop)| (&bytes[start..name_end], &bytes[start..stop]))
         .collect();
     sorted.sort_by(|a, b| a.0.cmp(b.0));
-    let joined: Vec<u8> = sorted.iter().flat_map(|(_, all)| all.iter().copied()).collect();
+    let joined: Vec<u8> = sorted
+        .iter()
+        .flat_map(|(_, all)| all.iter().copied())
+        .collect();
     bytes[8..end].copy_from_slice(&joined);
 }
 
@@ -32,7 +35,11 @@ type Span = (usize, usize, usize);
 fn attributes(bytes: &[u8], mut at: usize) -> Option<(Vec<Span>, usize)> {
     let mut spans = Vec::new();
     let nul = |from: usize| -> Option<usize> {
-        bytes.get(from..)?.iter().position(|&b| b == 0).map(|p| from + p)
+        bytes
+            .get(from..)?
+            .iter()
+            .position(|&b| b == 0)
+            .map(|p| from + p)
     };
     loop {
         let name_end = nul(at)?;
@@ -42,7 +49,9 @@ fn attributes(bytes: &[u8], mut at: usize) -> Option<(Vec<Span>, usize)> {
         let type_end = nul(name_end + 1)?;
         let size_at = type_end + 1;
         let size = i32::from_le_bytes(bytes.get(size_at..size_at + 4)?.try_into().ok()?);
-        let stop = size_at.checked_add(4)?.checked_add(usize::try_from(size).ok()?)?;
+        let stop = size_at
+            .checked_add(4)?
+            .checked_add(usize::try_from(size).ok()?)?;
         if stop > bytes.len() {
             return None;
         }
