@@ -325,7 +325,7 @@ fn merge_into_a_directory_writes_merged_files_there() {
     assert_eq!(code, 0, "{stderr}");
     assert_eq!(
         listing(&dir.path().join("out")),
-        vec!["merged.exr", "merged.png", "merged.state"]
+        vec!["merged.exr", "merged.hdr", "merged.png", "merged.state"]
     );
     let before = listing(dir.path());
     for out in ["missing/", "missing/c", "/nonexistent/c"] {
