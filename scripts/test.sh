@@ -15,10 +15,10 @@ if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null && ! command -v slurmctld
 fi
 export CANDELA_PYTHON="${CANDELA_PYTHON:-$PWD/target/venv/bin/python}"
 cargo test --all-targets "$@"
-# The Python package, built with the test profile into the same target directory (its
-# dependencies that cargo test compiled with the same features are reused; pyo3's macros turn on
-# two more features of syn, so the derive macros and the crates using them are compiled again),
-# installed into the venv (numpy, its one requirement, is among the pins), then its tests
-# (finding none, pytest exits 5: a failure).
-VIRTUAL_ENV="$PWD/target/venv" target/venv/bin/maturin develop --quiet --profile test
+# The Python package, built with the dev profile (maturin's default; its dependencies are those
+# cargo test compiled, with two more features of syn that pyo3's macros turn on, so the derive
+# macros and the crates using them are compiled again; `--profile test` would build the unit-test
+# harness, not a library), installed into the venv (numpy, its one requirement, is among the
+# pins), then its tests (finding none, pytest exits 5: a failure).
+VIRTUAL_ENV="$PWD/target/venv" target/venv/bin/maturin develop --quiet
 target/venv/bin/python -m pytest -q -p no:cacheprovider -p no:warnings tests/python
