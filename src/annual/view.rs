@@ -25,7 +25,6 @@ use super::metrics::{replicate_interval, Schedule};
 use super::results::{multipliers, Estimate};
 use super::sun::{declination_hour_angle, node_direction, set_sun, Grid};
 use super::year::HourSky;
-use crate::camera::projection::FilmMap;
 use crate::camera::Camera;
 use crate::daylight::patches::SkyPatches;
 use crate::film::radiance_to_xyz;
@@ -147,37 +146,6 @@ pub struct ViewMatrix {
     pub nodes: usize,
 }
 
-fn glare_geometry(camera: &Camera) -> GlareImage {
-    let (w, h) = (camera.width, camera.height);
-    let map = FilmMap::new(camera.projection(), w, h);
-    let n = w * h;
-    let (mut direction, mut solid_angle, mut inside) = (
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-    );
-    for y in 0..h {
-        for x in 0..w {
-            let d = map.direction(x as f64 + 0.5, y as f64 + 0.5);
-            let ok = map.pixel_inside(x, y) && d.is_some();
-            direction.push(d.unwrap_or([0.0, 0.0, 1.0]));
-            solid_angle.push(if ok { map.pixel_solid_angle(x, y) } else { 0.0 });
-            inside.push(ok);
-        }
-    }
-    GlareImage {
-        width: w,
-        height: h,
-        luminance_cd_m2: vec![0.0; n],
-        stderr_cd_m2: None,
-        direction,
-        solid_angle_sr: solid_angle,
-        inside,
-        view_dir: [0.0, 0.0, 1.0],
-        up: [0.0, 1.0, 0.0],
-    }
-}
-
 /// Calls `sample` with `per_batch` camera rays through pixel `pix` (film jittered by the
 /// sampler) and returns the mean of what it returns over the rays inside the view (a
 /// fisheye's rim pixels see the scene over part of their area) and their number.
@@ -232,7 +200,14 @@ pub fn view_coefficients(
     let sky_frame = sky.frame;
     let k = BATCHES as usize;
     let n_p = patches.len();
-    let image = glare_geometry(camera);
+    let n_pixels = camera.width * camera.height;
+    let image = GlareImage::of_projection(
+        camera.projection(),
+        camera.width,
+        camera.height,
+        vec![0.0; n_pixels],
+        None,
+    );
     let inside: Vec<usize> = (0..image.len()).filter(|&i| image.valid(i)).collect();
     let n_in = inside.len();
     let cos_w: Vec<f64> = inside

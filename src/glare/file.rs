@@ -109,6 +109,47 @@ fn projection_of_attribute(text: &str) -> Result<Projection, String> {
     })
 }
 
+impl GlareImage {
+    /// The image of `projection` at `width` × `height` pixels in its own view frame (looking
+    /// along +z, up +y): each pixel's direction through its centre, its solid angle and whether
+    /// it sees the scene, with the given luminances (cd/m²) and standard errors.
+    pub fn of_projection(
+        projection: Projection,
+        width: usize,
+        height: usize,
+        luminance_cd_m2: Vec<f64>,
+        stderr_cd_m2: Option<Vec<f64>>,
+    ) -> Self {
+        let map = FilmMap::new(projection, width, height);
+        let n = width * height;
+        let (mut direction, mut solid_angle_sr, mut inside) = (
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
+        for y in 0..height {
+            for x in 0..width {
+                let d = map.direction(x as f64 + 0.5, y as f64 + 0.5);
+                let ok = map.pixel_inside(x, y) && d.is_some();
+                direction.push(d.unwrap_or([0.0, 0.0, 1.0]));
+                solid_angle_sr.push(if ok { map.pixel_solid_angle(x, y) } else { 0.0 });
+                inside.push(ok);
+            }
+        }
+        GlareImage {
+            width,
+            height,
+            luminance_cd_m2,
+            stderr_cd_m2,
+            direction,
+            solid_angle_sr,
+            inside,
+            view_dir: [0.0, 0.0, 1.0],
+            up: [0.0, 1.0, 0.0],
+        }
+    }
+}
+
 /// Reads `path` (EXR or Radiance HDR) as a glare image in its view frame.
 pub fn read_glare_image(path: &Path) -> Result<GlareImage, GlareFileError> {
     let layers = output::read_image(path)?;
@@ -161,33 +202,9 @@ pub fn read_glare_image(path: &Path) -> Result<GlareImage, GlareFileError> {
     let luminance = channel(output::CHANNEL_Y)
         .ok_or_else(|| view_err("the image has no luminance channel `Y`".into()))?;
     let stderr = channel(output::CHANNEL_Y_STDERR);
-    let map = FilmMap::new(projection, w, h);
-    let n = w * h;
-    let (mut direction, mut solid_angle, mut inside) = (
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-    );
-    for y in 0..h {
-        for x in 0..w {
-            let d = map.direction(x as f64 + 0.5, y as f64 + 0.5);
-            let ok = map.pixel_inside(x, y) && d.is_some();
-            direction.push(d.unwrap_or([0.0, 0.0, 1.0]));
-            solid_angle.push(if ok { map.pixel_solid_angle(x, y) } else { 0.0 });
-            inside.push(ok);
-        }
-    }
-    Ok(GlareImage {
-        width: w,
-        height: h,
-        luminance_cd_m2: luminance,
-        stderr_cd_m2: stderr,
-        direction,
-        solid_angle_sr: solid_angle,
-        inside,
-        view_dir: [0.0, 0.0, 1.0],
-        up: [0.0, 1.0, 0.0],
-    })
+    Ok(GlareImage::of_projection(
+        projection, w, h, luminance, stderr,
+    ))
 }
 
 #[cfg(test)]
