@@ -30,6 +30,8 @@ __all__ = [
     "Scene",
     "RenderResult",
     "render",
+    "merge",
+    "MergeResult",
     "read_exr",
     "read_state",
     "colour",
@@ -147,7 +149,10 @@ class RenderResult:
     E_mask: Optional[np.ndarray]
     """Fraction of the pixel's samples that saw a receiving surface (E defined where > 0)."""
     channels: Dict[str, np.ndarray]
-    """Every EXR channel by name (``X``, ``Y``, ``Z``, ``stderr.Y``, ``E``, ``stderr.E``, ``mask.E``)."""
+    """Every EXR channel by name (``X``, ``Y``, ``Z``, ``stderr.Y``, ``E``, ``stderr.E``,
+    ``mask.E``; with ``alpha_opic`` ``melanopic.EDL`` and ``stderr.melanopic.EDL`` in cd/m²,
+    and with illuminance too ``melanopic.EDI``, ``stderr.melanopic.EDI`` in lx; with
+    ``mesopic`` ``scotopic.L``, ``mesopic.L``, ``stderr.mesopic.L`` in cd/m² and ``mesopic.m``)."""
     report: Dict[str, Any]
     """NAME.report.json as a dict (schema: docs/report-json.md)."""
     meters: Dict[str, Dict[str, Any]]
@@ -192,6 +197,10 @@ def render(
     overwrite: bool = False,
     save_state: bool = False,
     falsecolour: bool = False,
+    shard: Union[str, tuple, None] = None,
+    alpha_opic: bool = False,
+    mesopic: bool = False,
+    spectral_bands: int = 0,
     progress: Optional[Progress] = None,
     cancel: Any = None,
 ) -> RenderResult:
@@ -207,7 +216,13 @@ def render(
     for the report), ``target_error`` (a fraction, 0.01 = 1 %, with ``target_fraction`` and
     ``target_floor_cd_m2``), ``max_spp``, ``max_time_s`` and ``checkpoint_interval_s``
     (seconds; no checkpoints by default), ``resume``, ``overwrite``, ``save_state`` and
-    ``falsecolour``.
+    ``falsecolour``. ``shard`` renders one shard of a render split N ways (``--shard``): ``(I,
+    N)`` or ``"I/N"`` (0-based), or ``"auto"`` / ``"auto/N"`` to take it from a Slurm, AWS
+    Batch or Kubernetes array job's variables; :func:`merge` combines the shards.
+    ``alpha_opic`` keeps the melanopic EDL per pixel (and EDI with ``illuminance``),
+    ``mesopic`` the CIE 191 mesopic luminance, ``spectral_bands`` N spectral bands written to
+    NAME.spectral.exr (``--alpha-opic``, ``--mesopic``, ``--spectral-bands``; the first two
+    come back in ``channels``).
 
     ``progress(samples_done, samples_total, elapsed_s)`` is called at the start and after
     every pass; returning ``False`` cancels. ``cancel`` is anything with ``is_set()`` (a
@@ -251,6 +266,10 @@ def render(
         overwrite=overwrite,
         save_state=save_state,
         falsecolour=falsecolour,
+        shard=_shard_spec(shard),
+        alpha_opic=alpha_opic,
+        mesopic=mesopic,
+        spectral_bands=spectral_bands,
         progress=progress,
         cancel=cancel,
     )
@@ -285,6 +304,77 @@ def render(
         elapsed_s=r["elapsed_s"],
         samples_per_second=r["samples_per_second"],
         warnings=warnings,
+    )
+
+
+def _shard_spec(shard: Union[str, tuple, None]) -> Optional[str]:
+    if shard is None or isinstance(shard, str):
+        return shard
+    try:
+        index, count = shard
+    except (TypeError, ValueError):
+        raise CandelaError(f"shard must be (index, count) or \"I/N\", got {shard!r}") from None
+    return f"{int(index)}/{int(count)}"
+
+
+@dataclass
+class MergeResult:
+    """What :func:`merge` wrote, and the merged image (float32 arrays, exactly OUT.exr)."""
+
+    channels: Dict[str, np.ndarray]
+    """OUT.exr's channels by name (``X``, ``Y``, ``Z``, ``stderr.Y`` in cd/m², …)."""
+    exr_path: Path
+    png_path: Path
+    state_path: Path
+    """The merged state (not written by a partial merge of shards)."""
+    hdr_path: Optional[Path]
+    """OUT.hdr, when the inputs' renders wrote NAME.hdr."""
+    report_path: Optional[Path]
+    """OUT.report.json (shards only), with the merged meters and grids."""
+    report: Optional[Dict[str, Any]]
+    renders: int
+    """Number of states merged."""
+    seeds: List[int]
+    samples_per_pixel: float
+    shards: Optional[Dict[str, Any]]
+    """For shards: ``count``, ``spp_per_shard``, ``merged``, ``missing``, ``unfinished``,
+    ``partial``; None for a merge of independent renders."""
+
+    @property
+    def Y(self) -> np.ndarray:
+        """Luminance, cd/m²."""
+        return self.channels["Y"]
+
+
+def merge(
+    states: List[Union[str, os.PathLike]],
+    out: Union[str, os.PathLike],
+    *,
+    exposure_ev: Optional[float] = None,
+    partial: bool = False,
+) -> MergeResult:
+    """Merge render states as ``candela merge`` does: independent renders of one scene
+    (different seeds), or the shards of one render in any order (the same bits whatever the
+    order). ``out`` names OUT (writes OUT.exr, OUT.png, OUT.state, and OUT.report.json for
+    shards) or an existing directory (DIR/merged.*). ``partial`` merges the shards present
+    even if some are missing or unfinished; without it such a merge raises
+    :class:`CandelaError` naming them."""
+    r = _candela.merge(
+        [os.fspath(p) for p in states], os.fspath(out), exposure_ev=exposure_ev, partial=partial
+    )
+    path = lambda p: None if p is None else Path(p)  # noqa: E731
+    return MergeResult(
+        channels=dict(r["channels"]),
+        exr_path=Path(r["exr_path"]),
+        png_path=Path(r["png_path"]),
+        state_path=Path(r["state_path"]),
+        hdr_path=path(r["hdr_path"]),
+        report_path=path(r["report_path"]),
+        report=None if r["report_json"] is None else json.loads(r["report_json"]),
+        renders=r["renders"],
+        seeds=list(r["seeds"]),
+        samples_per_pixel=r["samples_per_pixel"],
+        shards=r["shards"],
     )
 
 

@@ -35,8 +35,15 @@ def render(
     overwrite: bool = False,
     save_state: bool = False,
     falsecolour: bool = False,
+    shard: Optional[str] = None,
+    alpha_opic: bool = False,
+    mesopic: bool = False,
+    spectral_bands: int = 0,
     progress: Optional[Callable[[int, int, float], Optional[bool]]] = None,
     cancel: Any = None,
+) -> Dict[str, Any]: ...
+def merge(
+    states: List[str], out: str, *, exposure_ev: Optional[float] = None, partial: bool = False
 ) -> Dict[str, Any]: ...
 def scene_dict_to_ron(json: str) -> str: ...
 def check_scene_text(text: str, name: str) -> None: ...

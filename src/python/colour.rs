@@ -267,16 +267,16 @@ fn tm30<'py>(
     Ok(d)
 }
 
+/// Wavelengths (nm) and values of a spectrum, as numpy arrays.
+type SpectrumArrays<'py> = (
+    Bound<'py, numpy::PyArray1<f64>>,
+    Bound<'py, numpy::PyArray1<f64>>,
+);
+
 /// A named spectrum of candela's tables (`D65`, `A`, `FL2`, `LED-B3`, `TCS01`, …) at its own
 /// wavelengths: (wavelengths_nm, values).
 #[pyfunction]
-fn named_spectrum<'py>(
-    py: Python<'py>,
-    name: &str,
-) -> PyResult<(
-    Bound<'py, numpy::PyArray1<f64>>,
-    Bound<'py, numpy::PyArray1<f64>>,
-)> {
+fn named_spectrum<'py>(py: Python<'py>, name: &str) -> PyResult<SpectrumArrays<'py>> {
     let sd = crate::colour::tables::named_spectrum(name).ok_or_else(|| {
         error_msg(format!(
             "unknown spectrum {name:?}; known: {}",

@@ -9,7 +9,7 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// Channels of `layers` as (height, width) float32 arrays.
-fn channel_dict<'py>(
+pub(super) fn channel_dict<'py>(
     py: Python<'py>,
     layers: &crate::output::Layers,
 ) -> PyResult<Bound<'py, PyDict>> {

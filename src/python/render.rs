@@ -9,8 +9,6 @@ use crate::job::{self, ImageDone, Outcome, Progress, RenderJob};
 use crate::render::{PassStatus, TargetError};
 use crate::report::units::UnitSystem;
 use crate::scene::Overrides;
-use numpy::ndarray::Array2;
-use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -63,7 +61,8 @@ fn seconds(what: &str, s: Option<f64>) -> PyResult<Option<Duration>> {
     illuminance=false, caustics=None, exposure_ev=None, units="si", target_error=None,
     target_fraction=1.0, target_floor_cd_m2=None, max_spp=None, max_time_s=None,
     checkpoint_interval_s=None, resume=false, overwrite=false, save_state=false,
-    falsecolour=false, progress=None, cancel=None))]
+    falsecolour=false, shard=None, alpha_opic=false, mesopic=false, spectral_bands=0,
+    progress=None, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
@@ -87,6 +86,10 @@ fn render<'py>(
     overwrite: bool,
     save_state: bool,
     falsecolour: bool,
+    shard: Option<&str>,
+    alpha_opic: bool,
+    mesopic: bool,
+    spectral_bands: usize,
     progress: Option<Bound<'py, PyAny>>,
     cancel: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -142,8 +145,15 @@ fn render<'py>(
         overwrite,
         save_state,
         falsecolour,
-        shard: None,
-        health: Default::default(),
+        shard: shard
+            .map(job::shard::parse_from_env)
+            .transpose()
+            .map_err(error)?,
+        health: crate::film::HealthChannels {
+            melanopic: alpha_opic,
+            mesopic,
+            spectral_bands,
+        },
     };
     let stop = AtomicBool::new(false);
     let (tx, rx) = mpsc::channel();
@@ -249,13 +259,23 @@ fn result_dict<'py>(
     warnings: Vec<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let film = &outputs.render.film;
-    let layers = job::files::film_layers(&job.scene.display().to_string(), film, film.e.is_some());
-    let channels = PyDict::new(py);
-    for (name, values) in &layers.channels {
-        let a = Array2::from_shape_vec((layers.height, layers.width), values.clone())
-            .map_err(|e| error_msg(e.to_string()))?;
-        channels.set_item(name, a.into_pyarray(py))?;
+    let mut layers =
+        job::files::film_layers(&job.scene.display().to_string(), film, film.e.is_some());
+    if job.health.melanopic || job.health.mesopic {
+        // The light-and-health channels are derived as the EXR is written: take them from it.
+        let written = py
+            .detach(|| crate::output::read_exr(&outputs.exr_path))
+            .map_err(|e| error(e.into()))?;
+        let have: std::collections::HashSet<String> =
+            layers.channels.iter().map(|(n, _)| n.clone()).collect();
+        layers.channels.extend(
+            written
+                .channels
+                .into_iter()
+                .filter(|(n, _)| !have.contains(n)),
+        );
     }
+    let channels = super::files::channel_dict(py, &layers)?;
     let d = PyDict::new(py);
     d.set_item("channels", channels)?;
     let report = std::fs::read_to_string(&outputs.report_path)
@@ -273,7 +293,63 @@ fn result_dict<'py>(
     Ok(d)
 }
 
+/// Merges render states or shards as `candela merge` does ([`job::merge_with`]); see
+/// `candela.merge` (python/candela) for the result.
+#[pyfunction]
+#[pyo3(signature = (states, out, *, exposure_ev=None, partial=false))]
+fn merge<'py>(
+    py: Python<'py>,
+    states: Vec<PathBuf>,
+    out: PathBuf,
+    exposure_ev: Option<f64>,
+    partial: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let options = job::MergeOptions {
+        exposure_ev,
+        partial,
+    };
+    let m = py
+        .detach(|| job::merge_with(&states, &out, &options))
+        .map_err(error)?;
+    let layers = py
+        .detach(|| crate::output::read_exr(&m.exr_path))
+        .map_err(|e| error(e.into()))?;
+    let d = PyDict::new(py);
+    d.set_item("channels", super::files::channel_dict(py, &layers)?)?;
+    d.set_item("exr_path", &m.exr_path)?;
+    d.set_item("png_path", &m.png_path)?;
+    d.set_item("hdr_path", &m.hdr_path)?;
+    d.set_item("state_path", &m.state_path)?;
+    d.set_item("report_path", &m.report_path)?;
+    d.set_item("renders", m.renders)?;
+    d.set_item("seeds", &m.seeds)?;
+    d.set_item("samples_per_pixel", m.samples_per_pixel)?;
+    let shards = match &m.shards {
+        None => None,
+        Some(s) => {
+            let sd = PyDict::new(py);
+            sd.set_item("count", s.count)?;
+            sd.set_item("spp_per_shard", s.spp_per_shard)?;
+            sd.set_item("merged", &s.merged)?;
+            sd.set_item("missing", &s.missing)?;
+            sd.set_item("unfinished", &s.unfinished)?;
+            sd.set_item("partial", s.partial)?;
+            Some(sd)
+        }
+    };
+    d.set_item("shards", shards)?;
+    let report = match &m.report_path {
+        Some(p) => Some(
+            std::fs::read_to_string(p).map_err(|e| error_msg(format!("{}: {e}", p.display())))?,
+        ),
+        None => None,
+    };
+    d.set_item("report_json", report)?;
+    Ok(d)
+}
+
 pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(merge, m)?)?;
     Ok(())
 }
