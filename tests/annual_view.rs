@@ -28,19 +28,8 @@ const EYE: [f32; 3] = [0.0, 1.2, -0.5];
 const CAMERA: &str = "camera: (position: (0, 1.2, -0.5), look_at: (0, 1.2, 2), \
      projection: Fisheye(mapping: Equidistant, fov_deg: 180.0), resolution: (32, 32))";
 
-fn site() -> candela::light::sky::SiteFrame {
-    candela::light::sky::SiteFrame::new(glam::DVec3::Y, glam::DVec3::NEG_Z).unwrap()
-}
-
-/// (east, north, up) and scene directions toward the sun at altitude and azimuth (degrees).
-fn to_sun(alt: f64, az: f64) -> ([f64; 3], Vec3) {
-    let (a, z) = (alt.to_radians(), az.to_radians());
-    let enu = [a.cos() * z.sin(), a.cos() * z.cos(), a.sin()];
-    (enu, Vec3::new(enu[0] as f32, enu[2] as f32, -enu[1] as f32))
-}
-
 fn hour_sky(patches: &SkyPatches, dn: f64, dh: f64, alt: f64, az: f64) -> HourSky {
-    let enu = to_sun(alt, az).0;
+    let enu = common::to_sun(alt, az).0;
     HourSky {
         month: 6,
         day: 21,
@@ -80,7 +69,7 @@ fn an_hour_of_the_view_from_coefficients_equals_its_direct_render() {
         (300.0, 70.0, 12.0, 235.0),
         (500.0, 60.0, 10.0, 185.0),
     ];
-    let dirs: Vec<[f64; 3]> = hours.iter().map(|h| to_sun(h.2, h.3).0).collect();
+    let dirs: Vec<[f64; 3]> = hours.iter().map(|h| common::to_sun(h.2, h.3).0).collect();
     let sw = world(&format!(
         "({CAMERA}, {ROOM}, lights: [Sun(sun: (altitude_deg: 45.0, azimuth_deg: 180.0), \
          amount: NormalIlluminance(1.0))])"
@@ -90,7 +79,7 @@ fn an_hour_of_the_view_from_coefficients_equals_its_direct_render() {
     vm.add_sun(
         &mut sun_world,
         &camera,
-        &site(),
+        &common::default_site(),
         &dirs,
         45.0,
         &settings,
@@ -109,7 +98,7 @@ fn an_hour_of_the_view_from_coefficients_equals_its_direct_render() {
         let dgp_m = candela::glare::indices::evaluate_luminance(&vm.image, &lum, &options).dgp;
         if h == 3 {
             // The disk alone: E_n cos θ T(θ).
-            let s = to_sun(alt, az).1;
+            let s = common::to_sun(alt, az).1;
             let view = (Vec3::new(0.0, 1.2, 2.0) - Vec3::from(EYE)).normalize();
             let expected = hs.sky.direct_normal_lx
                 * s.dot(view) as f64

@@ -50,18 +50,6 @@ fn sun_world(room: &str) -> candela::world::World {
     w.relit(lights)
 }
 
-/// The default site frame: up +y, north −z.
-fn site() -> candela::light::sky::SiteFrame {
-    candela::light::sky::SiteFrame::new(glam::DVec3::Y, glam::DVec3::NEG_Z).unwrap()
-}
-
-fn to_sun(alt: f64, az: f64) -> ([f64; 3], Vec3) {
-    let (a, z) = (alt.to_radians(), az.to_radians());
-    let enu = [a.cos() * z.sin(), a.cos() * z.cos(), a.sin()];
-    // Default site: up +y, north −z, east +x.
-    (enu, Vec3::new(enu[0] as f32, enu[2] as f32, -enu[1] as f32))
-}
-
 #[test]
 fn an_hour_with_its_sun_from_coefficients_equals_its_direct_render() {
     let patches = SkyPatches::new(4).unwrap();
@@ -73,13 +61,13 @@ fn an_hour_with_its_sun_from_coefficients_equals_its_direct_render() {
         (650.0, 110.0, 55.0, 190.0),
         (300.0, 70.0, 12.0, 235.0),
     ];
-    let dirs: Vec<[f64; 3]> = hours.iter().map(|h| to_sun(h.2, h.3).0).collect();
+    let dirs: Vec<[f64; 3]> = hours.iter().map(|h| common::to_sun(h.2, h.3).0).collect();
     let mut sw = sun_world(ROOM);
     let s: SunCoefficients = sun_coefficients(
         &mut sw,
         &receivers,
         &dirs,
-        &site(),
+        &common::default_site(),
         45.0,
         1 << 16,
         256,
@@ -102,7 +90,7 @@ fn an_hour_with_its_sun_from_coefficients_equals_its_direct_render() {
             &patches,
             dh,
             dn,
-            to_sun(alt, az).0,
+            common::to_sun(alt, az).0,
             1.0,
             DEFAULT_DEW_POINT_C,
             0.2,
@@ -153,7 +141,7 @@ fn an_hour_with_its_sun_from_coefficients_equals_its_direct_render() {
 fn direct_sun_behind_the_pane_is_cosine_times_slab_transmittance() {
     // The high sun (55°, azimuth 190°) lights point 0 through the pane (checked below: the
     // ray to the sun's centre crosses the window).
-    let (enu, dir) = to_sun(55.0, 190.0);
+    let (enu, dir) = common::to_sun(55.0, 190.0);
     let p = Vec3::from(POINTS[0]);
     let t = (2.0 - p.z) / dir.z;
     let at = p + dir * t;
@@ -163,7 +151,7 @@ fn direct_sun_behind_the_pane_is_cosine_times_slab_transmittance() {
         &mut sw,
         &[(p, Vec3::Y)],
         &[enu],
-        &site(),
+        &common::default_site(),
         45.0,
         16,
         4096,
@@ -317,7 +305,7 @@ fn sun_coefficients_need_a_unit_sun() {
             &mut w,
             &[(Vec3::Y, Vec3::Y)],
             &[[0.0, 0.0, 1.0]],
-            &site(),
+            &common::default_site(),
             45.0,
             16,
             16,

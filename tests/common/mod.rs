@@ -332,3 +332,19 @@ pub const SIDE_LIT_PORTAL: &str =
 /// A one-pixel camera inside the side-lit room.
 pub const SIDE_LIT_CAMERA: &str =
     "camera: (position: (0, 1, 0), look_at: (0, 1, 1), vfov_deg: 30, resolution: (1, 1))";
+
+/// The default site frame of a scene: up +y, north −z, east +x.
+pub fn default_site() -> candela::light::sky::SiteFrame {
+    candela::light::sky::SiteFrame::new(glam::DVec3::Y, glam::DVec3::NEG_Z).unwrap()
+}
+
+/// (east, north, up) and scene directions (default site) toward the sun at altitude and azimuth
+/// (degrees, azimuth from north through east).
+pub fn to_sun(alt_deg: f64, az_deg: f64) -> ([f64; 3], glam::Vec3) {
+    let (a, z) = (alt_deg.to_radians(), az_deg.to_radians());
+    let enu = [a.cos() * z.sin(), a.cos() * z.cos(), a.sin()];
+    (
+        enu,
+        glam::Vec3::new(enu[0] as f32, enu[2] as f32, -enu[1] as f32),
+    )
+}
