@@ -554,17 +554,20 @@ impl Film {
             ));
         }
         let at = |i: usize| (i % self.width, i / self.width);
-        let first = self.pixels[0].count;
+        // Passes give every pixel the same number of samples, or, in adaptive mode, the same
+        // number to each buffer of a pixel; pixels no ray leaves (outside a fisheye's circle)
+        // hold none.
+        let most = self.pixels.iter().map(|p| p.count).max().unwrap_or(0);
         for (i, p) in self.pixels.iter().enumerate() {
-            // Passes give every pixel the same number of samples, or, in adaptive mode, the same
-            // number to each buffer of a pixel.
-            let expected = self.decision.as_ref().map_or(first, |d| d[i].count);
-            if p.count != expected {
+            let ok = match &self.decision {
+                Some(d) => p.count == d[i].count,
+                None => p.count == most || p.count == 0,
+            };
+            if !ok {
                 let (x, y) = at(i);
-                return Err(if self.decision.is_some() {
-                    format!("pixel ({x}, {y}) has {} image samples but {expected} decision samples (adaptive passes give both buffers as many)", p.count)
-                } else {
-                    format!("pixel ({x}, {y}) has {} samples but pixel (0, 0) has {expected} (every pass gives every pixel as many)", p.count)
+                return Err(match &self.decision {
+                    Some(d) => format!("pixel ({x}, {y}) has {} image samples but {} decision samples (adaptive passes give both buffers as many)", p.count, d[i].count),
+                    None => format!("pixel ({x}, {y}) has {} samples but other pixels have {most} (every pass gives every pixel of the image as many)", p.count),
                 });
             }
         }

@@ -582,3 +582,99 @@ fn a_shard_stopped_by_sigterm_continues_to_the_uninterrupted_state() {
         "the requeued shard's state differs from the uninterrupted one"
     );
 }
+
+#[test]
+fn fisheye_shards_merge_and_resume_with_the_pixels_outside_the_circle_unsampled() {
+    let t = tempfile::tempdir().unwrap();
+    let dir = t.path();
+    let text = FURNACE.replace("REFLECTANCE", &RHO.to_string()).replace(
+        "vfov_deg: 90, resolution: (20, 16)",
+        "projection: Fisheye(mapping: Equidistant, fov_deg: 180.0), resolution: (16, 16)",
+    );
+    std::fs::write(dir.join("f.ron"), text).unwrap();
+    for i in [1, 0] {
+        shard(dir, "f.ron", "r", i, 2, 4);
+    }
+    let states = [shard_state("r", 0, 2), shard_state("r", 1, 2)];
+    let (code, stdout, err) = merge(dir, &states, "m", &[]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("merged shards [0, 1] of 2"), "{stdout}");
+    let (code, _, err) = run_env(
+        dir,
+        &[
+            "render",
+            "f.ron",
+            "--quiet",
+            "--threads",
+            "2",
+            "--spp",
+            "8",
+            "--save-state",
+            "--out",
+            "one",
+        ],
+        &[],
+    );
+    assert_eq!(code, 0, "{err}");
+    let merged = candela::state::RenderState::load(&dir.join("m.state")).unwrap();
+    let one = candela::state::RenderState::load(&dir.join("one.state")).unwrap();
+    let (mut outside, mut inside, mut means) = (0, 0, Vec::new());
+    for (i, (a, b)) in merged.film.pixels.iter().zip(&one.film.pixels).enumerate() {
+        assert_eq!(a.count, b.count);
+        assert!(
+            rel_close(a.sum_xyz[1], b.sum_xyz[1]),
+            "{} vs {}",
+            a.sum_xyz[1],
+            b.sum_xyz[1]
+        );
+        match a.count {
+            0 => outside += 1,
+            8 => inside += 1,
+            c => panic!("a pixel holds {c} samples: neither none nor all 8"),
+        }
+        // Pixels wholly inside the circle (those it cuts average in the black outside).
+        let (x, y) = ((i % 16) as f64, (i / 16) as f64);
+        let far = |c: f64| (c - 8.0).abs().max((c - 7.0).abs());
+        if far(x).powi(2) + far(y).powi(2) < 64.0 {
+            means.push(a.sum_xyz[1] / 8.0);
+        }
+    }
+    // The pixels whose square meets the 180° fisheye's circle (radius 8 pixels) are sampled,
+    // the others, in the corners, hold none.
+    let meets = (0..256)
+        .filter(|i| {
+            let (x, y) = ((i % 16) as f64, (i / 16) as f64);
+            let (nx, ny) = (8f64.clamp(x, x + 1.0), 8f64.clamp(y, y + 1.0));
+            (nx - 8.0).powi(2) + (ny - 8.0).powi(2) < 64.0
+        })
+        .count();
+    assert_eq!((inside, outside), (meets, 256 - meets));
+    // Every direction of the furnace sees 1/(1 − ρ) cd/m² (the pixels are independent: the
+    // mean within 4 standard errors from their spread).
+    let k = means.len() as f64;
+    let mean = means.iter().sum::<f64>() / k;
+    let var = means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (k - 1.0);
+    let exact = 1.0 / (1.0 - RHO);
+    assert!(
+        (mean - exact).abs() < 4.0 * (var / k).sqrt(),
+        "mean {mean}, exact {exact}"
+    );
+    // The fisheye render continues from its state to more samples.
+    let (code, _, err) = run_env(
+        dir,
+        &[
+            "render",
+            "f.ron",
+            "--quiet",
+            "--threads",
+            "2",
+            "--spp",
+            "12",
+            "--resume",
+            "--out",
+            "one",
+        ],
+        &[],
+    );
+    assert_eq!(code, 0, "{err}");
+}
