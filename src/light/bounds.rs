@@ -170,17 +170,56 @@ impl LightBounds {
         self.phi * self.orientation_measure() * area.max(1e-12) * kr
     }
 
+    /// Importance for a receiver at `p` (m) with unit normal `n`; see
+    /// [`NodeBounds::importance`].
+    pub fn importance(&self, p: Vec3, n: Option<Vec3>) -> f32 {
+        NodeBounds::from(self).importance(p, n)
+    }
+}
+
+/// [`LightBounds`] as the light BVH's nodes keep them for sampling: what the importance of
+/// every shading point needs, with the bounding sphere and sin θ_o computed once.
+#[derive(Clone, Copy, Debug)]
+pub struct NodeBounds {
+    /// Centre of the box and squared radius of its bounding sphere, m and m².
+    centre: Vec3,
+    r2: f32,
+    /// Power, lm.
+    pub phi: f32,
+    w: Vec3,
+    cos_o: f32,
+    sin_o: f32,
+    cos_e: f32,
+    two_sided: bool,
+}
+
+impl From<&LightBounds> for NodeBounds {
+    fn from(b: &LightBounds) -> Self {
+        NodeBounds {
+            centre: b.centroid(),
+            r2: 0.25 * (b.hi - b.lo).length_squared(),
+            phi: b.phi,
+            w: b.axes.w,
+            cos_o: b.axes.cos_theta,
+            sin_o: sin_of(b.axes.cos_theta),
+            cos_e: b.cos_e,
+            two_sided: b.two_sided,
+        }
+    }
+}
+
+impl NodeBounds {
     /// Importance for a receiver at `p` (m) with unit normal `n` (None: a point without a
     /// surface, e.g. inside a medium): φ × bounded cos at the emitter × bounded |cos| at the
     /// receiver / clamped squared distance, lm·m⁻². It is zero only where no light of the
     /// bounds can send anything to `p` (or every light lies exactly in the tangent plane).
+    #[inline]
     pub fn importance(&self, p: Vec3, n: Option<Vec3>) -> f32 {
         if self.phi <= 0.0 {
             return 0.0;
         }
-        let c = self.centroid();
-        let r2 = 0.25 * (self.hi - self.lo).length_squared();
-        let v = p - c;
+        let r2 = self.r2;
+        let v = p - self.centre;
         let dist2 = v.length_squared();
         if dist2 <= r2 || dist2 == 0.0 || !dist2.is_finite() {
             // Inside the bounding sphere: every direction is possible.
@@ -194,13 +233,12 @@ impl LightBounds {
         let sin2_b = r2 / dist2;
         let (sin_b, cos_b) = (sin2_b.sqrt(), (1.0 - sin2_b).max(0.0).sqrt());
 
-        let mut cos_w = self.axes.w.dot(wi);
+        let mut cos_w = self.w.dot(wi);
         if self.two_sided {
             cos_w = cos_w.abs();
         }
         let sin_w = sin_of(cos_w);
-        let cos_o = self.axes.cos_theta;
-        let sin_o = sin_of(cos_o);
+        let (cos_o, sin_o) = (self.cos_o, self.sin_o);
         // θ' = max(0, θ_w − θ_o − θ_b): the smallest angle between an emitter's axis and the
         // direction from one of its points to p.
         let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, cos_o);

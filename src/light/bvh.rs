@@ -22,7 +22,7 @@
 //! heuristic over 12 buckets of the centroids along each axis; below depth [`MEDIAN_DEPTH`] it
 //! splits at the median instead, which keeps every trail within 64 bits.
 
-use super::bounds::LightBounds;
+use super::bounds::{LightBounds, NodeBounds};
 use glam::Vec3;
 
 /// Depth below which nodes are split at the median (count), so the tree is at most
@@ -42,7 +42,7 @@ pub struct Emitter {
 
 #[derive(Clone, Debug)]
 struct Node {
-    bounds: LightBounds,
+    bounds: NodeBounds,
     /// Interior: index of the second child (the first follows the node). Leaf: emitter index.
     index: u32,
     leaf: bool,
@@ -106,7 +106,7 @@ impl LightBvh {
             let e = items[0];
             self.trails[e as usize] = trail;
             self.nodes.push(Node {
-                bounds: self.emitters[e as usize].bounds,
+                bounds: NodeBounds::from(&self.emitters[e as usize].bounds),
                 index: e,
                 leaf: true,
             });
@@ -118,7 +118,7 @@ impl LightBvh {
             .reduce(|a, b| LightBounds::union(&a, &b))
             .expect("a node has emitters");
         self.nodes.push(Node {
-            bounds,
+            bounds: NodeBounds::from(&bounds),
             index: 0,
             leaf: false,
         });
