@@ -412,7 +412,8 @@ pub fn render(a: &RenderOpts) -> Result<()> {
         let html = out.exr_path.with_extension("html");
         let r = candela::report::html::write_html_report(
             &out.exr_path,
-            Some(&out.report_path),
+            // A shard's render writes no report: its page has the image only.
+            Some(out.report_path.as_path()).filter(|p| p.is_file()),
             glare.as_ref(),
             &html,
         )?;

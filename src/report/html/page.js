@@ -256,11 +256,17 @@
     $("p-cct").textContent = t.cct;
     $("p-srgb-linear").textContent = t.srgbLinear;
     $("p-srgb-encoded").textContent = t.srgbEncoded;
+    placeMarker();
+  }
+  // The marker follows the layout (the legend, the window's size and the zoom change it).
+  function placeMarker() {
+    if (state.px === null) return;
+    const [x, y] = state.px;
     const c = $("image"), m = $("marker");
     const sx = c.clientWidth / W, sy = c.clientHeight / H;
     m.hidden = false;
-    m.style.left = `${c.offsetLeft + x * sx}px`;
-    m.style.top = `${c.offsetTop + y * sy}px`;
+    m.style.left = `${c.offsetLeft + c.clientLeft + x * sx}px`;
+    m.style.top = `${c.offsetTop + c.clientTop + y * sy}px`;
     m.style.width = `${Math.max(sx, 3)}px`;
     m.style.height = `${Math.max(sy, 3)}px`;
     m.classList.toggle("pinned", state.pinned);
@@ -329,6 +335,7 @@
     }
     ctx.putImageData(img, 0, 0);
     drawLegend();
+    placeMarker();
     $("caption").textContent = state.fc
       ? `False colour of ${state.fcQ} (${state.fcScale} scale, ${state.palette}) of ${D.file}, ${W}×${H} pixels.`
       : `${D.file}, ${W}×${H} pixels, sRGB at ${fixed(state.ev, 1)} EV (ISO 100: ${sig(0.125 * Math.pow(2, state.ev), 3)} cd/m² shows as 18 % grey).`;
@@ -493,6 +500,7 @@
       e.preventDefault();
       setProbe([x, y]);
     });
+    window.addEventListener("resize", placeMarker);
     c.addEventListener("focus", () => { if (state.px === null) setProbe([Math.floor(W / 2), Math.floor(H / 2)]); });
     const ev = $("ev");
     ev.value = state.ev;
