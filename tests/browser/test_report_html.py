@@ -260,6 +260,19 @@ def test_probe_false_colour_units_and_no_network(render, candela, driver):
     driver.find_element(By.ID, "units-imperial").click()
     assert text(driver, "legend-title") == "illuminance (fc), log scale"
     check_probe(driver, candela, exr, 21, 11, "imperial")
+    canvas.send_keys(Keys.ESCAPE)
+    for x, y in [(30, 28), (2, 12), (40, 20)]:
+        hover(driver, x, y, size)
+        check_probe(driver, candela, exr, x, y, "imperial")
+
+    # A range typed in: the legend runs from its minimum to its maximum.
+    Select(driver.find_element(By.ID, "fc-scale")).select_by_value("linear")
+    for id_, v in (("fc-min", "2"), ("fc-max", "12")):
+        field = driver.find_element(By.ID, id_)
+        field.clear()
+        field.send_keys(v, Keys.TAB)
+    ticks = driver.execute_script("return [...document.querySelectorAll('#legend-ticks li')].map(e => e.textContent)")
+    assert ticks == ["2", "3", "4", "5", "6", "7", "8", "9", "10", "11", "12"], ticks
     report = json.loads((render / "room.report.json").read_text())
     g = report["grids"][0]
     caption = text(driver, "grids").replace("\u202f", " ")
