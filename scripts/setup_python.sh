@@ -20,7 +20,9 @@ PYTHON="${PYTHON:-python3}"
 # which imports scipy and matplotlib at start-up; OpenImageIO 3.2.2.0, through which
 # colour-science reads spectral OpenEXR files (tests/health_render.rs). numpy stays below 2.4:
 # luxpy 1.12.5 calls float() on 1-element arrays, which numpy 2.4 refuses. maturin 1.16.0 builds
-# the Python package into this venv and pytest 9.2.0 runs its tests (tests/python/).
+# the Python package into this venv and pytest 9.2.0 runs its tests (tests/python/); selenium
+# 4.51.0 drives Debian's chromium through chromium-driver in the HTML report's browser test
+# (tests/browser/).
 PINS=(
   "colour-science==0.4.7"
   "numpy==2.3.5"
@@ -33,6 +35,7 @@ PINS=(
   "maturin==1.16.0"
   "pytest==9.2.0"
   "openimageio==3.2.2.0"
+  "selenium==4.51.0"
 )
 
 if [ ! -x "$VENV/bin/python" ]; then

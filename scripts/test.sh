@@ -3,7 +3,8 @@
 #   bash scripts/test.sh
 # It installs the Python reference (colour-science, pinned) into target/venv when missing, runs
 # the whole Rust test suite (optimised: [profile.test] opt-level = 3), then builds the Python
-# package into target/venv and runs its tests (tests/python/).
+# package into target/venv and runs its tests (tests/python/), and the HTML report's end-to-end
+# test in headless Chromium (tests/browser/).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup_python.sh
@@ -12,6 +13,14 @@ if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null && ! command -v slurmctld
     { apt-get update -qq &&
         DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends slurm-wlm munge; } ||
         echo "test.sh: slurm-wlm and munge could not be installed; tests/slurm.rs will skip" >&2
+fi
+# tests/browser/ opens the HTML report in headless Chromium through chromedriver: as root,
+# install Debian's packages when missing.
+if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null &&
+    ! { command -v chromium >/dev/null && command -v chromedriver >/dev/null; }; then
+    { apt-get update -qq &&
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium chromium-driver; } ||
+        echo "test.sh: chromium and chromium-driver could not be installed; tests/browser will fail" >&2
 fi
 export CANDELA_PYTHON="${CANDELA_PYTHON:-$PWD/target/venv/bin/python}"
 cargo test --all-targets "$@"
@@ -22,3 +31,6 @@ cargo test --all-targets "$@"
 # pins), then its tests (finding none, pytest exits 5: a failure).
 VIRTUAL_ENV="$PWD/target/venv" target/venv/bin/maturin develop --quiet
 target/venv/bin/python -m pytest -q -p no:cacheprovider -p no:warnings tests/python
+# The HTML report in headless Chromium (selenium, pinned above), with the candela binary that
+# `cargo test` built (target/debug/candela); screenshots and a PDF print go to target/browser/.
+target/venv/bin/python -m pytest -q -p no:cacheprovider -p no:warnings tests/browser

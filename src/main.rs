@@ -92,6 +92,8 @@ enum Command {
     Probe(cli::probe::ProbeArgs),
     /// False-colour PNG of luminance or illuminance with a legend; see docs/reports.md.
     Falsecolour(cli::falsecolour::FalsecolourArgs),
+    /// Self-contained HTML report of a render (NAME.html): the image with a pixel probe, false colour, grids, meters; see docs/report-html.md.
+    Report(cli::report::ReportArgs),
     /// Glare of a fisheye luminance image (DGP, UGR, DGI, VCP, CGI, E_v with 95 % intervals, the glare sources), as evalglare computes them; see docs/glare.md.
     Glare(cli::glare::GlareArgs),
     /// A year of daylight on the scene's grids from an EPW weather file: DA, cDA, UDI, sDA, ASE, EN 17037 with 95 % intervals, hourly illuminance (NAME.annual.json, NAME.annual.csv); see docs/annual.md.
@@ -147,6 +149,7 @@ fn main() -> ExitCode {
             }
         }),
         Command::Falsecolour(args) => cli::falsecolour::run(&args).map(|s| say_raw!("{s}")),
+        Command::Report(args) => cli::report::run(&args).map(|s| say_raw!("{s}")),
         Command::Annual(args) => cli::annual::run(&args).map(|s| say_raw!("{s}")),
         Command::Glare(args) => cli::glare::run(&args).map(|s| {
             if args.json {

@@ -9,6 +9,7 @@ pub mod glare;
 pub mod luminaire;
 pub mod probe;
 pub mod render;
+pub mod report;
 
 /// Longest line printed, in characters: a message quoting a huge input field stays readable.
 const MAX_LINE_CHARS: usize = 4096;

@@ -89,6 +89,9 @@ pub struct RenderOpts {
     /// Also keep N spectral bands (1 to 64) of equal width over 380–780 nm per pixel and write NAME.spectral.exr (spectral radiance, Fichet et al. 2021 layout). Not with --resume or --shard.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
     spectral_bands: u16,
+    /// Also write NAME.html, the self-contained HTML report (image with pixel probe, false colour, grids, meters, and the glare evaluation with --glare), as `candela report` does; see docs/report-html.md.
+    #[arg(long)]
+    report_html: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -397,6 +400,24 @@ pub fn render(a: &RenderOpts) -> Result<()> {
         let report =
             super::glare::run(&super::glare::GlareArgs::defaults_for(out.exr_path.clone()))?;
         say!("glare of {}:\n{}", shown(&out.exr_path), report.trim_end());
+    }
+    if a.report_html {
+        let glare = if a.glare {
+            let mut args = super::glare::GlareArgs::defaults_for(out.exr_path.clone());
+            args.json = true;
+            Some(serde_json::from_str(&super::glare::run(&args)?)?)
+        } else {
+            None
+        };
+        let html = out.exr_path.with_extension("html");
+        let r = candela::report::html::write_html_report(
+            &out.exr_path,
+            // A shard's render writes no report: its page has the image only.
+            Some(out.report_path.as_path()).filter(|p| p.is_file()),
+            glare.as_ref(),
+            &html,
+        )?;
+        say!("wrote {} ({:.2} MB)", shown(&r.path), r.bytes as f64 / 1e6);
     }
     Ok(())
 }

@@ -1,8 +1,10 @@
 //! Photometric reports (issue 5): the JSON report and grid CSVs, false-colour maps, grid heat
-//! maps and the pixel probe. See `docs/report-json.md` and `docs/reports.md`.
+//! maps, the pixel probe and the self-contained HTML report. See `docs/report-json.md`,
+//! `docs/reports.md` and `docs/report-html.md`.
 
 pub mod falsecolour;
 pub mod heatmap;
+pub mod html;
 pub mod json;
 pub mod probe;
 pub mod spectrum;
