@@ -269,6 +269,7 @@ pub fn build_for(
     let mut scene_object: Vec<usize> = Vec::with_capacity(scene.objects.len());
     let mut objects = Vec::with_capacity(scene.objects.len());
     let mut pending_area: Vec<(u32, String, EmissionDesc, DenseSpectrum)> = Vec::new();
+    let mut model_lights: Vec<(String, LightDesc)> = Vec::new();
     let lookup = |field: &str, name: &str| -> Result<u32, SceneError> {
         material_index.get(name).copied().ok_or_else(|| {
             let mut known: Vec<&str> = material_index.keys().copied().collect();
@@ -316,6 +317,52 @@ pub fn build_for(
                 file,
                 materials_from_file,
                 ke_luminance,
+                lights,
+            } if geometry::gltf::is_gltf(file) => {
+                let field = format!("{field}.shape");
+                if ke_luminance.is_some() {
+                    return Err(ctx.err(format!("{field}.ke_luminance"), "applies to OBJ models; a glTF material's emission is in cd/m² already (emissive_strength)"));
+                }
+                let model = geometry::gltf::load_gltf(&ctx.resolve(file))
+                    .map_err(|e| geometry::mesh_err(&ctx, &field, file, e))?;
+                if *lights {
+                    for (k, l) in model.lights.iter().enumerate() {
+                        let l = geometry::gltf::materials::placed(l, transform.as_ref());
+                        let at = format!("{field}.lights[{k}]");
+                        if let Some(d) = geometry::gltf::materials::light(&ctx, &at, &l)? {
+                            model_lights.push((at, d));
+                        }
+                    }
+                }
+                geometry::gltf::materials::parts(
+                    &ctx,
+                    &field,
+                    &model,
+                    materials_from_file,
+                    &o.material,
+                    &lookup,
+                    &mut materials,
+                )?
+                .into_iter()
+                .map(|p| Part {
+                    shape: p.shape,
+                    uvs: p.uvs,
+                    material: p.material,
+                    emission: p.emission,
+                })
+                .collect()
+            }
+            ShapeDesc::Model { lights: true, .. } => {
+                return Err(ctx.err(
+                    format!("{field}.shape.lights"),
+                    "only a glTF model (.gltf, .glb) has lights",
+                ));
+            }
+            ShapeDesc::Model {
+                file,
+                materials_from_file,
+                ke_luminance,
+                ..
             } => model_parts(
                 &ctx,
                 &field,
@@ -414,6 +461,9 @@ pub fn build_for(
         }
         lights.push(light);
     };
+    for (field, l) in &model_lights {
+        push(build_light(&ctx, field, l)?, &mut lights);
+    }
     for (i, l) in scene.lights.iter().enumerate() {
         let field = format!("lights[{i}]");
         let light = match l {
