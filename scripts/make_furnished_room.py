@@ -129,7 +129,7 @@ def main():
          "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0.0}},
     ]
     room = [
-        b.primitive([((0, 0, 0), (0, 0, Z), (X, 0, 0))], 0, uv_per_m=0.5),
+        b.primitive([((0, 0, 0), (0, 0, Z), (X, 0, 0))], 0, uv_per_m=1.0),
         b.primitive([((0, H, 0), (X, 0, 0), (0, 0, Z))], 2),
         b.primitive([
             ((0, 0, 0), (0, H, 0), (0, 0, Z)),        # x = 0, facing +x

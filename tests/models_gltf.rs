@@ -728,3 +728,34 @@ fn gltf_materials_map_by_rule() {
         assert!((d.reflectance.value(nm) as f64 - fit.value(nm as f64)).abs() < 1e-6);
     }
 }
+
+/// The shipped furnished room keeps its shared chair mesh once, placed by four nodes whose
+/// world transforms compose the parent's translation with each chair's own, and its floor
+/// texture is embedded.
+#[test]
+fn furnished_room_keeps_shared_meshes_once() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/furnished-room.glb");
+    let m = candela::geometry::gltf::load_gltf(&path).unwrap();
+    let chair = m
+        .meshes
+        .iter()
+        .position(|x| x.name.as_deref() == Some("chair"))
+        .unwrap();
+    let placed: Vec<_> = m.instances.iter().filter(|i| i.mesh == chair).collect();
+    assert_eq!(placed.len(), 4);
+    let first = placed[0].world.transform_point3(glam::Vec3::ZERO);
+    assert!(
+        (first - glam::Vec3::new(2.2, 0.0, 2.3)).length() < 1e-5,
+        "{first}"
+    );
+    let per_chair: u64 = m.meshes[chair]
+        .primitives
+        .iter()
+        .map(|p| p.mesh.indices.len() as u64)
+        .sum();
+    assert!(m.flatten_count() > 4 * per_chair);
+    assert!(matches!(
+        m.images[0],
+        candela::geometry::gltf::GltfImage::Bytes { .. }
+    ));
+}
