@@ -341,6 +341,34 @@ fn punctual_lights_give_their_photometric_values() {
             e.stderr
         );
     }
+    // The object's transform moves the model's lights with it: the point light of the last
+    // .gltf moved 1 m along z is √5 m from the meter, 2 m above it: E = I·cos θ/d² = 100·(2/√5)/5.
+    write(
+        &Doc {
+            meshes: vec![floor()],
+            json: json!({
+                "extensionsUsed": ["KHR_lights_punctual"],
+                "extensions": {"KHR_lights_punctual": {"lights": [cases[0].0]}},
+                "nodes": [{"mesh": 0}, {"translation": [0.5, 2.0, 0.0], "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+                "scenes": [{"nodes": [0, 1]}],
+                "materials": floor_mat,
+            }),
+        },
+        dir.path(),
+        "l.gltf",
+    );
+    let text = light_scene(
+        "l.gltf",
+        r#"Illuminance(name: "m", position: (0.5, 0.001, 0.0), normal: (0, 1, 0))"#,
+    )
+    .replace("}))],", "}), transform: (translate: (0, 0, 1)))],");
+    let e = measure_all(&build(&text, dir.path())).meters[0];
+    let want = 100.0 * (2.0 / 5f64.sqrt()) / 5.0;
+    eprintln!(
+        "moved point light: {} ± {} lx, expected {want}",
+        e.mean, e.stderr
+    );
+    assert!((e.mean - want).abs() <= 5.0 * e.stderr && e.stderr < 0.01 * want);
     // Without `lights: true` the file's lights are left out.
     let text = light_scene(
         "l.gltf",
