@@ -616,6 +616,18 @@ fn bad_gltf_files_are_clear_errors() {
         stderr.contains("materials_from_file[\"flor\"]") && stderr.contains("floor"),
         "{stderr}"
     );
+    // `ke_luminance` is OBJ's; a glTF model's emission is already in cd/m².
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        "materials_from_file: { \"flor\": Material(Black) }",
+        "ke_luminance: 100.0",
+    );
+    std::fs::write(&path, text).unwrap();
+    let (code, _, stderr) = common::cli(&["render", "--quiet", "--out", "out", "scene.ron"], d);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("shape.ke_luminance") && stderr.contains("OBJ"),
+        "{stderr}"
+    );
     // And the good model renders, as .gltf and .glb.
     for file in ["m.gltf", "m.glb"] {
         write(&doc(), d, file);

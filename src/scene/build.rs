@@ -319,38 +319,24 @@ pub fn build_for(
                 ke_luminance,
                 lights,
             } if geometry::gltf::is_gltf(file) => {
-                let field = format!("{field}.shape");
-                if ke_luminance.is_some() {
-                    return Err(ctx.err(format!("{field}.ke_luminance"), "applies to OBJ models; a glTF material's emission is in cd/m² already (emissive_strength)"));
-                }
-                let model = geometry::gltf::load_gltf(&ctx.resolve(file))
-                    .map_err(|e| geometry::mesh_err(&ctx, &field, file, e))?;
-                if *lights {
-                    for (k, l) in model.lights.iter().enumerate() {
-                        let l = geometry::gltf::materials::placed(l, transform.as_ref());
-                        let at = format!("{field}.lights[{k}]");
-                        if let Some(d) = geometry::gltf::materials::light(&ctx, &at, &l)? {
-                            model_lights.push((at, d));
-                        }
-                    }
-                }
-                geometry::gltf::materials::parts(
+                let model = (file.as_str(), materials_from_file, *ke_luminance, *lights);
+                let at = format!("{field}.shape");
+                let (parts, found) = geometry::gltf::materials::model_parts(
                     &ctx,
-                    &field,
-                    &model,
-                    materials_from_file,
-                    &o.material,
-                    &lookup,
+                    &at,
+                    model,
+                    (transform.as_ref(), &o.material, &lookup),
                     &mut materials,
-                )?
-                .into_iter()
-                .map(|p| Part {
-                    shape: p.shape,
-                    uvs: p.uvs,
-                    material: p.material,
-                    emission: p.emission,
-                })
-                .collect()
+                )?;
+                model_lights.extend(found);
+                (parts.into_iter())
+                    .map(|p| Part {
+                        shape: p.shape,
+                        uvs: p.uvs,
+                        material: p.material,
+                        emission: p.emission,
+                    })
+                    .collect()
             }
             ShapeDesc::Model { lights: true, .. } => {
                 return Err(ctx.err(

@@ -333,3 +333,45 @@ pub fn parts(
     }
     Ok(out)
 }
+
+/// A `Model` object at `field` whose file is glTF: `(file, materials_from_file, ke_luminance,
+/// lights)` as the scene gives them, `(transform, fallback, lookup)` the object's transform, its
+/// `material` and the scene's material names. Returns its parts and, with `lights`, the file's
+/// lights placed by the transform (with the fields to name them by).
+#[allow(clippy::type_complexity)]
+pub fn model_parts(
+    ctx: &Context,
+    field: &str,
+    (file, overrides, ke_luminance, with_lights): (
+        &str,
+        &std::collections::BTreeMap<String, crate::description::schema::MaterialRefDesc>,
+        Option<f64>,
+        bool,
+    ),
+    (transform, fallback, lookup): (
+        Option<&crate::geometry::Transform>,
+        &str,
+        &dyn Fn(&str, &str) -> Result<u32, SceneError>,
+    ),
+    materials: &mut Vec<Material>,
+) -> Result<(Vec<GltfPart>, Vec<(String, LightDesc)>), SceneError> {
+    if ke_luminance.is_some() {
+        return Err(ctx.err(
+            format!("{field}.ke_luminance"),
+            "applies to OBJ models; a glTF material's emission is in cd/m² already (emissive_strength)",
+        ));
+    }
+    let model = super::load_gltf(&ctx.resolve(file))
+        .map_err(|e| crate::geometry::mesh_err(ctx, field, file, e))?;
+    let mut lights = Vec::new();
+    if with_lights {
+        for (k, l) in model.lights.iter().enumerate() {
+            let at = format!("{field}.lights[{k}]");
+            if let Some(d) = light(ctx, &at, &placed(l, transform))? {
+                lights.push((at, d));
+            }
+        }
+    }
+    let parts = parts(ctx, field, &model, overrides, fallback, lookup, materials)?;
+    Ok((parts, lights))
+}
