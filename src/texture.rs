@@ -62,6 +62,29 @@ pub struct Texture {
     pub offset: Vec2,
 }
 
+/// Refuses an image of `w × h` texels that is empty, over [`MAX_TEXELS`] or too large for the
+/// memory available.
+fn check_size(path: &Path, w: u64, h: u64) -> Result<(), TextureError> {
+    let err = |message: String| TextureError {
+        path: path.to_path_buf(),
+        message,
+    };
+    let n = w.saturating_mul(h);
+    if w == 0 || h == 0 {
+        return Err(err("the image has no pixels".into()));
+    }
+    if n > MAX_TEXELS {
+        return Err(err(format!(
+            "the image is {w}×{h} pixels, more than the {MAX_TEXELS} texels a texture may have"
+        )));
+    }
+    crate::limits::check_memory(
+        n.saturating_mul(LOAD_BYTES_PER_TEXEL),
+        &format!("loading this {w}×{h} texture"),
+    )
+    .map_err(err)
+}
+
 /// The sigmoid S(x) = ½ + x / (2√(1+x²)) in f32 (exactly 0 or 1 beyond |x| = 10¹⁰).
 #[inline(always)]
 fn sigmoid(x: f32) -> f32 {
@@ -116,22 +139,7 @@ impl Texture {
         };
         let bytes = crate::limits::read_file(path, MAX_TEXTURE_FILE_BYTES)
             .map_err(|e| err(e.to_string()))?;
-        let check = |w: u64, h: u64| -> Result<(), TextureError> {
-            let n = w.saturating_mul(h);
-            if w == 0 || h == 0 {
-                return Err(err("the image has no pixels".into()));
-            }
-            if n > MAX_TEXELS {
-                return Err(err(format!(
-                    "the image is {w}×{h} pixels, more than the {MAX_TEXELS} texels a texture may have"
-                )));
-            }
-            crate::limits::check_memory(
-                n.saturating_mul(LOAD_BYTES_PER_TEXEL),
-                &format!("loading this {w}×{h} texture"),
-            )
-            .map_err(err)
-        };
+        let check = |w: u64, h: u64| check_size(path, w, h);
         if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
             drop(bytes);
             let layers = crate::output::read_exr(path).map_err(|e| err(e.to_string()))?;
@@ -151,7 +159,19 @@ impl Texture {
                 &texels,
             ));
         }
-        let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        Self::decode(path, &bytes, [1.0; 3])
+    }
+
+    /// A texture from the bytes of a PNG or JPEG image (sRGB-encoded; alpha ignored), each
+    /// texel's linear colour multiplied by `tint` (in [0, 1]) before upsampling; `path` names it
+    /// in messages. Checked as [`Texture::load`].
+    pub fn decode(path: &Path, bytes: &[u8], tint: [f32; 3]) -> Result<Texture, TextureError> {
+        let err = |message: String| TextureError {
+            path: path.to_path_buf(),
+            message,
+        };
+        let check = |w: u64, h: u64| check_size(path, w, h);
+        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| err(e.to_string()))?;
         match reader.format() {
@@ -166,7 +186,7 @@ impl Texture {
             .into_dimensions()
             .map_err(|e| err(format!("cannot read its header: {e}")))?;
         check(w as u64, h as u64)?;
-        let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| err(e.to_string()))?;
         let mut limits = image::Limits::default();
@@ -177,13 +197,18 @@ impl Texture {
         let img = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))
             .map_err(|_| err("the image decoder failed on malformed input".into()))?
             .map_err(|e| err(e.to_string()))?;
-        drop(bytes);
         let rgb = img.to_rgb8();
         drop(img);
         let lut: Vec<f32> = (0..=255u8)
             .map(|v| crate::colour::rgb::srgb_decode(v as f64 / 255.0) as f32)
             .collect();
-        let texels: Vec<[f32; 3]> = rgb.pixels().map(|p| p.0.map(|v| lut[v as usize])).collect();
+        let texels: Vec<[f32; 3]> = rgb
+            .pixels()
+            .map(|p| {
+                let c = p.0.map(|v| lut[v as usize]);
+                [c[0] * tint[0], c[1] * tint[1], c[2] * tint[2]]
+            })
+            .collect();
         drop(rgb);
         Ok(Texture::from_linear_rgb(w, h, &texels))
     }

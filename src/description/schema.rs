@@ -548,9 +548,10 @@ pub enum ShapeDesc {
     Obj(String),
     /// PLY file (ASCII or binary), relative to the scene file.
     Ply(String),
-    /// A building model: an OBJ file (relative to the scene file) whose faces keep the
-    /// materials of its MTL libraries, mapped to candela materials (docs/scene-format.md →
-    /// models); `materials_from_file` replaces some of them by name.
+    /// A building model: an OBJ file whose faces keep the materials of its MTL libraries, or a
+    /// glTF 2.0 file (`.gltf`, `.glb`) with its node hierarchy and materials (relative to the
+    /// scene file), mapped to candela materials (docs/scene-format.md → models);
+    /// `materials_from_file` replaces some of them by name.
     Model {
         file: String,
         #[serde(default, deserialize_with = "unique_override_keys")]
@@ -559,6 +560,9 @@ pub enum ShapeDesc {
         /// with a non-zero `Ke` emit (none do without it).
         #[serde(default)]
         ke_luminance: Option<f64>,
+        /// glTF only: add the file's `KHR_lights_punctual` lights (cd, lx) to the scene.
+        #[serde(default)]
+        lights: bool,
     },
 }
 

@@ -35,6 +35,7 @@
 
 mod bvh;
 mod desc;
+pub mod gltf;
 mod io;
 pub mod mtl;
 mod prim;

@@ -269,6 +269,7 @@ pub fn build_for(
     let mut scene_object: Vec<usize> = Vec::with_capacity(scene.objects.len());
     let mut objects = Vec::with_capacity(scene.objects.len());
     let mut pending_area: Vec<(u32, String, EmissionDesc, DenseSpectrum)> = Vec::new();
+    let mut model_lights: Vec<(String, LightDesc)> = Vec::new();
     let lookup = |field: &str, name: &str| -> Result<u32, SceneError> {
         material_index.get(name).copied().ok_or_else(|| {
             let mut known: Vec<&str> = material_index.keys().copied().collect();
@@ -316,6 +317,38 @@ pub fn build_for(
                 file,
                 materials_from_file,
                 ke_luminance,
+                lights,
+            } if geometry::gltf::is_gltf(file) => {
+                let model = (file.as_str(), materials_from_file, *ke_luminance, *lights);
+                let at = format!("{field}.shape");
+                let (parts, found) = geometry::gltf::materials::model_parts(
+                    &ctx,
+                    &at,
+                    model,
+                    (transform.as_ref(), &o.material, &lookup),
+                    &mut materials,
+                )?;
+                model_lights.extend(found);
+                (parts.into_iter())
+                    .map(|p| Part {
+                        shape: p.shape,
+                        uvs: p.uvs,
+                        material: p.material,
+                        emission: p.emission,
+                    })
+                    .collect()
+            }
+            ShapeDesc::Model { lights: true, .. } => {
+                return Err(ctx.err(
+                    format!("{field}.shape.lights"),
+                    "only a glTF model (.gltf, .glb) has lights",
+                ));
+            }
+            ShapeDesc::Model {
+                file,
+                materials_from_file,
+                ke_luminance,
+                ..
             } => model_parts(
                 &ctx,
                 &field,
@@ -414,6 +447,9 @@ pub fn build_for(
         }
         lights.push(light);
     };
+    for (field, l) in &model_lights {
+        push(build_light(&ctx, field, l)?, &mut lights);
+    }
     for (i, l) in scene.lights.iter().enumerate() {
         let field = format!("lights[{i}]");
         let light = match l {

@@ -1,0 +1,377 @@
+//! glTF materials and punctual lights as candela's (the rule is in docs/scene-format.md →
+//! models): base colour → a smooth reflectance spectrum as for `Rgb`; metallic ≥ 0.5 → a
+//! conductor whose normal-incidence reflectance is that spectrum; transmission ≥ 0.5 → a
+//! dielectric of index `ior`; else roughness ≥ 0.5 → Lambertian, below → a clear-coated
+//! Lambertian base. Emission: `emissiveFactor × emissive_strength` in cd/m² (luminance of its
+//! Rec. 709 Y). Lights keep glTF's photometric units: cd for point and spot, lx for directional.
+
+use super::{GltfImage, GltfLight, GltfLightKind, GltfMaterial, GltfModel};
+use crate::bxdf::diffuse::TexturedDiffuse;
+use crate::bxdf::Material;
+use crate::description::context::{Context, Role, SceneError};
+use crate::description::schema::{
+    Amount, DistributionDesc, EmissionDesc, IorDesc, LightDesc, MaskingDesc, MaterialDesc,
+    SpectrumDesc,
+};
+use crate::texture::{Texture, Wrap};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// Rec. 709 luminance weights of linear sRGB.
+fn luma(c: [f64; 3]) -> f64 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}
+
+/// Largest normal-incidence reflectance given to a conductor (its k is 2√(R/(1 − R)), finite).
+const MAX_METAL_REFLECTANCE: f64 = 0.999;
+
+/// Textures already decoded, by (image, tint bits), so materials sharing one share it.
+pub type TextureCache = HashMap<(usize, [u32; 3]), Arc<Texture>>;
+
+/// The candela material of glTF material `m` of `model`; errors at `field` name the material.
+pub fn material(
+    ctx: &Context,
+    field: &str,
+    model: &GltfModel,
+    m: &GltfMaterial,
+    cache: &mut TextureCache,
+) -> Result<Material, SceneError> {
+    let at = format!(
+        "{field} (material {:?} of '{}')",
+        m.name,
+        model.path.display()
+    );
+    let unit = |what: &str, v: f64| -> Result<f64, SceneError> {
+        if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
+            return Err(ctx.err(&at, format!("{what} {v} is outside [0, 1]")));
+        }
+        Ok(v)
+    };
+    let c = m.base_colour;
+    let rgb = [
+        unit("baseColorFactor", c[0])?,
+        unit("baseColorFactor", c[1])?,
+        unit("baseColorFactor", c[2])?,
+    ];
+    let metallic = unit("metallicFactor", m.metallic)?;
+    let roughness = unit("roughnessFactor", m.roughness)?;
+    let transmission = unit("transmissionFactor", m.transmission)?;
+    // glTF's roughness is perceptual: the microfacet α is its square.
+    let alpha = (roughness * roughness) as f32;
+    let desc = if transmission >= 0.5 {
+        if !(m.ior.is_finite() && m.ior >= 1.0) {
+            return Err(ctx.err(&at, format!("ior {} must be ≥ 1", m.ior)));
+        }
+        MaterialDesc::Dielectric {
+            // KHR_materials_ior's 1.0 means "no refraction": the thinnest interface candela has.
+            ior: IorDesc::Constant(m.ior.max(1.0 + 1e-4) as f32),
+            roughness: alpha,
+            roughness_v: None,
+            distribution: DistributionDesc::Ggx,
+        }
+    } else if metallic >= 0.5 {
+        let r = ctx.spectrum(
+            &at,
+            &SpectrumDesc::Rgb(rgb[0], rgb[1], rgb[2]),
+            Role::Reflectance,
+        )?;
+        // n = 1: F0 = k² / (4 + k²), so k = 2√(F0 / (1 − F0)) gives F0 the base colour.
+        let k: Vec<(f64, f64)> = (r.values.iter().enumerate())
+            .map(|(i, &f0)| {
+                let f0 = (f0 as f64).clamp(0.0, MAX_METAL_REFLECTANCE);
+                (360.0 + i as f64, 2.0 * (f0 / (1.0 - f0)).sqrt())
+            })
+            .collect();
+        MaterialDesc::Conductor {
+            metal: None,
+            n: Some(SpectrumDesc::Constant(1.0)),
+            k: Some(SpectrumDesc::Tabulated(k)),
+            roughness: alpha,
+            roughness_v: None,
+            distribution: DistributionDesc::Ggx,
+            masking: MaskingDesc::default(),
+        }
+    } else if let Some(t) = &m.base_texture {
+        let tint = rgb.map(|v| v as f32);
+        let key = (t.image, tint.map(f32::to_bits));
+        let texture = match cache.get(&key) {
+            Some(tex) => tex.clone(),
+            None => {
+                let loaded = match model.images.get(t.image) {
+                    Some(GltfImage::File(p)) => crate::limits::read_file(p, 4 << 30)
+                        .map_err(|e| format!("cannot use texture image '{}': {e}.", p.display()))
+                        .and_then(|b| Texture::decode(p, &b, tint).map_err(|e| e.to_string())),
+                    Some(GltfImage::Bytes { label, bytes }) => {
+                        Texture::decode(label, bytes, tint).map_err(|e| e.to_string())
+                    }
+                    None => Err(format!("image {} does not exist", t.image)),
+                };
+                let tex = Arc::new(loaded.map_err(|e| ctx.err(&at, e))?);
+                cache.insert(key, tex.clone());
+                tex
+            }
+        };
+        let mut tex = (*texture).clone();
+        tex.scale = t.uv_scale.into();
+        tex.offset = t.uv_offset.into();
+        tex.wrap = if t.clamp { Wrap::Clamp } else { Wrap::Repeat };
+        if !(tex.scale.is_finite() && tex.offset.is_finite()) {
+            return Err(ctx.err(&at, "the texture transform is not finite"));
+        }
+        return Ok(Material::TexturedDiffuse(TexturedDiffuse {
+            texture: Arc::new(tex),
+        }));
+    } else if roughness >= 0.5 {
+        MaterialDesc::Diffuse {
+            reflectance: SpectrumDesc::Rgb(rgb[0], rgb[1], rgb[2]),
+        }
+    } else {
+        if !(m.ior.is_finite() && m.ior >= 1.0) {
+            return Err(ctx.err(&at, format!("ior {} must be ≥ 1", m.ior)));
+        }
+        MaterialDesc::Coated {
+            base: SpectrumDesc::Rgb(rgb[0], rgb[1], rgb[2]),
+            ior: m.ior as f32,
+            roughness: alpha,
+            distribution: DistributionDesc::Ggx,
+        }
+    };
+    Material::build(ctx, &at, &desc)
+}
+
+/// The emission of glTF material `m`: front faces of luminance `strength · Y(emissive)` cd/m²
+/// with the colour of `emissive` (scaled to a peak of 1) as its spectral shape; `None` when
+/// `emissive` is black.
+pub fn emission(
+    ctx: &Context,
+    field: &str,
+    model: &GltfModel,
+    m: &GltfMaterial,
+) -> Result<Option<EmissionDesc>, SceneError> {
+    let e = m.emissive;
+    let at = || {
+        format!(
+            "{field} (material {:?} of '{}')",
+            m.name,
+            model.path.display()
+        )
+    };
+    if let Some(v) = e
+        .iter()
+        .find(|v| !(v.is_finite() && (0.0..=1.0).contains(*v)))
+    {
+        return Err(ctx.err(
+            at(),
+            format!("emissiveFactor component {v} is outside [0, 1]"),
+        ));
+    }
+    let s = m.emissive_strength;
+    if !(s.is_finite() && s >= 0.0) {
+        return Err(ctx.err(at(), format!("emissive_strength {s} must be ≥ 0")));
+    }
+    let peak = e.iter().copied().fold(0.0, f64::max);
+    if peak == 0.0 || s == 0.0 {
+        return Ok(None);
+    }
+    Ok(Some(EmissionDesc {
+        spectrum: SpectrumDesc::Rgb(e[0] / peak, e[1] / peak, e[2] / peak),
+        amount: Amount::Luminance(s * luma(e)),
+        two_sided: false,
+    }))
+}
+
+/// The candela light of glTF light `l`, its colour's luminance scaling the intensity (white
+/// (1, 1, 1) keeps it): point → `Point`, spot → `Spot` (the look-at point 1 m along its axis),
+/// directional → `Distant`. `None` for a black or zero-intensity light.
+pub fn light(ctx: &Context, field: &str, l: &GltfLight) -> Result<Option<LightDesc>, SceneError> {
+    let c = l.colour;
+    let at = || format!("{field} (light {:?})", l.name);
+    if let Some(v) = c
+        .iter()
+        .find(|v| !(v.is_finite() && (0.0..=1.0).contains(*v)))
+    {
+        return Err(ctx.err(at(), format!("color component {v} is outside [0, 1]")));
+    }
+    if !(l.intensity.is_finite() && l.intensity >= 0.0) {
+        return Err(ctx.err(at(), format!("intensity {} must be ≥ 0", l.intensity)));
+    }
+    let peak = c.iter().copied().fold(0.0, f64::max);
+    let amount = l.intensity * luma(c);
+    if peak == 0.0 || amount == 0.0 {
+        return Ok(None);
+    }
+    let spectrum = SpectrumDesc::Rgb(c[0] / peak, c[1] / peak, c[2] / peak);
+    let p = l.position.to_array();
+    Ok(Some(match l.kind {
+        GltfLightKind::Point => LightDesc::Point {
+            position: p,
+            spectrum,
+            amount: Amount::Intensity(amount),
+        },
+        GltfLightKind::Spot {
+            inner_rad,
+            outer_rad,
+        } => LightDesc::Spot {
+            position: p,
+            look_at: (l.position + l.direction).to_array(),
+            inner_deg: inner_rad.to_degrees() as f32,
+            outer_deg: outer_rad.to_degrees() as f32,
+            spectrum,
+            amount: Amount::Intensity(amount),
+        },
+        GltfLightKind::Directional => LightDesc::Distant {
+            direction: l.direction.to_array(),
+            spectrum,
+            amount: Amount::Illuminance(amount),
+        },
+    }))
+}
+
+/// `l` moved by the object's transform `t` (its direction renormalised).
+pub fn placed(l: &GltfLight, t: Option<&crate::geometry::Transform>) -> GltfLight {
+    let mut l = l.clone();
+    if let Some(t) = t {
+        l.position = t.matrix.transform_point3(l.position);
+        l.direction = t.matrix.transform_vector3(l.direction).normalize_or_zero();
+    }
+    l
+}
+
+/// One world object made from a glTF model: a primitive placed by one node (in the model's
+/// space, before the object's transform), its texture coordinates, material and emission.
+pub struct GltfPart {
+    pub shape: crate::geometry::Shape,
+    pub uvs: Option<Vec<glam::Vec2>>,
+    pub material: u32,
+    pub emission: Option<EmissionDesc>,
+}
+
+/// The parts of glTF `model` used as the `Model` shape at `field`: every primitive of every
+/// node that places a mesh, flattened to world space. Materials come from the file by the rule
+/// above, or from `overrides` by glTF material name; a primitive without a material takes the
+/// object's `fallback`. Materials made here are appended to `materials`.
+pub fn parts(
+    ctx: &Context,
+    field: &str,
+    model: &GltfModel,
+    overrides: &std::collections::BTreeMap<String, crate::description::schema::MaterialRefDesc>,
+    fallback: &str,
+    lookup: &dyn Fn(&str, &str) -> Result<u32, SceneError>,
+    materials: &mut Vec<Material>,
+) -> Result<Vec<GltfPart>, SceneError> {
+    use crate::description::schema::MaterialRefDesc;
+    let file = model.path.display();
+    for name in overrides.keys() {
+        if !model.materials.iter().any(|m| &m.name == name) {
+            let mut names: Vec<&str> = model.materials.iter().map(|m| m.name.as_str()).collect();
+            names.sort_unstable();
+            return Err(ctx.err(
+                format!("{field}.materials_from_file[{name:?}]"),
+                format!(
+                    "'{file}' has no material {name:?}; its materials: {}",
+                    names.join(", ")
+                ),
+            ));
+        }
+    }
+    let mut cache = TextureCache::new();
+    let mut ids: Vec<Option<(u32, Option<EmissionDesc>)>> = vec![None; model.materials.len()];
+    let mut fallback_id = None;
+    let mut out = Vec::new();
+    for inst in &model.instances {
+        let t = crate::geometry::Transform::from_affine(inst.world);
+        for p in &model.meshes[inst.mesh].primitives {
+            if p.mesh.indices.is_empty() {
+                continue;
+            }
+            let (material, emission) = match p.material {
+                None => {
+                    let id = match fallback_id {
+                        Some(id) => id,
+                        None => {
+                            let id = lookup(&format!("{field}.material"), fallback).map_err(|e| {
+                                ctx.err(
+                                    format!("{field}.material"),
+                                    format!("'{file}' has primitives without a material; they take the object's `material`: {e}"),
+                                )
+                            })?;
+                            *fallback_id.insert(id)
+                        }
+                    };
+                    (id, None)
+                }
+                Some(i) => {
+                    if ids[i].is_none() {
+                        let m = &model.materials[i];
+                        let over = format!("{field}.materials_from_file[{:?}]", m.name);
+                        let id = match overrides.get(&m.name) {
+                            Some(MaterialRefDesc::Named(n)) => lookup(&over, n)?,
+                            Some(MaterialRefDesc::Material(desc)) => {
+                                materials.push(Material::build(ctx, &over, desc)?);
+                                materials.len() as u32 - 1
+                            }
+                            None => {
+                                materials.push(material(ctx, field, model, m, &mut cache)?);
+                                materials.len() as u32 - 1
+                            }
+                        };
+                        ids[i] = Some((id, emission(ctx, field, model, m)?));
+                    }
+                    ids[i].clone().expect("set above")
+                }
+            };
+            let shape = crate::geometry::Shape::Mesh(p.mesh.clone())
+                .to_world(&t)
+                .map_err(|e| ctx.err(field, format!("'{file}' node {}: {e}", inst.node)))?;
+            out.push(GltfPart {
+                shape,
+                uvs: p.uvs.clone(),
+                material,
+                emission,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// A `Model` object at `field` whose file is glTF: `(file, materials_from_file, ke_luminance,
+/// lights)` as the scene gives them, `(transform, fallback, lookup)` the object's transform, its
+/// `material` and the scene's material names. Returns its parts and, with `lights`, the file's
+/// lights placed by the transform (with the fields to name them by).
+#[allow(clippy::type_complexity)]
+pub fn model_parts(
+    ctx: &Context,
+    field: &str,
+    (file, overrides, ke_luminance, with_lights): (
+        &str,
+        &std::collections::BTreeMap<String, crate::description::schema::MaterialRefDesc>,
+        Option<f64>,
+        bool,
+    ),
+    (transform, fallback, lookup): (
+        Option<&crate::geometry::Transform>,
+        &str,
+        &dyn Fn(&str, &str) -> Result<u32, SceneError>,
+    ),
+    materials: &mut Vec<Material>,
+) -> Result<(Vec<GltfPart>, Vec<(String, LightDesc)>), SceneError> {
+    if ke_luminance.is_some() {
+        return Err(ctx.err(
+            format!("{field}.ke_luminance"),
+            "applies to OBJ models; a glTF material's emission is in cd/m² already (emissive_strength)",
+        ));
+    }
+    let model = super::load_gltf(&ctx.resolve(file))
+        .map_err(|e| crate::geometry::mesh_err(ctx, field, file, e))?;
+    let mut lights = Vec::new();
+    if with_lights {
+        for (k, l) in model.lights.iter().enumerate() {
+            let at = format!("{field}.lights[{k}]");
+            if let Some(d) = light(ctx, &at, &placed(l, transform))? {
+                lights.push((at, d));
+            }
+        }
+    }
+    let parts = parts(ctx, field, &model, overrides, fallback, lookup, materials)?;
+    Ok((parts, lights))
+}
