@@ -385,7 +385,7 @@ fn glare_refuses_what_it_cannot_evaluate() {
 /// The DGP interval of a noisy render (64 × 64 fisheye, 8 spp) covers the DGP of a converged
 /// render (2048 spp, whose own error is a 256th of the noisy renders' variance) of the same view
 /// at the stated 95 % over 60 independent seeds: at least 53 (a calibrated interval has fewer
-/// with probability 0.009; the synthetic-image calibration in tests/glare_indices.rs pins the
+/// with probability 0.01; the synthetic-image calibration in tests/glare_indices.rs pins the
 /// rate itself), and the intervals' stated standard deviation within 25 % of the errors' rms
 /// (60 errors estimate it to ±9 %). A study of several minutes:
 /// `cargo test --release --test glare_cli -- --ignored --nocapture` (measured: 55 of 60, see
