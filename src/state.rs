@@ -600,6 +600,57 @@ impl RenderState {
 mod tests {
     use super::*;
 
+    /// A 3 × 2 film with one sample per pixel and melanopic and 4-band sums, as a state.
+    fn health_state() -> RenderState {
+        let mut film = Film::new(3, 2);
+        for p in &mut film.pixels {
+            p.add([1.0, 2.0, 3.0]);
+        }
+        let channels = HealthChannels {
+            melanopic: true,
+            mesopic: false,
+            spectral_bands: 4,
+        };
+        let mut h = HealthFilm::new(channels, false, 6).unwrap();
+        for (k, v) in h.sums.iter_mut().enumerate() {
+            *v = k as f64 * 0.25;
+        }
+        film.health = Some(h);
+        RenderState {
+            magic: MAGIC.into(),
+            version: VERSION,
+            scene_hash: 7,
+            scene: "s.ron".into(),
+            seed: 1,
+            max_depth: UNLIMITED_DEPTH,
+            illuminance: false,
+            film,
+            shard: None,
+            meters: Vec::new(),
+            merged_seeds: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn health_sums_round_trip_and_bad_ones_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("h.state");
+        let st = health_state();
+        st.save(&path).unwrap();
+        assert_eq!(RenderState::load(&path).unwrap(), st);
+        // A negative sum, then sums that the channels do not account for, with valid checksums.
+        let mut bad = health_state();
+        bad.film.health.as_mut().unwrap().sums[5] = -1.0;
+        bad.save(&path).unwrap();
+        let e = RenderState::load(&path).unwrap_err().to_string();
+        assert!(e.contains("light-and-health sum 5"), "{e}");
+        let mut bad = health_state();
+        bad.film.health.as_mut().unwrap().sums.pop();
+        bad.save(&path).unwrap();
+        let e = RenderState::load(&path).unwrap_err().to_string();
+        assert!(e.contains("light-and-health sums number 119"), "{e}");
+    }
+
     #[test]
     fn checksum_sees_every_change_within_one_word() {
         // Lengths around the 32-byte blocks; every word, 64 changes each (single bits and
