@@ -45,9 +45,14 @@ const MAX_PIXEL_BYTES: u64 = (PIXEL_FLOATS + E_FLOATS) * 8 + 3 * 10;
 /// state may hold; the seed list is checked against itself when merging.
 pub const MAX_SCENE_NAME_BYTES: u64 = 64 << 10;
 pub const MAX_MERGED_SEEDS: u64 = 1 << 20;
+/// Most bytes of a pixel's light-and-health sums: three batched quantities and the most bands.
+const MAX_HEALTH_BYTES: u64 =
+    (3 * crate::film::PIXEL_BATCHES as u64 + crate::film::MAX_SPECTRAL_BANDS as u64) * 8;
 /// Largest state file read: that of the largest film allowed ([`MAX_PIXELS`], adaptive: two
-/// buffers), with the longest name and seed list, the fixed fields and the checksum.
+/// buffers, and every light-and-health channel), with the longest name and seed list, the
+/// fixed fields and the checksum.
 pub const MAX_STATE_BYTES: u64 = 2 * MAX_PIXELS * MAX_PIXEL_BYTES
+    + MAX_PIXELS * MAX_HEALTH_BYTES
     + MAX_SCENE_NAME_BYTES
     + 10 * MAX_MERGED_SEEDS
     + MAX_METERS * 256

@@ -387,7 +387,7 @@ fn glare_refuses_what_it_cannot_evaluate() {
 /// at the stated 95 % over 60 independent seeds: at least 53 (a calibrated interval has fewer
 /// with probability 0.01; the synthetic-image calibration in tests/glare_indices.rs pins the
 /// rate itself), and the intervals' stated standard deviation within 25 % of the errors' rms
-/// (60 errors estimate it to ±9 %). A study of several minutes:
+/// (60 errors estimate it to ±9 %). A study of about 75 s on 2 cores:
 /// `cargo test --release --test glare_cli -- --ignored --nocapture` (measured: 55 of 60, see
 /// docs/glare.md).
 #[test]
