@@ -214,8 +214,30 @@ def main() -> int:
 
     write_alpha_opic()
     write_ces()
+    write_vs()
     write_cornell()
     return 0
+
+
+def write_vs() -> None:
+    """The 15 NIST CQS 9.0 test colour samples VS1-VS15 (colour.quality.cqs integrates them
+    after the same align call)."""
+    from colour.quality.datasets.vs import SDS_VS
+
+    vs = SDS_VS["NIST CQS 9.0"]
+    first = vs["VS1"]
+    write(
+        "vs-nist-cqs9.csv",
+        "# NIST Colour Quality Scale 9.0 test colour samples VS1-VS15 (spectral reflectance factors)\n"
+        f"# source: colour-science {VERSION}, colour.quality.datasets.vs.SDS_VS['NIST CQS 9.0']"
+        "[VSn].copy().align(SpectralShape(360, 830, 1))\n"
+        "#   (from the NIST CQS 9.0 spreadsheet, Ohno & Davis; Davis & Ohno, Opt. Eng. 49(3) 033602)\n"
+        f"#   native {first.shape.start:g}-{first.shape.end:g} nm every {first.shape.interval:g} nm, "
+        f"{first.interpolator.__name__} interpolation\n"
+        "# licence: published by NIST (a US government work); redistributed by colour-science\n"
+        "#   (BSD-3-Clause); the tabulated values are factual data.\n",
+        {f"VS{i}": aligned(vs[f"VS{i}"]) for i in range(1, 16)},
+    )
 
 
 def write_alpha_opic() -> None:

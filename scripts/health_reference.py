@@ -12,6 +12,9 @@ Reads {"task": ..., ...} on stdin and writes JSON on stdout:
   task "tm30": {"cases": [{"id", "values": [...]}]}
       -> colour-science colour_fidelity_index_CIE2017 and colour_fidelity_index_ANSIIESTM3018
          (R_f, R_g, CCT, per-bin R_cs, R_hs, R_fs, per-sample R_fi).
+  task "cqs": {"cases": [{"id", "values": [...]}]}
+      -> colour-science colour_quality_scale(method="NIST CQS 9.0"): Q_a, Q_f, Q_g, and per
+         sample VS1-VS15 Q_a,i, Delta C, Delta E, Delta E'.
   task "xyz_methods": {"cases": [{"id", "values": [...]}]}
       -> colour-science sd_to_XYZ(method="Integration"), its default (ASTM E308),
          luminous_efficacy (trapezoid) of each spectrum.
@@ -122,6 +125,31 @@ def tm30(doc):
     return {"colour_science": colour.__version__, "results": out}
 
 
+def cqs(doc):
+    import colour
+    from colour import SpectralDistribution
+    from colour.quality import colour_quality_scale
+
+    out = []
+    for case in doc["cases"]:
+        sd = SpectralDistribution(np.array(case["values"], dtype=float), WL)
+        q = colour_quality_scale(sd, additional_data=True, method="NIST CQS 9.0")
+        s = [q.Q_as[i] for i in sorted(q.Q_as)]
+        out.append(
+            {
+                "qa": float(q.Q_a),
+                "qf": float(q.Q_f),
+                "qg": float(q.Q_g),
+                "qp": q.Q_p,
+                "qai": [float(v.Q_a) for v in s],
+                "dc": [float(v.D_C_ab) for v in s],
+                "de": [float(v.D_E_ab) for v in s],
+                "dep": [float(v.D_Ep_ab) for v in s],
+            }
+        )
+    return {"colour_science": colour.__version__, "results": out}
+
+
 def xyz_methods(doc):
     import colour
 
@@ -141,7 +169,13 @@ def xyz_methods(doc):
 
 def main() -> int:
     doc = json.load(sys.stdin)
-    task = {"alpha_opic": alpha_opic, "mesopic": mesopic, "tm30": tm30, "xyz_methods": xyz_methods}
+    task = {
+        "alpha_opic": alpha_opic,
+        "mesopic": mesopic,
+        "tm30": tm30,
+        "cqs": cqs,
+        "xyz_methods": xyz_methods,
+    }
     json.dump(task[doc["task"]](doc), sys.stdout)
     return 0
 

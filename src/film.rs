@@ -401,8 +401,8 @@ pub struct Film {
     pub e: Option<Vec<IlluminanceSums>>,
     #[serde(default)]
     pub decision_e: Option<Vec<IlluminanceSums>>,
-    /// Light-and-health channels of the image buffer, when asked for; render states do not
-    /// carry them.
+    /// Light-and-health channels of the image buffer, when asked for (written to render states
+    /// after the film's own fields, see `state`).
     #[serde(skip)]
     pub health: Option<HealthFilm>,
 }
@@ -459,8 +459,17 @@ impl Film {
     }
     /// Combine another film of the same size (independent samples: a different seed).
     pub fn merge(&mut self, o: &Film) {
-        // Health channels are kept only by the render that made them.
-        self.health = None;
+        // Health sums first: their batches continue the pixel's numbering before the merge.
+        let same = |a: &HealthFilm, b: &HealthFilm| {
+            (a.channels, a.illuminance) == (b.channels, b.illuminance)
+        };
+        match (self.health.as_mut(), o.health.as_ref()) {
+            (Some(a), Some(b)) if same(a, b) => {
+                let pixels = &self.pixels;
+                a.merge(b, |i| pixels[i].count);
+            }
+            _ => self.health = None,
+        }
         self.light_paths[0] += o.light_paths[0];
         self.light_paths[1] += o.light_paths[1];
         // Illuminance first: its batches continue the pixel's numbering before the merge.

@@ -1,5 +1,6 @@
 //! Render state files (`NAME.state`): per-pixel sums, sums of squares, batch sums and sample
-//! counts (both buffers in adaptive mode; illuminance sums when the render estimates it), the scene's hash and the settings that determine the random
+//! counts (both buffers in adaptive mode; illuminance sums when the render estimates it; the
+//! light-and-health sums when the render keeps them), the scene's hash and the settings that determine the random
 //! sequence, so a render can be resumed exactly or merged with independent renders.
 //!
 //! A file is the little-endian [postcard](https://docs.rs/postcard) encoding of [`RenderState`]
@@ -10,7 +11,7 @@
 //! list) against the limits, the bytes present and the memory available, before anything is
 //! allocated for them; then the values ([`Film::check`]).
 
-use crate::film::{Film, IlluminanceSums, PixelSums};
+use crate::film::{Film, HealthChannels, HealthFilm, IlluminanceSums, PixelSums};
 use crate::meter::MeterSums;
 use crate::output::write_atomic;
 use crate::sampling::mix64;
@@ -23,9 +24,9 @@ pub const MAGIC: &str = "candela-render-state";
 /// Format version: 4 added the checksum, 12 the per-pixel batch sums with the illuminance sums
 /// in buffers of their own (12 because no single flipped bit turns it into one of the
 /// unchecked versions 1–3, see [`RenderState::decode`]), 13 the shard a state renders
-/// ([`ShardInfo`]; no single flipped bit turns 13 into 1–3 either); other versions are refused
-/// with a message.
-pub const VERSION: u32 = 13;
+/// ([`ShardInfo`]; no single flipped bit turns 13 into 1–3 either), 14 the light-and-health
+/// sums (likewise); other versions are refused with a message.
+pub const VERSION: u32 = 14;
 
 /// Bytes of the checksum at the end of the file.
 const CHECKSUM_BYTES: usize = 8;
@@ -44,9 +45,14 @@ const MAX_PIXEL_BYTES: u64 = (PIXEL_FLOATS + E_FLOATS) * 8 + 3 * 10;
 /// state may hold; the seed list is checked against itself when merging.
 pub const MAX_SCENE_NAME_BYTES: u64 = 64 << 10;
 pub const MAX_MERGED_SEEDS: u64 = 1 << 20;
+/// Most bytes of a pixel's light-and-health sums: three batched quantities and the most bands.
+const MAX_HEALTH_BYTES: u64 =
+    (3 * crate::film::PIXEL_BATCHES as u64 + crate::film::MAX_SPECTRAL_BANDS as u64) * 8;
 /// Largest state file read: that of the largest film allowed ([`MAX_PIXELS`], adaptive: two
-/// buffers), with the longest name and seed list, the fixed fields and the checksum.
+/// buffers, and every light-and-health channel), with the longest name and seed list, the
+/// fixed fields and the checksum.
 pub const MAX_STATE_BYTES: u64 = 2 * MAX_PIXELS * MAX_PIXEL_BYTES
+    + MAX_PIXELS * MAX_HEALTH_BYTES
     + MAX_SCENE_NAME_BYTES
     + 10 * MAX_MERGED_SEEDS
     + MAX_METERS * 256
@@ -109,6 +115,86 @@ struct StateRef<'a> {
     shard: Option<ShardInfo>,
     meters: &'a [MeterSums],
     merged_seeds: &'a [u64],
+    health: Option<HealthRef<'a>>,
+}
+
+/// The light-and-health sums of a film ([`HealthFilm`]) as written: the channels, whether the
+/// melanopic channel has an m-EDI part, and the sums pixel after pixel.
+#[derive(Serialize)]
+struct HealthRef<'a> {
+    melanopic: bool,
+    mesopic: bool,
+    spectral_bands: u64,
+    illuminance: bool,
+    sums: &'a [f64],
+}
+
+impl<'a> HealthRef<'a> {
+    fn of(film: &'a Film) -> Option<Self> {
+        film.health.as_ref().map(|h| HealthRef {
+            melanopic: h.channels.melanopic,
+            mesopic: h.channels.mesopic,
+            spectral_bands: h.channels.spectral_bands as u64,
+            illuminance: h.illuminance,
+            sums: &h.sums,
+        })
+    }
+}
+
+/// Reads the light-and-health sums of a film of `n` pixels rendered with(out) illuminance,
+/// checking the channels, the length against the bytes left and the memory before allocating,
+/// and the values after.
+fn take_health(bytes: &mut &[u8], n: u64, illuminance: bool) -> Result<HealthFilm, String> {
+    let (melanopic, mesopic): (bool, bool) = take(bytes, "its light-and-health channels")?;
+    let bands: u64 = take(bytes, "its number of spectral bands")?;
+    let with_e: bool = take(bytes, "whether its melanopic channel has m-EDI")?;
+    if bands > crate::film::MAX_SPECTRAL_BANDS as u64 {
+        return Err(format!(
+            "it claims {bands} spectral bands per pixel, more than the limit of {}",
+            crate::film::MAX_SPECTRAL_BANDS
+        ));
+    }
+    let channels = HealthChannels {
+        melanopic,
+        mesopic,
+        spectral_bands: bands as usize,
+    };
+    if !channels.any() || with_e != (melanopic && illuminance) {
+        return Err(
+            "its light-and-health record names no channel, or an m-EDI part that does not match the illuminance setting"
+                .into(),
+        );
+    }
+    let len: u64 = take(bytes, "the length of its light-and-health sums")?;
+    let want = n * channels.floats_per_pixel(illuminance) as u64;
+    if len != want {
+        return Err(format!(
+            "its light-and-health sums number {len}, but its film and channels need {want}"
+        ));
+    }
+    if (bytes.len() as u64) < len * 8 {
+        return Err(format!(
+            "its {len} light-and-health sums need {} bytes, but only {} remain (truncated?)",
+            len * 8,
+            bytes.len()
+        ));
+    }
+    crate::limits::check_memory(len * 8, &format!("the light-and-health sums of {n} pixels"))?;
+    let mut sums = Vec::with_capacity(len as usize);
+    for k in 0..len {
+        let v: f64 = take(bytes, "a light-and-health sum")?;
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(format!(
+                "light-and-health sum {k} is {v:e}, but sums of radiance are finite and ≥ 0"
+            ));
+        }
+        sums.push(v);
+    }
+    Ok(HealthFilm {
+        channels,
+        illuminance,
+        sums,
+    })
 }
 
 impl StateRef<'_> {
@@ -298,6 +384,7 @@ impl RenderState {
             merged_seeds: &self.merged_seeds,
             shard: self.shard,
             meters: &self.meters,
+            health: HealthRef::of(&self.film),
         }
         .save(path)
     }
@@ -325,6 +412,7 @@ impl RenderState {
             merged_seeds: &[],
             shard,
             meters,
+            health: HealthRef::of(film),
         }
         .save(path)
     }
@@ -474,6 +562,11 @@ impl RenderState {
         for _ in 0..seeds {
             merged_seeds.push(take(&mut bytes, "a merged seed")?);
         }
+        let health = match take::<u8>(&mut bytes, "whether it has light-and-health sums")? {
+            0 => None,
+            1 => Some(take_health(&mut bytes, n, p.illuminance)?),
+            t => return Err(format!("its light-and-health tag is {t}, not 0 or 1")),
+        };
         if !bytes.is_empty() {
             return Err(format!("{} bytes follow its last field", bytes.len()));
         }
@@ -489,7 +582,7 @@ impl RenderState {
             light_paths,
             e,
             decision_e,
-            health: None,
+            health,
         };
         film.check(p.illuminance)?;
         Ok(Self {
@@ -511,6 +604,57 @@ impl RenderState {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 3 × 2 film with one sample per pixel and melanopic and 4-band sums, as a state.
+    fn health_state() -> RenderState {
+        let mut film = Film::new(3, 2);
+        for p in &mut film.pixels {
+            p.add([1.0, 2.0, 3.0]);
+        }
+        let channels = HealthChannels {
+            melanopic: true,
+            mesopic: false,
+            spectral_bands: 4,
+        };
+        let mut h = HealthFilm::new(channels, false, 6).unwrap();
+        for (k, v) in h.sums.iter_mut().enumerate() {
+            *v = k as f64 * 0.25;
+        }
+        film.health = Some(h);
+        RenderState {
+            magic: MAGIC.into(),
+            version: VERSION,
+            scene_hash: 7,
+            scene: "s.ron".into(),
+            seed: 1,
+            max_depth: UNLIMITED_DEPTH,
+            illuminance: false,
+            film,
+            shard: None,
+            meters: Vec::new(),
+            merged_seeds: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn health_sums_round_trip_and_bad_ones_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("h.state");
+        let st = health_state();
+        st.save(&path).unwrap();
+        assert_eq!(RenderState::load(&path).unwrap(), st);
+        // A negative sum, then sums that the channels do not account for, with valid checksums.
+        let mut bad = health_state();
+        bad.film.health.as_mut().unwrap().sums[5] = -1.0;
+        bad.save(&path).unwrap();
+        let e = RenderState::load(&path).unwrap_err().to_string();
+        assert!(e.contains("light-and-health sum 5"), "{e}");
+        let mut bad = health_state();
+        bad.film.health.as_mut().unwrap().sums.pop();
+        bad.save(&path).unwrap();
+        let e = RenderState::load(&path).unwrap_err().to_string();
+        assert!(e.contains("light-and-health sums number 119"), "{e}");
+    }
 
     #[test]
     fn checksum_sees_every_change_within_one_word() {

@@ -1,6 +1,6 @@
 //! Light-and-health colour quantities against their peers: CIE S 026 α-opic quantities against
 //! luxpy, the CIE S 026 toolbox's published D65 ELRs, CIE 191 mesopic luminance against luxpy,
-//! and TM-30 / CIE 224:2017 colour fidelity against colour-science.
+//! TM-30 / CIE 224:2017 colour fidelity and NIST CQS 9.0 against colour-science.
 //!
 //! The reference values come from `scripts/health_reference.py`, run with the project venv
 //! (`scripts/setup_python.sh`: colour-science 0.4.7, luxpy 1.12.5). Candela and the peers sum
@@ -383,6 +383,51 @@ fn tm30_and_cie2017_against_colour_science() {
         beyond.len()
     ));
     assert!(src.len() - beyond.len() >= 35);
+}
+
+#[test]
+fn cqs_against_colour_science() {
+    use candela::colour::cqs::{colour_quality_scale, N_VS};
+    // Illuminant A, the daylights, the F-series, the LEDs, blackbodies on both sides of the
+    // 5000 K switch of reference, and random spectra.
+    let src = sources();
+    let cases: Vec<Value> = src
+        .iter()
+        .map(|(n, t)| json!({"id": n, "values": t.to_vec()}))
+        .collect();
+    let r = python_json(
+        REFERENCE,
+        &[],
+        Some(&json!({"task": "cqs", "cases": cases})),
+    );
+    let mut dev = Deviations::default();
+    for ((name, t), want) in src.iter().zip(r["results"].as_array().unwrap()) {
+        let c = colour_quality_scale(t);
+        let f = |k: &str| want[k].as_f64().unwrap();
+        abs(&mut dev, "Qa", name, c.q_a, f("qa"), 1e-6);
+        abs(&mut dev, "Qf", name, c.q_f, f("qf"), 1e-6);
+        abs(&mut dev, "Qg", name, c.q_g, f("qg"), 1e-6);
+        assert!(want["qp"].is_null() && c.q_p.is_none(), "{name}: Qp");
+        let (qai, dc, de, dep) = (
+            floats(&want["qai"]),
+            floats(&want["dc"]),
+            floats(&want["de"]),
+            floats(&want["dep"]),
+        );
+        assert_eq!(qai.len(), N_VS);
+        for (i, s) in c.samples.iter().enumerate() {
+            abs(&mut dev, "Qa,i (15 VS)", name, s.q_a, qai[i], 1e-6);
+            abs(&mut dev, "dC*ab,i", name, s.delta_c_ab, dc[i], 1e-8);
+            abs(&mut dev, "dE*ab,i", name, s.delta_e_ab, de[i], 1e-8);
+            abs(&mut dev, "dE'ab,i", name, s.delta_e_p_ab, dep[i], 1e-8);
+        }
+    }
+    dev.print(&format!(
+        "NIST CQS 9.0 vs colour-science {}: {} spectra",
+        r["colour_science"],
+        src.len()
+    ));
+    assert!(src.len() >= 50);
 }
 
 #[path = "../src/cli/colour.rs"]

@@ -717,9 +717,10 @@ fn huge_claimed_sizes_are_refused_without_allocating() {
 #[test]
 fn a_fifo_or_an_oversized_file_is_refused_without_reading() {
     // The limit is the state of the largest film (2²⁸ pixels, two buffers of up to 382 bytes
-    // each: sums and illuminance sums) and of a shard's meter sums (256 bytes each): one byte
-    // more, as a sparse file, is refused before a byte is read.
-    let largest = 2 * (1u64 << 28) * 382 + state::MAX_METERS * 256;
+    // each: sums and illuminance sums, and 896 bytes of light-and-health sums: 3 × 16 batch
+    // sums and 64 bands) and of a shard's meter sums (256 bytes each): one byte more, as a
+    // sparse file, is refused before a byte is read.
+    let largest = 2 * (1u64 << 28) * 382 + (1u64 << 28) * 896 + state::MAX_METERS * 256;
     assert!((largest..largest + (32 << 20)).contains(&state::MAX_STATE_BYTES));
     let dir = tempfile::tempdir().unwrap();
     let big = dir.path().join("big.state");

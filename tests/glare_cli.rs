@@ -383,10 +383,13 @@ fn glare_refuses_what_it_cannot_evaluate() {
 }
 
 /// The DGP interval of a noisy render (64 × 64 fisheye, 8 spp) covers the DGP of a converged
-/// render (2048 spp) of the same view at about the stated 95 % over independent seeds: at
-/// least 25 of 30 (a true rate of 95 % passes with probability 0.98; the synthetic-image
-/// calibration in tests/glare_indices.rs pins the rate itself). A study of about a minute:
-/// `cargo test --release --test glare_cli -- --ignored --nocapture` (measured: 26 of 30).
+/// render (2048 spp, whose own error is a 256th of the noisy renders' variance) of the same view
+/// at the stated 95 % over 60 independent seeds: at least 53 (a calibrated interval has fewer
+/// with probability 0.01; the synthetic-image calibration in tests/glare_indices.rs pins the
+/// rate itself), and the intervals' stated standard deviation within 25 % of the errors' rms
+/// (60 errors estimate it to ±9 %). A study of about 75 s on 2 cores:
+/// `cargo test --release --test glare_cli -- --ignored --nocapture` (measured: 55 of 60, see
+/// docs/glare.md).
 #[test]
 #[ignore]
 fn dgp_interval_covers_the_converged_dgp_over_seeds() {
@@ -414,16 +417,27 @@ fn dgp_interval_covers_the_converged_dgp_over_seeds() {
     let truth = render(2048, 1_000_000);
     let t = truth["value"].as_f64().unwrap();
     let mut covered = 0;
-    let trials = 30;
+    let trials = 60;
+    let (mut err2, mut sd2, mut err) = (0.0, 0.0, 0.0);
     for seed in 0..trials {
         let d = render(8, seed);
         let ci = d["ci95"].as_array().unwrap();
         let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
         covered += (lo <= t && t <= hi) as u32;
+        let v = d["value"].as_f64().unwrap();
+        err += v - t;
+        err2 += (v - t).powi(2);
+        // The half-width is t₀.₉₇₅(63) = 1.998 standard deviations of the 64 draws.
+        sd2 += ((hi - lo) / 2.0 / 1.998).powi(2);
     }
+    let n = trials as f64;
+    let ratio = (err2 / sd2).sqrt();
     println!(
-        "DGP converged {t:.5} (± {:.5}); covered by {covered}/{trials} intervals at 8 spp",
-        (truth["ci95"][1].as_f64().unwrap() - truth["ci95"][0].as_f64().unwrap()) / 2.0
+        "DGP converged {t:.5} (± {:.5}); covered by {covered}/{trials} intervals at 8 spp; mean \
+         error {:+.6}; rms error / rms stated sd {ratio:.3}",
+        (truth["ci95"][1].as_f64().unwrap() - truth["ci95"][0].as_f64().unwrap()) / 2.0,
+        err / n
     );
-    assert!(covered >= 25, "{covered}/{trials}");
+    assert!(covered >= 53, "{covered}/{trials}");
+    assert!((0.8..=1.25).contains(&ratio), "{ratio}");
 }

@@ -287,19 +287,6 @@ fn the_cli_writes_the_channels_the_meter_and_the_spectral_image() {
         measure: (samples: 256),
     )"#;
     std::fs::write(dir.path().join("s.ron"), scene).unwrap();
-    let (code, _, err) = common::cli(
-        &[
-            "render",
-            "s.ron",
-            "--quiet",
-            "--alpha-opic",
-            "--shard",
-            "0/2",
-        ],
-        dir.path(),
-    );
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("--resume or --shard"), "{err}");
     let (code, out, err) = common::cli(
         &[
             "render",
@@ -355,4 +342,120 @@ fn the_cli_writes_the_channels_the_meter_and_the_spectral_image() {
         out.contains("TM-30 Rf") && out.contains("relative SPD"),
         "{out}"
     );
+}
+
+const HEALTH_FLAGS: [&str; 6] = [
+    "--illuminance",
+    "--alpha-opic",
+    "--mesopic",
+    "--spectral-bands",
+    "8",
+    "--quiet",
+];
+
+fn cli_ok(dir: &std::path::Path, args: &[&str]) -> String {
+    let (code, out, err) = common::cli(args, dir);
+    assert_eq!(code, 0, "{args:?}: {err}");
+    out
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * a.abs().max(b.abs()) + 1e-300
+}
+
+/// The health sums of two states hold the same samples: equal but for the order of addition
+/// (each pixel's batches too, so the merge and the resume keep the batch numbering).
+fn same_health(a: &candela::state::RenderState, b: &candela::state::RenderState) {
+    let (ha, hb) = (
+        a.film.health.as_ref().unwrap(),
+        b.film.health.as_ref().unwrap(),
+    );
+    assert_eq!((ha.channels, ha.illuminance), (hb.channels, hb.illuminance));
+    assert_eq!(ha.sums.len(), hb.sums.len());
+    assert!(ha.sums.iter().any(|&v| v > 0.0));
+    for (k, (x, y)) in ha.sums.iter().zip(&hb.sums).enumerate() {
+        assert!(close(*x, *y), "health sum {k}: {x} vs {y}");
+    }
+    for (p, q) in a.film.pixels.iter().zip(&b.film.pixels) {
+        assert_eq!(p.count, q.count);
+        assert!(close(p.sum_xyz[1], q.sum_xyz[1]));
+    }
+}
+
+/// Health renders resume and shard like plain ones: two shards of 8 spp merged, and a render
+/// of 8 spp resumed to 16, hold the sums of one render at 16 spp (8 is half the 16 batches, so
+/// the second half's batches must be moved on by 8), and the merged EXR and spectral EXR
+/// carry the channels. A resume that asks for other channels than the state's is refused.
+#[test]
+fn health_channels_survive_shards_merge_and_resume() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = r#"(
+        camera: (position: (0.0, 2.0, 0.0), look_at: (0.3, 0.0, 0.2), vfov_deg: 40, resolution: (8, 6)),
+        render: (spp: 16),
+        materials: { "plane": Diffuse(reflectance: Constant(0.5)) },
+        objects: [(shape: Quad(origin: (-100, 0, -100), edge_u: (0, 0, 200), edge_v: (200, 0, 0)), material: "plane")],
+        lights: [Environment(spectrum: Blackbody(2700.0), amount: Luminance(100.0))],
+    )"#;
+    std::fs::write(d.join("s.ron"), scene).unwrap();
+    let run = |extra: &[&str]| {
+        let mut a = vec!["render", "s.ron"];
+        a.extend_from_slice(&HEALTH_FLAGS);
+        a.extend_from_slice(extra);
+        cli_ok(d, &a)
+    };
+    run(&["--spp", "16", "--save-state", "--out", "single"]);
+    for i in ["0/2", "1/2"] {
+        run(&["--spp", "8", "--shard", i, "--out", "r"]);
+    }
+    cli_ok(
+        d,
+        &[
+            "merge",
+            "r.shard-1-of-2.state",
+            "r.shard-0-of-2.state",
+            "-o",
+            "m",
+        ],
+    );
+    let load = |n: &str| candela::state::RenderState::load(&d.join(n)).unwrap();
+    let single = load("single.state");
+    same_health(&load("m.state"), &single);
+    for f in ["m.exr", "m.spectral.exr"] {
+        assert!(d.join(f).is_file(), "{f}");
+    }
+    let exr = candela::output::read_exr(&d.join("m.exr")).unwrap();
+    let one = candela::output::read_exr(&d.join("single.exr")).unwrap();
+    for c in [
+        "melanopic.EDL",
+        "melanopic.EDI",
+        "mesopic.L",
+        "stderr.melanopic.EDL",
+    ] {
+        let (a, b) = (exr.channel(c).unwrap(), one.channel(c).unwrap());
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-5 * y.abs().max(1e-3), "{c}: {x} vs {y}");
+        }
+    }
+
+    run(&["--spp", "8", "--save-state", "--out", "res"]);
+    run(&["--spp", "16", "--resume", "--out", "res"]);
+    same_health(&load("res.state"), &single);
+    let (code, _, err) = common::cli(
+        &[
+            "render",
+            "s.ron",
+            "--quiet",
+            "--illuminance",
+            "--mesopic",
+            "--spp",
+            "24",
+            "--resume",
+            "--out",
+            "res",
+        ],
+        d,
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("light-and-health channels"), "{err}");
 }

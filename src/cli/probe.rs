@@ -73,6 +73,7 @@ struct SpectrumProbe {
     bands: usize,
     rendition: Option<candela::colour::tm30::ColourRendition>,
     ra: f64,
+    cqs_qa: Option<f64>,
 }
 
 impl SpectrumProbe {
@@ -81,8 +82,12 @@ impl SpectrumProbe {
             Some(c) => format!("TM-30 Rf {:.1}, Rg {:.1}", c.rf, c.rg),
             None => "TM-30 undefined (black or outside the CCT range)".to_string(),
         };
+        let cqs = match self.cqs_qa {
+            Some(q) => format!("; CQS Qa {q:.1}"),
+            None => String::new(),
+        };
         format!(
-            "  {:<13} {tm30}; CIE Ra {:.1}   (the pixel's spectrum as a relative SPD, {} bands of {})\n",
+            "  {:<13} {tm30}; CIE Ra {:.1}{cqs}   (the pixel's spectrum as a relative SPD, {} bands of {})\n",
             "rendition", self.ra, self.bands, self.file
         )
     }
@@ -94,6 +99,7 @@ impl SpectrumProbe {
             "tm30_rf": self.rendition.as_ref().map(|c| c.rf),
             "tm30_rg": self.rendition.as_ref().map(|c| c.rg),
             "cri_ra": self.ra,
+            "cqs_qa": self.cqs_qa,
         })
     }
 }
@@ -146,6 +152,8 @@ fn spectral_rendition(
         bands: nm.len(),
         rendition: candela::colour::tm30::colour_rendition(&table),
         ra: candela::colour::cri::colour_rendering_index(&table).ra,
+        cqs_qa: Some(candela::colour::cqs::colour_quality_scale(&table).q_a)
+            .filter(|q| q.is_finite()),
     }))
 }
 

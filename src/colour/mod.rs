@@ -1,6 +1,6 @@
 //! Colour science for candela: spectral tables, spectral distributions, colorimetry, colour
 //! models, chromatic adaptation, RGB colourspaces, correlated colour temperature and colour
-//! rendering, α-opic (non-visual) quantities, colour rendition (TM-30, CIE 2017) and mesopic
+//! rendering, α-opic (non-visual) quantities, colour rendition (TM-30, CIE 2017, NIST CQS) and mesopic
 //! photometry.
 //!
 //! Everything here is `f64` and deterministic, and every conversion is validated against
@@ -10,6 +10,7 @@
 pub mod adaptation;
 pub mod alpha_opic;
 pub mod colorimetry;
+pub mod cqs;
 pub mod cri;
 pub mod grid;
 pub mod illuminants;

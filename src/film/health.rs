@@ -177,6 +177,30 @@ impl HealthFilm {
             sums: &mut self.sums[i * o.stride..(i + 1) * o.stride],
         }
     }
+    /// Adds the sums of `o` (the same channels; the samples of another seed or shard), pixel
+    /// `i` of this film having had `count(i)` samples before: as [`PixelSums::merge`] does,
+    /// `o`'s batch b joins batch (b + count) mod 16, so a batched quantity keeps the batches
+    /// of its pixel's luminance.
+    pub fn merge(&mut self, o: &HealthFilm, count: impl Fn(usize) -> u64) {
+        let off = offsets(&self.channels, self.illuminance);
+        let stride = off.stride;
+        for (i, (a, b)) in self
+            .sums
+            .chunks_exact_mut(stride)
+            .zip(o.sums.chunks_exact(stride))
+            .enumerate()
+        {
+            let r = (count(i) % PIXEL_BATCHES as u64) as usize;
+            for at in [off.mel_l, off.mel_e, off.scotopic].into_iter().flatten() {
+                for k in 0..PIXEL_BATCHES {
+                    a[at + (k + r) % PIXEL_BATCHES] += b[at + k];
+                }
+            }
+            for k in off.bands..stride {
+                a[k] += b[k];
+            }
+        }
+    }
     /// A detached pixel's sums (a pass works on copies), to add samples to.
     pub fn view<'a>(&self, sums: &'a mut [f64]) -> HealthPixel<'a> {
         HealthPixel {

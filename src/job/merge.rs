@@ -1,7 +1,9 @@
 //! Merging independent renders of one scene (different seeds) from their state files into one
 //! estimate: the sums add, so the merged film is the render with all their samples. Shards of
 //! one render (`render --shard`) are merged in the order of their index whatever the order they
-//! are given in, so the merged sums, and every output, are the same bit for bit.
+//! are given in, so the merged sums, and every output, are the same bit for bit. Light-and-health
+//! sums (`--alpha-opic`, `--mesopic`, `--spectral-bands`) merge with the film; inputs must keep
+//! the same channels, and OUT.spectral.exr is written when they keep spectral bands.
 
 use super::files::{check_exposure, check_output_dir, film_layers, output_stem, write_png};
 use super::shard::ShardSummary;
@@ -41,6 +43,11 @@ pub struct MergeOutputs {
     pub report_path: Option<PathBuf>,
     /// The merged meters' and grid points' sums (shards that measured them).
     pub meters: Vec<crate::meter::MeterSums>,
+}
+
+/// The light-and-health channels a film keeps (none: the default).
+fn health(film: &crate::film::Film) -> crate::film::HealthChannels {
+    film.health.as_ref().map(|h| h.channels).unwrap_or_default()
 }
 
 /// Merges `states` into OUT.exr, OUT.png, OUT.state and, when an input's render wrote a
@@ -108,6 +115,7 @@ pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Res
             || s.film.width != film.width
             || s.film.height != film.height
             || s.film.decision.is_some() != film.decision.is_some()
+            || health(&s.film) != health(&first.film)
         {
             bail!(
                 "{} and {} are renders of different scenes or settings and cannot be merged",
@@ -182,6 +190,10 @@ pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Res
         }
     }
     output::write_exr(&exr_path, &layers).context("cannot write the EXR")?;
+    if let Some(spectral) = crate::film::spectral_layers(&film, &first.scene) {
+        let path = with_suffix(&stem, ".spectral.exr");
+        output::write_exr(&path, &spectral).context("cannot write the spectral EXR")?;
+    }
     write_png(&film, &png_path, exposure_ev)?;
     let hdr_path = match &view {
         Some(v) => {

@@ -290,11 +290,6 @@ fn check_job(job: &RenderJob) -> Result<()> {
             "--shard splits a fixed number of samples per pixel among the shards; --target-error decides it pixel by pixel as the render goes, which separate shards cannot share: give --shard with --spp",
         ));
     }
-    if job.health.any() && (job.resume || job.shard.is_some()) {
-        return Err(invalid_option(
-            "--alpha-opic, --mesopic and --spectral-bands keep per-pixel sums that render states do not carry: they cannot be combined with --resume or --shard (render with more --spp instead)",
-        ));
-    }
     if job.health.spectral_bands > crate::film::MAX_SPECTRAL_BANDS {
         return Err(invalid_option(format!(
             "--spectral-bands must be at most {}",
@@ -366,6 +361,19 @@ fn initial_film(
             } else {
                 "rendered without"
             }
+        );
+    }
+    let kept = st
+        .film
+        .health
+        .as_ref()
+        .map(|h| h.channels)
+        .unwrap_or_default();
+    if kept != job.health {
+        bail!(
+            "cannot resume from {}: it keeps the light-and-health channels {kept:?}, but this run asks for {:?}; resume it with the same --alpha-opic, --mesopic and --spectral-bands",
+            state_path.display(),
+            job.health
         );
     }
     Ok(st.film)
@@ -500,7 +508,7 @@ pub fn run(
     let mut film = initial_film(&resume_job, &world, hash, shard_info, &state_path)?;
     let resumed_samples = film.total_samples();
     let illuminance = world.settings.illuminance;
-    if job.health.any() {
+    if job.health.any() && film.health.is_none() {
         let h = crate::film::HealthFilm::new(job.health, illuminance, w * h)
             .map_err(anyhow::Error::msg)?;
         film.health = Some(h);

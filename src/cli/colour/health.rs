@@ -1,5 +1,6 @@
 //! The parts of `candela spectrum` beyond classic colorimetry: CIE S 026 α-opic quantities,
-//! CIE 224:2017 / TM-30-20 colour rendition with its colour vector graphic, and the XYZ and
+//! CIE 224:2017 / TM-30-20 colour rendition with its colour vector graphic, NIST CQS 9.0, and
+//! the XYZ and
 //! luminous efficacy by an explicitly chosen method (`--method`, `--efficacy-rule`). See
 //! `docs/colour.md`.
 
@@ -10,6 +11,7 @@ use serde_json::{json, Value};
 
 use candela::colour::alpha_opic::{alpha_opic_quantities, AlphaOpic, AlphaOpicQuantities};
 use candela::colour::colorimetry::{sd_to_xyz_emissive_with, XyzMethod};
+use candela::colour::cqs::{colour_quality_scale, Cqs};
 use candela::colour::grid::LEN;
 use candela::colour::models::xyz_to_xy;
 use candela::colour::tables::Observer;
@@ -74,6 +76,7 @@ fn rule_name(r: EfficacyRule) -> &'static str {
 pub struct Extras {
     alpha_opic: Option<AlphaOpicQuantities>,
     rendition: Option<ColourRendition>,
+    cqs: Option<Cqs>,
     method: Option<(XyzMethod, [f64; 3], [f64; 2])>,
     efficacy: Option<(EfficacyRule, f64)>,
 }
@@ -90,13 +93,16 @@ pub fn extras(
     let alpha_opic = light
         .then(|| alpha_opic_quantities(table))
         .filter(|q| q.illuminance_lx > 0.0 && q.illuminance_lx.is_finite());
+    // Only the shape matters: scale to a peak of 1 so huge or tiny inputs stay finite.
+    let peak = table.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let rendition = if light {
-        // Only the shape matters: scale to a peak of 1 so huge or tiny inputs stay finite.
-        let peak = table.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         colour_rendition(&table.map(|v| v / peak))
     } else {
         None
     };
+    let cqs = light
+        .then(|| quality_scale(&table.map(|v| v / peak)))
+        .flatten();
     if let Some(path) = &opts.cvg {
         let r = rendition.as_ref().with_context(|| {
             "--cvg: the colour vector graphic needs a light source with power in 380–780 nm"
@@ -117,9 +123,18 @@ pub fn extras(
     Ok(Extras {
         alpha_opic,
         rendition,
+        cqs,
         method,
         efficacy,
     })
+}
+
+/// NIST CQS 9.0 of a relative SPD, or None when it has no light in 360–780 nm (no CCT).
+pub fn quality_scale(table: &[f64; LEN]) -> Option<Cqs> {
+    let y = sd_to_xyz_emissive_with(table, Observer::Cie1931_2, XyzMethod::AstmE308)[1];
+    (y > 0.0 && y.is_finite())
+        .then(|| colour_quality_scale(table))
+        .filter(|c| c.q_a.is_finite())
 }
 
 fn reference_name(r: Reference) -> String {
@@ -167,6 +182,22 @@ pub fn add_json(j: &mut Value, e: &Extras) {
                 "chroma_shift_percent": b.chroma_shift_percent,
                 "hue_shift_rad": b.hue_shift_rad,
                 "fidelity": b.fidelity,
+            })).collect::<Vec<_>>(),
+        });
+    }
+    if let Some(c) = &e.cqs {
+        j["cqs"] = json!({
+            "method": "NIST CQS 9.0",
+            "qa": c.q_a,
+            "qf": c.q_f,
+            "qg": c.q_g,
+            "cct_k": c.cct_k,
+            "reference": if c.reference_is_blackbody { "blackbody" } else { "CIE daylight" },
+            "samples": c.samples.iter().map(|s| json!({
+                "qa": s.q_a,
+                "delta_e_ab": s.delta_e_ab,
+                "delta_c_ab": s.delta_c_ab,
+                "delta_e_prime_ab": s.delta_e_p_ab,
             })).collect::<Vec<_>>(),
         });
     }
@@ -270,6 +301,31 @@ pub fn add_text(line: &mut dyn FnMut(&str, String), e: &Extras) {
         line(
             "  Rf,h1–h16",
             row(&|j| format!("{:.1}", r.bins[j].fidelity)),
+        );
+    }
+    if let Some(c) = &e.cqs {
+        line(
+            "CQS (NIST 9.0) Qa, Qf, Qg",
+            format!(
+                "{:.2}, {:.2}, {:.2} (reference: {} at {:.0} K)",
+                c.q_a,
+                c.q_f,
+                c.q_g,
+                if c.reference_is_blackbody {
+                    "blackbody"
+                } else {
+                    "CIE daylight"
+                },
+                c.cct_k
+            ),
+        );
+        line(
+            "  ΔE*ab VS1–VS15",
+            c.samples
+                .iter()
+                .map(|s| format!("{:.2}", s.delta_e_ab))
+                .collect::<Vec<_>>()
+                .join(" "),
         );
     }
 }
