@@ -80,13 +80,13 @@ pub struct RenderOpts {
     /// Render shard I of N (0-based): samples I·spp … (I+1)·spp − 1 of every pixel, so N shards at --spp S merge (`candela merge`) into the render at N·S spp. Writes NAME.shard-I-of-N.state (always) and images; rerunning the same command continues its state. `auto` takes I and N from a Slurm array (SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN, SLURM_ARRAY_TASK_COUNT); `auto/N` takes I from SLURM_ARRAY_TASK_ID, AWS_BATCH_JOB_ARRAY_INDEX or JOB_COMPLETION_INDEX (Kubernetes). See docs/cluster.md.
     #[arg(long, value_name = "I/N|auto|auto/N")]
     shard: Option<String>,
-    /// Also keep the melanopic equivalent daylight luminance per pixel (EXR channels melanopic.EDL, stderr.melanopic.EDL, cd/m²; CIE S 026) and, with --illuminance, the melanopic EDI (melanopic.EDI, stderr.melanopic.EDI, lx). Not with --resume or --shard.
+    /// Also keep the melanopic equivalent daylight luminance per pixel (EXR channels melanopic.EDL, stderr.melanopic.EDL, cd/m²; CIE S 026) and, with --illuminance, the melanopic EDI (melanopic.EDI, stderr.melanopic.EDI, lx). Not with light-traced caustics.
     #[arg(long)]
     alpha_opic: bool,
-    /// Also keep the scotopic luminance per pixel and write the CIE 191 mesopic luminance (EXR channels scotopic.L, mesopic.L, stderr.mesopic.L, mesopic.m). Not with --resume or --shard.
+    /// Also keep the scotopic luminance per pixel and write the CIE 191 mesopic luminance (EXR channels scotopic.L, mesopic.L, stderr.mesopic.L, mesopic.m). Not with light-traced caustics.
     #[arg(long)]
     mesopic: bool,
-    /// Also keep N spectral bands (1 to 64) of equal width over 380–780 nm per pixel and write NAME.spectral.exr (spectral radiance, Fichet et al. 2021 layout). Not with --resume or --shard.
+    /// Also keep N spectral bands (1 to 64) of equal width over 380–780 nm per pixel and write NAME.spectral.exr (spectral radiance, Fichet et al. 2021 layout). Not with light-traced caustics.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
     spectral_bands: u16,
     /// Also write NAME.html, the self-contained HTML report (image with pixel probe, false colour, grids, meters, and the glare evaluation with --glare), as `candela report` does; see docs/report-html.md.
