@@ -321,7 +321,7 @@ pub fn build_for(
             } if geometry::gltf::is_gltf(file) => {
                 let model = (file.as_str(), materials_from_file, *ke_luminance, *lights);
                 let at = format!("{field}.shape");
-                let (parts, found) = geometry::gltf::materials::model_parts(
+                let (parts, found) = super::gltf::model_parts(
                     &ctx,
                     &at,
                     model,

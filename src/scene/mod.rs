@@ -5,6 +5,7 @@
 //! where the parser knows it, and the field path (e.g. `objects[3] "floor".emission.amount`).
 
 pub mod build;
+pub mod gltf;
 
 use std::path::Path;
 

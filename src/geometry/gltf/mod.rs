@@ -8,10 +8,9 @@
 //! space) and the list of node world transforms that place it, so shared meshes need not be
 //! copied by whoever builds instances; [`GltfModel::flatten_count`] says how many triangles a
 //! world-space copy holds. Materials and lights are kept as the file gives them; how they become
-//! candela's is in `materials.rs` and docs/scene-format.md → models.
+//! candela's is in `scene::gltf` and docs/scene-format.md → models.
 
 mod data;
-pub mod materials;
 
 use super::{GeometryError, TriangleMesh};
 use crate::limits;

@@ -5,7 +5,6 @@
 //! Lambertian base. Emission: `emissiveFactor × emissive_strength` in cd/m² (luminance of its
 //! Rec. 709 Y). Lights keep glTF's photometric units: cd for point and spot, lx for directional.
 
-use super::{GltfImage, GltfLight, GltfLightKind, GltfMaterial, GltfModel};
 use crate::bxdf::diffuse::TexturedDiffuse;
 use crate::bxdf::Material;
 use crate::description::context::{Context, Role, SceneError};
@@ -13,6 +12,7 @@ use crate::description::schema::{
     Amount, DistributionDesc, EmissionDesc, IorDesc, LightDesc, MaskingDesc, MaterialDesc,
     SpectrumDesc,
 };
+use crate::geometry::gltf::{GltfImage, GltfLight, GltfLightKind, GltfMaterial, GltfModel};
 use crate::texture::{Texture, Wrap};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -361,7 +361,7 @@ pub fn model_parts(
             "applies to OBJ models; a glTF material's emission is in cd/m² already (emissive_strength)",
         ));
     }
-    let model = super::load_gltf(&ctx.resolve(file))
+    let model = crate::geometry::gltf::load_gltf(&ctx.resolve(file))
         .map_err(|e| crate::geometry::mesh_err(ctx, field, file, e))?;
     let mut lights = Vec::new();
     if with_lights {
