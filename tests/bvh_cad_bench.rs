@@ -31,6 +31,19 @@ fn rss() -> (u64, u64) {
     (kb("VmRSS:"), kb("VmHWM:"))
 }
 
+unsafe extern "C" {
+    /// glibc: returns freed heap memory to the system, so that RSS counts live data.
+    fn malloc_trim(pad: usize) -> i32;
+}
+
+/// Returns freed heap memory to the system (RSS then counts what is live).
+fn trim() {
+    // SAFETY: malloc_trim only releases free memory of glibc's heap.
+    unsafe {
+        malloc_trim(0);
+    }
+}
+
 /// Resets VmHWM to the current RSS.
 fn reset_peak() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
@@ -91,12 +104,15 @@ struct Built {
 }
 
 fn build(shapes: &[(Shape, u32)], groups: &[InstanceGroup]) -> Built {
+    trim();
     let before = rss().0;
     reset_peak();
     let t = Instant::now();
     let geo = SceneGeometry::build_instanced(shapes, &[], groups).expect("valid geometry");
     let seconds = t.elapsed().as_secs_f64();
-    let (now, peak) = rss();
+    let peak = rss().1;
+    trim();
+    let now = rss().0;
     Built {
         geo,
         seconds,
