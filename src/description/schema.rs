@@ -564,6 +564,12 @@ pub enum ShapeDesc {
         #[serde(default)]
         lights: bool,
     },
+    /// One mesh (`Obj`, `Ply`, `Triangles` or `Model`) stored once and placed at each of
+    /// `transforms` (each applied before the object's own `transform`).
+    Instances {
+        mesh: Box<ShapeDesc>,
+        transforms: Vec<TransformDesc>,
+    },
 }
 
 fn unique_override_keys<'de, D>(d: D) -> Result<BTreeMap<String, MaterialRefDesc>, D::Error>

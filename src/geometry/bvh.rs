@@ -30,6 +30,11 @@ pub(super) const MAX_DEPTH: usize = 64;
 /// Most levels of the binary tree.
 const MAX_BVH2_HEIGHT: u32 = MAX_DEPTH as u32 - 1;
 
+/// Peak memory of [`SceneGeometry::build`] per primitive, bytes, beyond its input: the
+/// primitives, their boxes and ids, the binary and the wide tree (measured: 170–250 B for
+/// 10⁵–10⁷ triangles, tests/bvh_cad_bench.rs).
+pub const BUILD_PEAK_BYTES_PER_PRIM: u64 = 300;
+
 /// obvhs's `BvhBuildParams::medium_build()` values for the steps after PLOC.
 const REINSERTION_BATCH_RATIO: f32 = 0.05;
 const MAX_PRIMS_PER_LEAF: u32 = 3;
@@ -85,6 +90,57 @@ fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
     sah::build(aabbs, MAX_BVH2_HEIGHT)
 }
 
+/// The CWBVH over `aabbs` (not empty), leaves of at most `max_prims_per_leaf`, with empty
+/// child slots made unhittable.
+pub(super) fn build_cwbvh(aabbs: &[Aabb], max_prims_per_leaf: u32) -> CwBvh {
+    let mut bvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
+        &build_bvh2(aabbs),
+        max_prims_per_leaf,
+        true,
+        false,
+    );
+    bvh.nodes.shrink_to_fit();
+    // Empty child slots get inverted boxes (min 255 > max 0) so the node test misses them
+    // (it does not check the slot's meta byte).
+    for node in &mut bvh.nodes {
+        for k in 0..8 {
+            if node.child_meta[k] == 0 {
+                node.child_min_x[k] = 255;
+                node.child_min_y[k] = 255;
+                node.child_min_z[k] = 255;
+                node.child_max_x[k] = 0;
+                node.child_max_y[k] = 0;
+                node.child_max_z[k] = 0;
+            }
+        }
+    }
+    bvh
+}
+
+/// Refuses a CWBVH too deep for the traversal stack (which the binary tree's height bound
+/// already excludes).
+pub(super) fn check_depth(bvh: &CwBvh, n: usize) -> Result<(), GeometryError> {
+    let depth = cwbvh_depth(bvh);
+    if depth as usize >= MAX_DEPTH {
+        return Err(GeometryError::InvalidShape {
+            shape: "scene",
+            object: 0,
+            message: format!(
+                "internal error: the BVH over {n} primitives is {depth} levels deep (at most {} supported)",
+                MAX_DEPTH - 1
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The padded box of a primitive or instance with bounds `(a, b)`: a few ulps wider, so that
+/// rounding in bounds and quantization can never exclude its surface.
+pub(super) fn padded_aabb(a: Vec3, b: Vec3) -> Aabb {
+    let pad = (a.abs().max(b.abs()) * gamma(4)) + Vec3::splat(f32::MIN_POSITIVE);
+    Aabb::new((a - pad).into(), (b + pad).into())
+}
+
 fn invalid(shape: &Shape, object: u32, message: impl Into<String>) -> GeometryError {
     GeometryError::InvalidShape {
         shape: shape.name(),
@@ -117,6 +173,18 @@ impl SceneGeometry {
         shapes: &[(Shape, u32)],
         uvs: &[Option<&[glam::Vec2]>],
     ) -> Result<SceneGeometry, GeometryError> {
+        let n: u64 = shapes
+            .iter()
+            .map(|(s, _)| match s {
+                Shape::Mesh(m) => m.indices.len() as u64,
+                _ => 1,
+            })
+            .sum();
+        crate::limits::check_memory(
+            n.saturating_mul(BUILD_PEAK_BYTES_PER_PRIM),
+            &format!("the BVH over {n} primitives"),
+        )
+        .map_err(|message| GeometryError::OutOfMemory { message })?;
         let mut prim_uvs: Vec<[u32; 3]> = Vec::new();
         let mut all_uvs: Vec<glam::Vec2> = Vec::new();
         let any_uvs = uvs.iter().any(Option::is_some);
@@ -290,10 +358,7 @@ impl SceneGeometry {
             }
             lo = lo.min(a);
             hi = hi.max(b);
-            // Pad by a few ulps so rounding in bounds/quantization can never exclude the
-            // primitive's surface.
-            let pad = (a.abs().max(b.abs()) * gamma(4)) + Vec3::splat(f32::MIN_POSITIVE);
-            aabbs.push(Aabb::new((a - pad).into(), (b + pad).into()));
+            aabbs.push(padded_aabb(a, b));
         }
         let bounds = if prims.is_empty() {
             (Vec3::ZERO, Vec3::ZERO)
@@ -303,41 +368,10 @@ impl SceneGeometry {
         let mut bvh = if prims.is_empty() {
             CwBvh::default()
         } else {
-            obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
-                &build_bvh2(&aabbs),
-                MAX_PRIMS_PER_LEAF,
-                true,
-                false,
-            )
+            build_cwbvh(&aabbs, MAX_PRIMS_PER_LEAF)
         };
-        bvh.nodes.shrink_to_fit();
-        // Empty child slots get inverted boxes (min 255 > max 0) so the node test misses them
-        // (it does not check the slot's meta byte).
-        for node in &mut bvh.nodes {
-            for k in 0..8 {
-                if node.child_meta[k] == 0 {
-                    node.child_min_x[k] = 255;
-                    node.child_min_y[k] = 255;
-                    node.child_min_z[k] = 255;
-                    node.child_max_x[k] = 0;
-                    node.child_max_y[k] = 0;
-                    node.child_max_z[k] = 0;
-                }
-            }
-        }
         // The traversal stack's bound, which the binary tree's height already guarantees.
-        let depth = cwbvh_depth(&bvh);
-        if depth as usize >= MAX_DEPTH {
-            return Err(GeometryError::InvalidShape {
-                shape: "scene",
-                object: 0,
-                message: format!(
-                    "internal error: the BVH over {} primitives is {depth} levels deep (at most {} supported)",
-                    prims.len(),
-                    MAX_DEPTH - 1
-                ),
-            });
-        }
+        check_depth(&bvh, prims.len())?;
         drop(aabbs);
 
         // Lay primitives out in leaf order so the traversal indexes them directly.
@@ -393,6 +427,7 @@ impl SceneGeometry {
             uvs: all_uvs,
             object_prims,
             bounds,
+            instances: None,
         })
     }
 }

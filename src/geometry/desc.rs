@@ -129,6 +129,12 @@ impl Shape {
             ShapeDesc::Model { .. } => {
                 return Err(ctx.err(field, "a Model is built with its materials by the scene"))
             }
+            ShapeDesc::Instances { .. } => {
+                return Err(ctx.err(
+                    field,
+                    "Instances are built by the scene (an Instances shape cannot be nested)",
+                ))
+            }
             ShapeDesc::Ply(rel) => {
                 Shape::Mesh(load_ply(&ctx.resolve(rel)).map_err(|e| mesh_err(ctx, field, rel, e))?)
             }
@@ -137,6 +143,34 @@ impl Shape {
 }
 
 impl Transform {
+    /// The transforms of an `Instances` shape at `field` (`field.transforms[k]`): at least one,
+    /// each finite and invertible.
+    pub fn build_instances(
+        ctx: &Context,
+        field: &str,
+        transforms: &[TransformDesc],
+    ) -> Result<Vec<Transform>, SceneError> {
+        if transforms.is_empty() {
+            return Err(ctx.err(
+                format!("{field}.transforms"),
+                "the list is empty: give at least one transform (the instance's placement)",
+            ));
+        }
+        let mut out = Vec::with_capacity(transforms.len());
+        for (k, t) in transforms.iter().enumerate() {
+            let f = format!("{field}.transforms[{k}]");
+            let tf = Transform::build(ctx, &f, t)?;
+            if !tf.is_invertible() {
+                return Err(ctx.err(
+                    f,
+                    "the transform is singular (a scale too small or too large to invert in single precision)",
+                ));
+            }
+            out.push(tf);
+        }
+        Ok(out)
+    }
+
     /// The transform `t` describes at `field` (scale factors must be positive).
     pub fn build(ctx: &Context, field: &str, t: &TransformDesc) -> Result<Transform, SceneError> {
         let tr = match t.translate {

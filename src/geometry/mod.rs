@@ -36,6 +36,7 @@
 mod bvh;
 mod desc;
 pub mod gltf;
+mod instance;
 mod io;
 pub mod mtl;
 mod prim;
@@ -45,7 +46,9 @@ mod sample;
 mod scene;
 mod traverse;
 
+pub use bvh::BUILD_PEAK_BYTES_PER_PRIM;
 pub(crate) use desc::mesh_err;
+pub use instance::{InstanceGroup, NO_INSTANCE};
 pub use io::{load_obj, load_obj_model, load_ply, ObjGroup, ObjModel};
 pub use query::RayHit;
 pub use robust::{
@@ -119,6 +122,9 @@ pub enum GeometryError {
         object: u32,
         message: String,
     },
+    /// The BVH over the scene's primitives would need more memory than is available.
+    #[error("the scene's geometry is too large to build: {message}.")]
+    OutOfMemory { message: String },
     /// A transform cannot be applied to a shape.
     #[error("cannot transform {shape}: {message}.")]
     InvalidTransform {
@@ -412,6 +418,10 @@ pub struct Hit {
     pub prim: u32,
     /// The caller's id of the scene object the primitive came from.
     pub object: u32,
+    /// The instance hit (its index in the caller's order over all instance groups), or
+    /// [`NO_INSTANCE`]. On an instance, `prim` is the primitive's id within the instanced mesh,
+    /// not an id the primitive lookups (`prim_area`, sampling) take.
+    pub instance: u32,
     /// The ray arrived on the side `ng` points to (`dot(dir, ng) < 0`).
     pub front_face: bool,
     /// Conservative per-axis absolute error bound of `p` (for [`offset_ray_origin`]).

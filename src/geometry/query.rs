@@ -121,11 +121,22 @@ impl SceneGeometry {
     /// This is [`SceneGeometry::intersect_basic`]'s traversal followed by the full hit record
     /// (point, unit normals, shading normal, error bounds).
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
-        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+        if !Self::ray_ok(origin, dir, t_max) {
             return None;
         }
         let pre = RayPre::new(origin, dir);
-        let (prim, t, a, b) = self.closest_dyn(&pre, t_max)?;
+        let flat = if self.tris.is_empty() {
+            None
+        } else {
+            self.closest_dyn(&pre, t_max)
+        };
+        if let Some(set) = &self.instances {
+            let t = flat.map_or(t_max, |f| f.1);
+            if let Some(h) = set.closest(origin, dir, t) {
+                return Some(set.make_hit(h, dir));
+            }
+        }
+        let (prim, t, a, b) = flat?;
         Some(self.make_hit(prim, &pre, t, a, b))
     }
 
@@ -133,11 +144,34 @@ impl SceneGeometry {
     /// the unnormalized geometric normal, and the primitive and object ids. Same hits and
     /// conventions as [`SceneGeometry::intersect`], without building the full [`Hit`].
     pub fn intersect_basic(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<RayHit> {
-        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+        if !Self::ray_ok(origin, dir, t_max) {
             return None;
         }
         let pre = RayPre::new(origin, dir);
-        let (prim, t, u, v) = self.closest_dyn(&pre, t_max)?;
+        let flat = if self.tris.is_empty() {
+            None
+        } else {
+            self.closest_dyn(&pre, t_max)
+        };
+        if let Some(set) = &self.instances {
+            let t = flat.map_or(t_max, |f| f.1);
+            if let Some(h) = set.closest(origin, dir, t) {
+                let (ng, object) = set.basic(&h);
+                let (_, _, prim, (t, mut u, mut v)) = h;
+                if set.mirrored(&h) {
+                    std::mem::swap(&mut u, &mut v);
+                }
+                return Some(RayHit {
+                    t,
+                    u,
+                    v,
+                    ng,
+                    prim,
+                    object,
+                });
+            }
+        }
+        let (prim, t, u, v) = flat?;
         let tri = &self.tris[prim as usize];
         let ng = if tri[0].x.is_nan() {
             self.prim(prim).normal_at(origin + t * dir)
@@ -156,7 +190,7 @@ impl SceneGeometry {
 
     /// Closest-hit traversal: (primitive, t, a, b) of the closest hit.
     #[inline(always)]
-    fn closest_dyn(&self, pre: &RayPre, t_max: f32) -> Option<(u32, f32, f32, f32)> {
+    pub(super) fn closest_dyn(&self, pre: &RayPre, t_max: f32) -> Option<(u32, f32, f32, f32)> {
         match pre.kz {
             0 => self.closest::<0>(pre, t_max),
             1 => self.closest::<1>(pre, t_max),
@@ -225,7 +259,7 @@ impl SceneGeometry {
 
     /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
     /// brute-force tests).
-    fn make_hit(&self, prim: u32, pre: &RayPre, t: f32, a: f32, b: f32) -> Hit {
+    pub(super) fn make_hit(&self, prim: u32, pre: &RayPre, t: f32, a: f32, b: f32) -> Hit {
         let v = &self.tris[prim as usize];
         let g = if v[0].x.is_nan() {
             self.others[v[1].x.to_bits() as usize].hit_geom(pre, t, a, b)
@@ -261,6 +295,7 @@ impl SceneGeometry {
             tex,
             prim,
             object: self.prim_object[prim as usize],
+            instance: super::NO_INSTANCE,
             front_face: pre.d.dot(g.ng) < 0.0,
             error: g.error,
         }
@@ -269,15 +304,24 @@ impl SceneGeometry {
     /// True if anything is hit with `t` in `(0, t_max)` (any-hit traversal, for shadow rays).
     /// Same ray conventions as [`SceneGeometry::intersect`].
     pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+        if !Self::ray_ok(origin, dir, t_max) {
             return false;
         }
-        let pre = RayPre::new(origin, dir);
-        let block = |_: u32, _: &RayPre, _: PrimT| false;
-        match pre.kz {
-            0 => self.any_hit::<0>(&pre, t_max, block),
-            1 => self.any_hit::<1>(&pre, t_max, block),
-            _ => self.any_hit::<2>(&pre, t_max, block),
+        if !self.tris.is_empty() {
+            let pre = RayPre::new(origin, dir);
+            let block = |_: u32, _: &RayPre, _: PrimT| false;
+            let hit = match pre.kz {
+                0 => self.any_hit::<0>(&pre, t_max, block),
+                1 => self.any_hit::<1>(&pre, t_max, block),
+                _ => self.any_hit::<2>(&pre, t_max, block),
+            };
+            if hit {
+                return true;
+            }
+        }
+        match &self.instances {
+            Some(set) => set.any_hit(origin, dir, t_max, &mut |_, _| false),
+            None => false,
         }
     }
 
@@ -296,7 +340,7 @@ impl SceneGeometry {
         passes: &[bool],
         mut crossed: impl FnMut(&Hit) -> bool,
     ) -> bool {
-        if self.tris.is_empty() || !Self::ray_ok(origin, dir, t_max) {
+        if !Self::ray_ok(origin, dir, t_max) {
             return false;
         }
         let pre = RayPre::new(origin, dir);
@@ -321,17 +365,28 @@ impl SceneGeometry {
             }
             true
         };
-        match pre.kz {
-            0 => self.any_hit::<0>(&pre, t_max, &mut pass),
-            1 => self.any_hit::<1>(&pre, t_max, &mut pass),
-            _ => self.any_hit::<2>(&pre, t_max, &mut pass),
+        let blocked = !self.tris.is_empty()
+            && match pre.kz {
+                0 => self.any_hit::<0>(&pre, t_max, &mut pass),
+                1 => self.any_hit::<1>(&pre, t_max, &mut pass),
+                _ => self.any_hit::<2>(&pre, t_max, &mut pass),
+            };
+        if blocked {
+            return true;
+        }
+        match &self.instances {
+            // Instanced meshes are triangles: each crossing is one hit.
+            Some(set) => set.any_hit(origin, dir, t_max, &mut |object, hit| {
+                passes.get(object as usize).copied().unwrap_or(false) && crossed(&hit())
+            }),
+            None => false,
         }
     }
 
     /// Any-hit traversal; a hit primitive for which `pass(prim, ray, (t, a, b))` is true does
     /// not end it.
     #[inline(always)]
-    fn any_hit<const KZ: usize>(
+    pub(super) fn any_hit<const KZ: usize>(
         &self,
         pre: &RayPre,
         t_max: f32,
@@ -388,6 +443,10 @@ impl SceneGeometry {
                 best = Some((i as u32, a, b));
             }
         }
-        best.map(|(i, a, b)| self.make_hit(i, &pre, tmax, a, b))
+        let flat = best.map(|(i, a, b)| self.make_hit(i, &pre, tmax, a, b));
+        match &self.instances {
+            Some(set) => set.brute_force(origin, dir, tmax).or(flat),
+            None => flat,
+        }
     }
 }

@@ -3,6 +3,7 @@
 //! queries in `query` (over the node walk in `traverse`), primitive sampling in `sample`.
 
 use super::bvh::cwbvh_depth;
+use super::instance::InstanceSet;
 use super::prim::Prim;
 use glam::Vec3;
 use obvhs::cwbvh::node::CwBvhNode;
@@ -29,6 +30,9 @@ pub struct SceneGeometry {
     /// (object id, primitive ids), sorted by object id.
     pub(super) object_prims: Vec<(u32, Vec<u32>)>,
     pub(super) bounds: (Vec3, Vec3),
+    /// Instanced meshes and their top-level BVH; `None` when the scene has none, so that
+    /// scenes without instances pay one branch per query for them.
+    pub(super) instances: Option<Box<InstanceSet>>,
 }
 
 impl SceneGeometry {
@@ -67,6 +71,8 @@ impl SceneGeometry {
         self.bounds
     }
 
+    /// Primitives stored outside instances (instanced meshes: see
+    /// [`SceneGeometry::instanced_triangle_count`]).
     pub fn primitive_count(&self) -> usize {
         self.tris.len()
     }
@@ -81,7 +87,8 @@ impl SceneGeometry {
         self.bvh.nodes.len()
     }
 
-    /// Approximate heap memory in bytes (BVH nodes, primitive data, per-primitive ids, normals).
+    /// Approximate heap memory in bytes (BVH nodes, primitive data, per-primitive ids, normals,
+    /// instances and their meshes).
     pub fn memory_bytes(&self) -> usize {
         self.bvh.nodes.capacity() * std::mem::size_of::<CwBvhNode>()
             + self.bvh.primitive_indices.capacity() * 4
@@ -97,5 +104,6 @@ impl SceneGeometry {
                 .iter()
                 .map(|(_, v)| v.capacity() * 4 + 32)
                 .sum::<usize>()
+            + self.instances.as_ref().map_or(0, |s| s.memory_bytes())
     }
 }

@@ -13,6 +13,9 @@ use glam::Vec3;
 use std::collections::HashMap;
 use std::path::Path;
 
+mod instances;
+use instances::{instance_group, instance_spheres, InstanceParts};
+
 /// Overrides of the scene's render settings by the job (`candela render`'s options).
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
@@ -270,6 +273,7 @@ pub fn build_for(
     let mut objects = Vec::with_capacity(scene.objects.len());
     let mut pending_area: Vec<(u32, String, EmissionDesc, DenseSpectrum)> = Vec::new();
     let mut model_lights: Vec<(String, LightDesc)> = Vec::new();
+    let mut groups: Vec<(usize, InstanceParts)> = Vec::new();
     let lookup = |field: &str, name: &str| -> Result<u32, SceneError> {
         material_index.get(name).copied().ok_or_else(|| {
             let mut known: Vec<&str> = material_index.keys().copied().collect();
@@ -306,7 +310,23 @@ pub fn build_for(
                 None => Ok(shape),
             }
         };
-        let parts = match &o.shape {
+        // An `Instances` shape: its mesh's parts, placed at each of its transforms below.
+        let (shape_desc, instances) = match &o.shape {
+            ShapeDesc::Instances { mesh, transforms } => (
+                mesh.as_ref(),
+                Some(Transform::build_instances(
+                    &ctx,
+                    &format!("{field}.shape"),
+                    transforms,
+                )?),
+            ),
+            desc => (desc, None),
+        };
+        let shape_field = match instances {
+            Some(_) => format!("{field}.shape.mesh"),
+            None => format!("{field}.shape"),
+        };
+        let parts = match shape_desc {
             ShapeDesc::Model { .. } if o.emission.is_some() => {
                 return Err(ctx.err(
                     format!("{field}.emission"),
@@ -358,11 +378,33 @@ pub fn build_for(
                 &mut materials,
             )?,
             desc => vec![Part {
-                shape: Shape::build(&ctx, &format!("{field}.shape"), desc)?,
+                shape: Shape::build(&ctx, &shape_field, desc)?,
                 uvs: None,
                 material: lookup(&format!("{field}.material"), &o.material)?,
                 emission: o.emission.clone(),
             }],
+        };
+        let parts = match instances {
+            Some(tfs) => match instance_group(&ctx, &field, parts, tfs, transform.as_ref())? {
+                Ok(group) => {
+                    for _ in &group.transforms {
+                        for part in &group.parts {
+                            scene_object.push(i);
+                            objects.push(Object {
+                                material: part.material,
+                                light: None,
+                            });
+                        }
+                    }
+                    groups.push((
+                        objects.len() - group.transforms.len() * group.parts.len(),
+                        group,
+                    ));
+                    continue;
+                }
+                Err(copies) => copies,
+            },
+            None => parts,
         };
         for part in parts {
             let id = objects.len() as u32;
@@ -391,6 +433,11 @@ pub fn build_for(
                 .contains(MaterialFlags::DELTA)
         })
         .filter_map(|(shape, _)| crate::world::caustic_lights::bounding_sphere(shape))
+        .chain(
+            groups
+                .iter()
+                .flat_map(|(_, g)| instance_spheres(g, &materials)),
+        )
         .collect();
     // The film's memory, before the BVH is built: light tracing (when anything can start and
     // aim its paths) keeps more per pixel.
@@ -413,15 +460,28 @@ pub fn build_for(
         caustics,
     )?;
     let uvs: Vec<Option<&[glam::Vec2]>> = shape_uvs.iter().map(|u| u.as_deref()).collect();
-    let geometry = SceneGeometry::build_with_uvs(&shapes, &uvs).map_err(|e| {
-        let field = match &e {
-            geometry::GeometryError::InvalidShape { object, .. } => scene_object
-                .get(*object as usize)
-                .map(|&i| format!("{}.shape", object_field(i, &scene.objects[i]))),
-            _ => None,
-        };
-        ctx.err(field.unwrap_or_else(|| "objects".into()), e.to_string())
-    })?;
+    let instance_groups: Vec<geometry::InstanceGroup> = groups
+        .iter()
+        .map(|(first, g)| geometry::InstanceGroup {
+            parts: g
+                .parts
+                .iter()
+                .map(|p| (&p.shape, p.uvs.as_deref()))
+                .collect(),
+            transforms: &g.transforms,
+            first_object: *first as u32,
+        })
+        .collect();
+    let geometry =
+        SceneGeometry::build_instanced(&shapes, &uvs, &instance_groups).map_err(|e| {
+            let field = match &e {
+                geometry::GeometryError::InvalidShape { object, .. } => scene_object
+                    .get(*object as usize)
+                    .map(|&i| format!("{}.shape", object_field(i, &scene.objects[i]))),
+                _ => None,
+            };
+            ctx.err(field.unwrap_or_else(|| "objects".into()), e.to_string())
+        })?;
     let (lo, hi) = geometry.bounds();
     let scene_radius = if lo.is_finite() && hi.is_finite() && hi.cmpge(lo).all() {
         (0.5 * (hi - lo).length()).max(1e-6)
