@@ -318,27 +318,6 @@ fn boxes_scene(objects: &str) -> String {
     )
 }
 
-/// Mean Y and its standard error over the `b`×`b` pixel blocks of a film.
-fn blocks(film: &candela::film::Film, b: usize) -> Vec<(f64, f64)> {
-    let (w, h) = (film.width, film.height);
-    let mut out = Vec::new();
-    for by in 0..h / b {
-        for bx in 0..w / b {
-            let (mut m, mut v) = (0.0, 0.0);
-            for y in by * b..(by + 1) * b {
-                for x in bx * b..(bx + 1) * b {
-                    let p = &film.pixels[y * w + x];
-                    m += p.mean_xyz()[1];
-                    v += p.y_standard_error().powi(2);
-                }
-            }
-            let n = (b * b) as f64;
-            out.push((m / n, v.sqrt() / n));
-        }
-    }
-    out
-}
-
 /// 1 000 instances of a box render as 1 000 copies written as separate objects. Not
 /// bit-identical: an instance is intersected in its object space, so hit points differ from
 /// the copies' in the last bits and a path can take another turn. With the same seed the two
@@ -372,7 +351,11 @@ fn thousand_instances_render_as_thousand_copies() {
         .filter(|(p, q)| p.mean_xyz() == q.mean_xyz())
         .count();
     let mut worst = 0.0f64;
-    for (i, ((ma, sa), (mb, sb))) in blocks(&a, 8).iter().zip(&blocks(&b, 8)).enumerate() {
+    for (i, ((ma, sa), (mb, sb))) in common::block_means(&a, 8)
+        .iter()
+        .zip(&common::block_means(&b, 8))
+        .enumerate()
+    {
         let z = (ma - mb) / (sa * sa + sb * sb).sqrt();
         worst = worst.max(z.abs());
         assert!(

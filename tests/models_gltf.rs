@@ -181,34 +181,6 @@ fn cornell_with_model(file: &str) -> String {
     )
 }
 
-fn build(text: &str, dir: &Path) -> candela::world::World {
-    let path = dir.join("scene.ron");
-    std::fs::write(&path, text).unwrap();
-    candela::scene::load_world(&path, &candela::scene::Overrides::default())
-        .unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Mean Y and its standard error over the `b`×`b` pixel blocks of a film.
-fn blocks(film: &candela::film::Film, b: usize) -> Vec<(f64, f64)> {
-    let (w, h) = (film.width, film.height);
-    let mut out = Vec::new();
-    for by in 0..h / b {
-        for bx in 0..w / b {
-            let (mut m, mut v) = (0.0, 0.0);
-            for y in by * b..(by + 1) * b {
-                for x in bx * b..(bx + 1) * b {
-                    let p = &film.pixels[y * w + x];
-                    m += p.mean_xyz()[1];
-                    v += p.y_standard_error().powi(2);
-                }
-            }
-            let n = (b * b) as f64;
-            out.push((m / n, v.sqrt() / n));
-        }
-    }
-    out
-}
-
 /// The Cornell box written as a `.glb` (nested node transforms) with the RON spectra given by
 /// name renders the same image as the RON scene: every 6×6-pixel block agrees within 4.5
 /// combined standard errors (64 blocks: a false alarm has probability 4·10⁻⁴), and so does the
@@ -230,14 +202,14 @@ fn cornell_box_from_gltf_renders_as_the_ron_scene() {
         );
         assert_eq!(a.primitives[0].mesh.indices, b.primitives[0].mesh.indices);
     }
-    let ron = build(&cornell_text(), dir.path());
-    let model = build(
+    let ron = common::world_in(&cornell_text(), dir.path());
+    let model = common::world_in(
         &cornell_with_model("cornell.glb").replace("seed: 0", "seed: 7"),
         dir.path(),
     );
     assert_eq!(model.objects.len(), ron.objects.len());
     let (a, b) = (common::render(&ron, 1), common::render(&model, 1));
-    let (ba, bb) = (blocks(&a, 6), blocks(&b, 6));
+    let (ba, bb) = (common::block_means(&a, 6), common::block_means(&b, 6));
     let mut worst = 0.0f64;
     for (i, ((ma, sa), (mb, sb))) in ba.iter().zip(&bb).enumerate() {
         let z = (ma - mb) / (sa * sa + sb * sb).sqrt();
@@ -325,7 +297,7 @@ fn punctual_lights_give_their_photometric_values() {
         };
         let name = if k % 2 == 0 { "l.glb" } else { "l.gltf" };
         write(&doc, dir.path(), name);
-        let w = build(
+        let w = common::world_in(
             &light_scene(
                 name,
                 r#"Illuminance(name: "m", position: (0.5, 0.0, 0.0), normal: (0, 1, 0))"#,
@@ -362,7 +334,7 @@ fn punctual_lights_give_their_photometric_values() {
         r#"Illuminance(name: "m", position: (0.5, 0.001, 0.0), normal: (0, 1, 0))"#,
     )
     .replace("}))],", "}), transform: (translate: (0, 0, 1)))],");
-    let e = measure_all(&build(&text, dir.path())).meters[0];
+    let e = measure_all(&common::world_in(&text, dir.path())).meters[0];
     let want = 100.0 * (2.0 / 5f64.sqrt()) / 5.0;
     eprintln!(
         "moved point light: {} ± {} lx, expected {want}",
@@ -375,7 +347,7 @@ fn punctual_lights_give_their_photometric_values() {
         r#"Illuminance(name: "m", position: (0.5, 0.0, 0.0), normal: (0, 1, 0))"#,
     )
     .replace("lights: true, ", "");
-    let w = build(&text, dir.path());
+    let w = common::world_in(&text, dir.path());
     assert!(w.lights.is_empty());
 }
 
@@ -403,7 +375,7 @@ fn emissive_material_is_seen_at_its_luminance() {
     objects: [(shape: Model(file: "e.glb"))],
     meters: [Luminance(name: "l", position: (0.3, 1, 0.2), direction: (0, -1, 0), half_angle_deg: 5)],
 )"#;
-        let w = build(text, dir.path());
+        let w = common::world_in(text, dir.path());
         let want = s * (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]);
         common::assert_every_pixel(&common::render(&w, 1), want, 5.0);
         let m = measure_all(&w).meters[0];
@@ -700,7 +672,7 @@ fn textured_gltf_floor_mean_luminance_is_e_rho_over_pi() {
     objects: [(shape: Model(file: "t.glb"))],
     lights: [Distant(direction: (0, -1, 0), spectrum: Named("D65"), amount: Illuminance(1000.0))],
 )"#;
-    let w = build(text, dir.path());
+    let w = common::world_in(text, dir.path());
     assert!(w
         .materials
         .iter()
@@ -751,7 +723,7 @@ fn gltf_materials_map_by_rule() {
     objects: [(shape: Model(file: "m.glb"))],
     lights: [Distant(direction: (0, -1, 0), spectrum: Named("D65"), amount: Illuminance(1000.0))],
 )"#;
-    let w = build(text, dir.path());
+    let w = common::world_in(text, dir.path());
     let mats: Vec<&Material> = w
         .objects
         .iter()

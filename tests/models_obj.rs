@@ -69,34 +69,6 @@ fn cornell_obj(dir: &Path) -> String {
     )
 }
 
-fn build(text: &str, dir: &Path) -> candela::world::World {
-    let path = dir.join("scene.ron");
-    std::fs::write(&path, text).unwrap();
-    candela::scene::load_world(&path, &candela::scene::Overrides::default())
-        .unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Mean Y and its standard error over the `b`×`b` pixel blocks of a film.
-fn blocks(film: &candela::film::Film, b: usize) -> Vec<(f64, f64)> {
-    let (w, h) = (film.width, film.height);
-    let mut out = Vec::new();
-    for by in 0..h / b {
-        for bx in 0..w / b {
-            let (mut m, mut v) = (0.0, 0.0);
-            for y in by * b..(by + 1) * b {
-                for x in bx * b..(bx + 1) * b {
-                    let p = &film.pixels[y * w + x];
-                    m += p.mean_xyz()[1];
-                    v += p.y_standard_error().powi(2);
-                }
-            }
-            let n = (b * b) as f64;
-            out.push((m / n, v.sqrt() / n));
-        }
-    }
-    out
-}
-
 /// The Cornell box built from OBJ + MTL with the RON spectra given by name renders the same
 /// image as the RON scene: every 6×6-pixel block agrees within 4.5 combined standard errors
 /// (64 blocks: a false alarm has probability 4·10⁻⁴), and so does the image mean.
@@ -104,12 +76,12 @@ fn blocks(film: &candela::film::Film, b: usize) -> Vec<(f64, f64)> {
 fn cornell_box_from_obj_renders_as_the_ron_scene() {
     let dir = tempfile::tempdir().unwrap();
     let obj_text = cornell_obj(dir.path()).replace("seed: 0", "seed: 7");
-    let ron = build(&cornell_text(), dir.path());
-    let obj = build(&obj_text, dir.path());
+    let ron = common::world_in(&cornell_text(), dir.path());
+    let obj = common::world_in(&obj_text, dir.path());
     // Four MTL materials, each its own object (the light is one more object).
     assert_eq!(obj.objects.len(), 5);
     let (a, b) = (common::render(&ron, 1), common::render(&obj, 1));
-    let (ba, bb) = (blocks(&a, 6), blocks(&b, 6));
+    let (ba, bb) = (common::block_means(&a, 6), common::block_means(&b, 6));
     let mut worst = 0.0f64;
     for (i, ((ma, sa), (mb, sb))) in ba.iter().zip(&bb).enumerate() {
         let z = (ma - mb) / (sa * sa + sb * sb).sqrt();
@@ -142,7 +114,7 @@ fn mtl_materials_map_by_rule() {
         &text[..start],
         &text[end..]
     );
-    let w = build(&text, dir.path());
+    let w = common::world_in(&text, dir.path());
     // The scene's own materials come first: search the model's, from the end.
     let red = w
         .materials
@@ -238,7 +210,7 @@ fn textured_plane_mean_luminance_is_e_rho_over_pi() {
         let expected = 1000.0 * rho / std::f64::consts::PI;
         // uv runs 0..1 across the 4 m quad; the camera sees its middle 2 m: 4 periods.
         let r = format!("Texture(file: \"{file}\", uv_scale: (8, 8))");
-        let w = build(&plane_scene(&r, 64), dir.path());
+        let w = common::world_in(&plane_scene(&r, 64), dir.path());
         let film = common::render(&w, 1);
         let (m, se) = common::image_mean(&film);
         eprintln!(
@@ -351,7 +323,7 @@ fn colorchecker_texels_render_their_srgb_colour() {
     ];
     for p in patches {
         png(&dir.path().join("patch.png"), 1, 1, &[p]);
-        let w = build(&plane_scene("Texture(file: \"patch.png\")", 16), dir.path());
+        let w = common::world_in(&plane_scene("Texture(file: \"patch.png\")", 16), dir.path());
         let (xyz, _) = common::image_mean(&common::render(&w, 1));
         let lin = p.map(|v| candela::colour::rgb::srgb_decode(v as f64 / 255.0));
         let m = [

@@ -348,3 +348,31 @@ pub fn to_sun(alt_deg: f64, az_deg: f64) -> ([f64; 3], glam::Vec3) {
         glam::Vec3::new(enu[0] as f32, enu[2] as f32, -enu[1] as f32),
     )
 }
+
+/// Writes `text` as `dir`/scene.ron and builds its world (files it names resolve from `dir`).
+pub fn world_in(text: &str, dir: &Path) -> World {
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, text).unwrap();
+    scene::load_world(&path, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Mean Y (cd/m²) and its standard error over each `b`×`b` pixel block of a film, row by row.
+pub fn block_means(film: &Film, b: usize) -> Vec<(f64, f64)> {
+    let (w, h) = (film.width, film.height);
+    let mut out = Vec::new();
+    for by in 0..h / b {
+        for bx in 0..w / b {
+            let (mut m, mut v) = (0.0, 0.0);
+            for y in by * b..(by + 1) * b {
+                for x in bx * b..(bx + 1) * b {
+                    let p = &film.pixels[y * w + x];
+                    m += p.mean_xyz()[1];
+                    v += p.y_standard_error().powi(2);
+                }
+            }
+            let n = (b * b) as f64;
+            out.push((m / n, v.sqrt() / n));
+        }
+    }
+    out
+}

@@ -1,0 +1,124 @@
+//! The parts of an OBJ + MTL building model (`Model(file: "x.obj")`): one world object per
+//! material its faces use, mapped from the MTL or replaced by `materials_from_file`.
+
+use crate::bxdf::Material;
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::*;
+use crate::geometry::{self, Shape};
+
+/// One world object made from a scene object: its shape (before the object's transform), its
+/// texture coordinates, material and emission.
+pub(super) struct Part {
+    pub(super) shape: Shape,
+    pub(super) uvs: Option<Vec<glam::Vec2>>,
+    pub(super) material: u32,
+    pub(super) emission: Option<EmissionDesc>,
+}
+
+/// The parts of a `Model` object at `field`: one per material its OBJ file uses, with the
+/// material mapped from the MTL (or given by `materials_from_file`), faces that name none
+/// taking `fallback`; materials made here are appended to `materials`.
+pub(super) fn model_parts(
+    ctx: &Context,
+    field: &str,
+    (file, overrides, ke_luminance): (
+        &str,
+        &std::collections::BTreeMap<String, MaterialRefDesc>,
+        Option<f64>,
+    ),
+    fallback: &str,
+    lookup: &dyn Fn(&str, &str) -> Result<u32, SceneError>,
+    materials: &mut Vec<Material>,
+) -> Result<Vec<Part>, SceneError> {
+    let shape_field = format!("{field}.shape");
+    let model = geometry::load_obj_model(&ctx.resolve(file))
+        .map_err(|e| geometry::mesh_err(ctx, &shape_field, file, e))?;
+    let names = || {
+        let mut n: Vec<&str> = model.materials.iter().map(|m| m.name.as_str()).collect();
+        n.sort_unstable();
+        n.join(", ")
+    };
+    for name in overrides.keys() {
+        if !model.materials.iter().any(|m| &m.name == name) {
+            return Err(ctx.err(
+                format!("{shape_field}.materials_from_file[{name:?}]"),
+                format!(
+                    "{file:?} defines no material {name:?}; its materials: {}",
+                    names()
+                ),
+            ));
+        }
+    }
+    if let Some(l) = ke_luminance {
+        if !(l.is_finite() && l >= 0.0) {
+            return Err(ctx.err(
+                format!("{shape_field}.ke_luminance"),
+                format!("{l} must be a luminance ≥ 0, cd/m²"),
+            ));
+        }
+    }
+    let mut parts = Vec::with_capacity(model.groups.len());
+    for g in model.groups {
+        let Some(name) = g.material else {
+            let material = lookup(&format!("{field}.material"), fallback).map_err(|e| {
+                ctx.err(
+                    format!("{field}.material"),
+                    format!("{file:?} has faces before any `usemtl`; they take the object's `material`: {}", e),
+                )
+            })?;
+            parts.push(Part {
+                shape: Shape::Mesh(g.mesh),
+                uvs: g.uvs,
+                material,
+                emission: None,
+            });
+            continue;
+        };
+        let mtl = model
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .expect("the loader checks every usemtl");
+        let over = format!("{shape_field}.materials_from_file[{name:?}]");
+        let material = match overrides.get(&name) {
+            Some(MaterialRefDesc::Named(n)) => lookup(&over, n)?,
+            Some(MaterialRefDesc::Material(desc)) => {
+                materials.push(Material::build(ctx, &over, desc)?);
+                materials.len() as u32 - 1
+            }
+            None => {
+                materials.push(Material::from_mtl(ctx, &shape_field, mtl)?);
+                materials.len() as u32 - 1
+            }
+        };
+        let emission = match (ke_luminance, mtl.ke) {
+            (Some(l), Some(ke)) if ke.iter().any(|&v| v > 0.0) => {
+                if let Some(v) = ke.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+                    return Err(ctx.err(
+                        format!(
+                            "{shape_field} (`Ke` of material {name:?}, '{}' line {})",
+                            mtl.file.display(),
+                            mtl.line
+                        ),
+                        format!("component {v} must be ≥ 0"),
+                    ));
+                }
+                let peak = ke.iter().copied().fold(0.0, f64::max);
+                let y = 0.2126 * ke[0] + 0.7152 * ke[1] + 0.0722 * ke[2];
+                Some(EmissionDesc {
+                    spectrum: SpectrumDesc::Rgb(ke[0] / peak, ke[1] / peak, ke[2] / peak),
+                    amount: Amount::Luminance(l * y),
+                    two_sided: false,
+                })
+            }
+            _ => None,
+        };
+        parts.push(Part {
+            shape: Shape::Mesh(g.mesh),
+            uvs: g.uvs,
+            material,
+            emission,
+        });
+    }
+    Ok(parts)
+}
