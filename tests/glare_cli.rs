@@ -389,7 +389,8 @@ fn glare_refuses_what_it_cannot_evaluate() {
 /// rate itself), and the intervals' stated standard deviation within 25 % of the errors' rms
 /// (60 errors estimate it to ±9 %). A study of about 75 s on 2 cores:
 /// `cargo test --release --test glare_cli -- --ignored --nocapture` (measured: 55 of 60, see
-/// docs/glare.md).
+/// docs/glare.md). It also prints the coverage of the UGR and DGI intervals, as they are and
+/// moved by the bias the draws show, which it does not assert (48 and 49 of 60 at 8 spp).
 #[test]
 #[ignore]
 fn dgp_interval_covers_the_converged_dgp_over_seeds() {
@@ -412,15 +413,28 @@ fn dgp_interval_covers_the_converged_dgp_over_seeds() {
         ];
         let (code, _, stderr) = common::cli(&args, &dir);
         assert_eq!(code, 0, "{stderr}");
-        glare(&dir.join(&name))["dgp"].clone()
+        glare(&dir.join(&name))
     };
-    let truth = render(2048, 1_000_000);
+    let truth_all = render(2048, 1_000_000);
+    let truth = truth_all["dgp"].clone();
     let t = truth["value"].as_f64().unwrap();
+    let mut other = [(0u32, 0u32, 0.0f64); 2];
     let mut covered = 0;
     let trials = 60;
     let (mut err2, mut sd2, mut err) = (0.0, 0.0, 0.0);
     for seed in 0..trials {
-        let d = render(8, seed);
+        let all = render(8, seed);
+        for (o, key) in other.iter_mut().zip(["ugr", "dgi"]) {
+            let (x, tx) = (&all[key], truth_all[key]["value"].as_f64().unwrap());
+            let f = |v: &Value, i: usize| v.as_array().unwrap()[i].as_f64().unwrap();
+            let (lo, hi) = (f(&x["ci95"], 0), f(&x["ci95"], 1));
+            let v = x["value"].as_f64().unwrap();
+            let b = 0.5 * (f(&x["quantiles95"], 0) + f(&x["quantiles95"], 1)) - v;
+            o.0 += (lo <= tx && tx <= hi) as u32;
+            o.1 += (lo - b <= tx && tx <= hi - b) as u32;
+            o.2 += v - tx;
+        }
+        let d = all["dgp"].clone();
         let ci = d["ci95"].as_array().unwrap();
         let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
         covered += (lo <= t && t <= hi) as u32;
@@ -438,6 +452,14 @@ fn dgp_interval_covers_the_converged_dgp_over_seeds() {
         (truth["ci95"][1].as_f64().unwrap() - truth["ci95"][0].as_f64().unwrap()) / 2.0,
         err / n
     );
+    for (o, key) in other.iter().zip(["UGR", "DGI"]) {
+        println!(
+            "{key}: covered {}/{trials}, bias-corrected {}/{trials}, mean error {:+.4}",
+            o.0,
+            o.1,
+            o.2 / n
+        );
+    }
     assert!(covered >= 53, "{covered}/{trials}");
     assert!((0.8..=1.25).contains(&ratio), "{ratio}");
 }
