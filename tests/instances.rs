@@ -350,19 +350,7 @@ fn thousand_instances_render_as_thousand_copies() {
         .zip(&b.pixels)
         .filter(|(p, q)| p.mean_xyz() == q.mean_xyz())
         .count();
-    let mut worst = 0.0f64;
-    for (i, ((ma, sa), (mb, sb))) in common::block_means(&a, 8)
-        .iter()
-        .zip(&common::block_means(&b, 8))
-        .enumerate()
-    {
-        let z = (ma - mb) / (sa * sa + sb * sb).sqrt();
-        worst = worst.max(z.abs());
-        assert!(
-            z.abs() < 4.5,
-            "block {i}: instances {ma} ± {sa}, copies {mb} ± {sb}"
-        );
-    }
+    let worst = common::assert_blocks_agree(&a, &b, 8, ("instances", "copies"));
     let ((ya, sa), (yb, sb)) = (common::image_mean(&a), common::image_mean(&b));
     eprintln!(
         "instances vs copies: mean Y {:.3} vs {:.3} cd/m², worst block |z| {worst:.3}, {identical} of {} pixels bit-identical",

@@ -209,16 +209,7 @@ fn cornell_box_from_gltf_renders_as_the_ron_scene() {
     );
     assert_eq!(model.objects.len(), ron.objects.len());
     let (a, b) = (common::render(&ron, 1), common::render(&model, 1));
-    let (ba, bb) = (common::block_means(&a, 6), common::block_means(&b, 6));
-    let mut worst = 0.0f64;
-    for (i, ((ma, sa), (mb, sb))) in ba.iter().zip(&bb).enumerate() {
-        let z = (ma - mb) / (sa * sa + sb * sb).sqrt();
-        worst = worst.max(z.abs());
-        assert!(
-            z.abs() < 4.5,
-            "block {i}: RON {ma} ± {sa}, glTF {mb} ± {sb} cd/m²"
-        );
-    }
+    let worst = common::assert_blocks_agree(&a, &b, 6, ("RON", "glTF"));
     let ((ya, sa), (yb, sb)) = (common::image_mean(&a), common::image_mean(&b));
     let z = (ya[1] - yb[1]) / (sa.powi(2) + sb.powi(2)).sqrt();
     eprintln!(

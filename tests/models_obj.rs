@@ -81,16 +81,7 @@ fn cornell_box_from_obj_renders_as_the_ron_scene() {
     // Four MTL materials, each its own object (the light is one more object).
     assert_eq!(obj.objects.len(), 5);
     let (a, b) = (common::render(&ron, 1), common::render(&obj, 1));
-    let (ba, bb) = (common::block_means(&a, 6), common::block_means(&b, 6));
-    let mut worst = 0.0f64;
-    for (i, ((ma, sa), (mb, sb))) in ba.iter().zip(&bb).enumerate() {
-        let z = (ma - mb) / (sa * sa + sb * sb).sqrt();
-        worst = worst.max(z.abs());
-        assert!(
-            z.abs() < 4.5,
-            "block {i}: RON {ma} ± {sa}, OBJ {mb} ± {sb} cd/m²"
-        );
-    }
+    let worst = common::assert_blocks_agree(&a, &b, 6, ("RON", "OBJ"));
     let ((ya, sa), (yb, sb)) = (common::image_mean(&a), common::image_mean(&b));
     let z = (ya[1] - yb[1]) / (sa.powi(2) + sb.powi(2)).sqrt();
     eprintln!(

@@ -376,3 +376,22 @@ pub fn block_means(film: &Film, b: usize) -> Vec<(f64, f64)> {
     }
     out
 }
+
+/// Two renders of one view compared block by block (`b`×`b` pixels): asserts that each block's
+/// mean Y agrees within 4.5 combined standard errors, naming the renders `names` in the
+/// message; returns the largest |z|.
+pub fn assert_blocks_agree(a: &Film, b: &Film, block: usize, names: (&str, &str)) -> f64 {
+    let mut worst = 0.0f64;
+    let (ba, bb) = (block_means(a, block), block_means(b, block));
+    for (i, ((ma, sa), (mb, sb))) in ba.iter().zip(&bb).enumerate() {
+        let z = (ma - mb) / (sa * sa + sb * sb).sqrt();
+        worst = worst.max(z.abs());
+        assert!(
+            z.abs() < 4.5,
+            "block {i}: {} {ma} ± {sa}, {} {mb} ± {sb} cd/m²",
+            names.0,
+            names.1
+        );
+    }
+    worst
+}
