@@ -4,7 +4,11 @@
 The room is 8 m x 6 m x 3 m, grey and Lambertian (ceiling 0.8, walls 0.7, floor 0.2), lit by N
 copies of one IES luminaire on a regular ceiling layout, with a 16 x 12 work-plane grid at
 0.8 m. N = 500 is an open-plan floor instead, 60 m x 48 m x 3 m with 25 x 20 luminaires on a
-2.4 m square pitch (about the N = 6 office's 8 m^2 per luminaire), the grid over the whole floor. Radiance is z-up; candela is y-up. A Radiance point (X, Y, Z) is candela's
+2.4 m square pitch (about the N = 6 office's 8 m^2 per luminaire), the grid over the whole floor.
+--n daylit is the N = 6 office without luminaires, daylit instead: an open window (no glazing)
+of WINDOW in the wall at Radiance y = 0, under a CIE overcast sky of SKY_LX horizontal
+illuminance over a ground of reflectance GROUND_RHO (gensky -c -B, Radiance's 179 lm/W; candela's
+Sky with the window as its portal). Radiance is z-up; candela is y-up. A Radiance point (X, Y, Z) is candela's
 (X, Z, 6 - Y): a proper rotation (no mirror), so an asymmetric luminaire keeps its handedness.
 Both tools put C0 along +X and C90 along Radiance's +Y (= candela's -Z), nadir down.
 
@@ -29,6 +33,11 @@ GRID_NX, GRID_NY, GRID_H = 16, 12, 0.8
 LUM_Z = 2.95  # luminaire centre height, m (5 cm below the ceiling)
 LUM_RADIUS = 0.01  # radius of Radiance's illum sphere, m: a near point source, like candela's
 
+# The daylit office's window in the wall y = 0 (Radiance): x from, x to, sill, head (m); its sky.
+WINDOW = (1.0, 7.0, 0.9, 2.4)
+SKY_LX = 10000.0
+GROUND_RHO = 0.2
+
 # Layouts: columns x rows of luminaires at the centres of equal cells of the ceiling.
 LAYOUTS = {6: (3, 2), 48: (8, 6), 500: (25, 20)}
 # The camera of the images (Radiance coordinates): eye 1.6 m high, 0.5 m from the wall y = 6,
@@ -39,6 +48,8 @@ VIEW_VFOV = 60.0
 
 
 def layout(n):
+    if n == "daylit":
+        return []
     if n not in LAYOUTS:
         sys.exit(f"no layout for N={n}; known: {sorted(LAYOUTS)}")
     cols, rows = LAYOUTS[n]
@@ -93,6 +104,28 @@ def candela_scene(n, ies_rel, samples, max_depth, image=None):
     measure: (samples: {samples}),
 """ if not image else "")
     what = f"a {res[0]} x {res[1]} picture" if image else f"{GRID_NX} x {GRID_NY} work-plane grid at {GRID_H} m"
+    if n == "daylit":
+        x0, x1, y0, y1 = WINDOW
+        # The window wall (candela z = ly) as four quads round the opening, normals inward (-z).
+        window_wall = "".join(
+            f"""        (name: "window wall {name}", material: "wall",
+         shape: Quad(origin: {fmt(o)}, edge_u: {fmt(u)}, edge_v: {fmt(v)})),
+"""
+            for name, o, u, v in [
+                ("below", (0, 0, ly), (0, y0, 0), (lx, 0, 0)),
+                ("above", (0, y1, ly), (0, lz - y1, 0), (lx, 0, 0)),
+                ("left", (0, y0, ly), (0, y1 - y0, 0), (x0, 0, 0)),
+                ("right", (x1, y0, ly), (0, y1 - y0, 0), (lx - x1, 0, 0)),
+            ]
+        )
+        portal = f"(origin: {fmt((x0, y0, ly))}, edge_u: {fmt((x1 - x0, 0, 0))}, edge_v: {fmt((0, y1 - y0, 0))})"
+        lights = (f"        Sky(model: CieOvercast, amount: HorizontalIlluminance({SKY_LX}), spectrum: Named(\"E\"),\n"
+                  f"            ground_reflectance: {GROUND_RHO}, portals: [{portal}]),")
+        what += f", daylit through a {x1 - x0:g} m x {y1 - y0:g} m open window under a CIE overcast sky of {SKY_LX:g} lx"
+    else:
+        window_wall = f"""        (name: "wall z=6", material: "wall",
+         shape: Quad(origin: (0.0, 0.0, {ly}), edge_u: (0.0, {lz}, 0.0), edge_v: ({lx}, 0.0, 0.0))),
+"""
     # Quads in candela coordinates: x in [0, lx], y in [0, lz] (up), z in [0, ly].
     return f"""// Radiance benchmark office (bench/radiance/gen_scene.py): {lx:g} x {ly:g} x {lz:g} m, N = {n}
 // luminaires, grey Lambertian surfaces, {what}. Generated; do not edit.
@@ -115,9 +148,7 @@ Scene(
          shape: Quad(origin: ({lx}, 0.0, 0.0), edge_u: (0.0, 0.0, {ly}), edge_v: (0.0, {lz}, 0.0))),
         (name: "wall z=0", material: "wall",
          shape: Quad(origin: (0.0, 0.0, 0.0), edge_u: ({lx}, 0.0, 0.0), edge_v: (0.0, {lz}, 0.0))),
-        (name: "wall z=6", material: "wall",
-         shape: Quad(origin: (0.0, 0.0, {ly}), edge_u: (0.0, {lz}, 0.0), edge_v: ({lx}, 0.0, 0.0))),
-    ],
+{window_wall}    ],
 {grids}    lights: [
 {lights}
     ],
@@ -142,8 +173,23 @@ def radiance_scene(n, lum_modifiers):
     poly("ceiling", "ceiling", [(0, 0, lz), (lx, 0, lz), (lx, ly, lz), (0, ly, lz)])
     poly("wall", "wall_x0", [(0, 0, 0), (0, 0, lz), (0, ly, lz), (0, ly, 0)])
     poly("wall", "wall_x8", [(lx, 0, 0), (lx, ly, 0), (lx, ly, lz), (lx, 0, lz)])
-    poly("wall", "wall_y0", [(0, 0, 0), (lx, 0, 0), (lx, 0, lz), (0, 0, lz)])
+    if n == "daylit":
+        x0, x1, y0, y1 = WINDOW
+        poly("wall", "wall_y0_below", [(0, 0, 0), (lx, 0, 0), (lx, 0, y0), (0, 0, y0)])
+        poly("wall", "wall_y0_above", [(0, 0, y1), (lx, 0, y1), (lx, 0, lz), (0, 0, lz)])
+        poly("wall", "wall_y0_left", [(0, 0, y0), (x0, 0, y0), (x0, 0, y1), (0, 0, y1)])
+        poly("wall", "wall_y0_right", [(x1, 0, y0), (lx, 0, y0), (lx, 0, y1), (x1, 0, y1)])
+    else:
+        poly("wall", "wall_y0", [(0, 0, 0), (lx, 0, 0), (lx, 0, lz), (0, 0, lz)])
     poly("wall", "wall_y6", [(0, ly, 0), (0, ly, lz), (lx, ly, lz), (lx, ly, 0)])
+    if n == "daylit":
+        # The sky of gensky -c (its -B is the sky's horizontal irradiance, W/m^2 at 179 lm/W)
+        # and its ground below the horizon, as glow sources seen only by ambient rays.
+        out.append(f"!gensky -ang 45 0 -c -B {SKY_LX / 179.0:.6f} -g {GROUND_RHO}")
+        out.append("skyfunc glow sky_glow\n0\n0\n4 1 1 1 0")
+        out.append("sky_glow source sky\n0\n0\n4 0 0 1 180")
+        out.append("sky_glow source ground\n0\n0\n4 0 0 -1 180")
+        return "\n".join(out) + "\n"
     # ies2rad's modifier chain (brightdata -> illum 'lum_light') is direction-only, so every
     # luminaire is a sphere of that modifier at its own centre, none rotated.
     out.append(lum_modifiers)
@@ -154,7 +200,7 @@ def radiance_scene(n, lum_modifiers):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--n", type=int, required=True, help="number of luminaires (6, 48 or 500)")
+    ap.add_argument("--n", required=True, help="number of luminaires (6, 48 or 500), or daylit")
     ap.add_argument("--ies", required=True, help="IES file")
     ap.add_argument("--out-dir", required=True)
     ap.add_argument("--samples", type=int, default=4096, help="candela measure.samples per grid point")
@@ -164,6 +210,8 @@ def main():
     ap.add_argument("--image", metavar="WxH", help="also write office-N-image.ron: a W x H picture, no grid")
     a = ap.parse_args()
     global ROOM
+    if a.n != "daylit":
+        a.n = int(a.n)
     ROOM = OPEN_PLAN if a.n == 500 else OFFICE
 
     os.makedirs(a.out_dir, exist_ok=True)

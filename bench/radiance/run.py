@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """candela against Radiance (rtrace -I) on the work-plane grid of an office; see bench/README.md.
 
-For each N (luminaires): writes the scenes (gen_scene.py), makes both converged references
+For each N (luminaires, or "daylit": the office under an overcast sky through a window): writes the scenes (gen_scene.py), makes both converged references
 (cached), checks that they agree within their errors, then times Radiance at its "medium" and
 "high" ambient settings and in Monte Carlo mode against candela at the sample count that gives
 the same RMS error, alternating the runs. Prints a Markdown table; writes everything to
@@ -242,7 +242,8 @@ def bias(values, ref):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--ns", default="6,48", help="luminaire counts (6, 48, 500)")
+    ap.add_argument("--ns", default="6,48", help="luminaire counts (6, 48, 500) and/or daylit (the N = 6 office "
+                    "lit by an overcast sky through a window instead)")
     ap.add_argument("--reps", type=int, default=3, help="timed runs of each configuration")
     ap.add_argument("--reps-high", type=int, default=3, help="timed runs of Radiance \"high\" (minutes each)")
     ap.add_argument("--threads", type=int, default=2)
@@ -275,7 +276,7 @@ def main():
     b = Bench(a)
     results = {"settings": vars(a), "presets": PRESETS, "machine": os.uname().nodename, "ns": {}}
     disagree = False
-    for n in [int(x) for x in a.ns.split(",")]:
+    for n in [x if x == "daylit" else int(x) for x in a.ns.split(",")]:
         b.generate(n)
         if a.radiance_refs_only:
             b.cached(f"refs-radiance-{n}-{b.scene_hash(n)}-{a.ref_ad}ab{a.ref_ab}", a.ref_runs, lambda: b.ref_radiance(n))

@@ -1,32 +1,39 @@
 //! A bounding volume hierarchy over the lights at a finite position, for choosing one light per
 //! shading point in proportion to an estimate of what it sends there (many-light sampling of
 //! Conty Estevez & Kulla 2018, "Importance Sampling of Many Lights with Adaptive Tree
-//! Splitting", without the splitting; the same scheme as pbrt-v4's BVH light sampler).
+//! Splitting", without the splitting; the scheme of pbrt-v4's BVH light sampler, four children
+//! per node).
 //!
 //! Leaves are single emitters: a point, spot or goniometric light, or ONE primitive of an area
 //! light (so a luminous ceiling made of one object with many primitives is sampled by where
-//! its primitives are, not as a whole). Each node stores [`LightBounds`]: a box (m), a power φ
-//! (lm: π L A × sides for an area primitive of luminance L (cd/m²) and area A (m²), 4π × peak
-//! intensity (cd) for point-like sources) and the cones of its emitters' axes and spread.
+//! its primitives are, not as a whole). Each node keeps the [`LightBounds`] of its children: a
+//! box (m), a power φ (lm: π L A × sides for an area primitive of luminance L (cd/m²) and area
+//! A (m²), 4π × peak intensity (cd) for point-like sources) and the cones of their emitters'
+//! axes and spread.
 //!
-//! Sampling walks from the root: at each node both children's importance for the receiver at
-//! p with normal n ([`LightBounds::importance`], φ × bounded emitter cosine × bounded receiver
-//! |cos| / clamped squared distance) is computed, a child is chosen in proportion, and the
-//! sample number is rescaled for the next level. The probability of a leaf is the product of
-//! the choices; [`LightBvh::pmf`] recomputes it by following the leaf's bit trail from the
-//! root (0 = first child, 1 = second), with the same arithmetic as [`LightBvh::sample`], so it
-//! is exactly the probability the sample reported. The bounds are conservative, so a light that
-//! can send light to p never has probability zero.
+//! Sampling walks from the root: at each node its (up to four) children's importances for the
+//! receiver at p with normal n ([`LightBounds::importance`], φ × bounded emitter cosine ×
+//! bounded receiver |cos| / clamped squared distance) are computed together
+//! ([`Bounds4::importance`]), a child is chosen in proportion, and the sample number is
+//! rescaled for the next level. The probability of a leaf is the product of the choices;
+//! [`LightBvh::pmf`] recomputes it by following the leaf's trail from the root (two bits per
+//! level: the child taken), with the same arithmetic as [`LightBvh::sample`], so it is exactly
+//! the probability the sample reported. The bounds are conservative, so a light that can send
+//! light to p never has probability zero.
 //!
-//! The tree is built top-down, splitting each node in two by the surface area–orientation
-//! heuristic over 12 buckets of the centroids along each axis; below depth [`MEDIAN_DEPTH`] it
-//! splits at the median instead, which keeps every trail within 64 bits.
+//! The tree is built top-down as a binary tree, splitting each node in two by the surface
+//! area–orientation heuristic over 12 buckets of the centroids along each axis (below depth
+//! [`MEDIAN_DEPTH`] at the median instead), then collapsed to four children per node: a node's
+//! children are its binary grandchildren (a child that is a leaf is kept as it is). Four
+//! importances cost about as much as one when computed side by side, and the walk is half as
+//! deep.
 
-use super::bounds::{LightBounds, NodeBounds};
+use super::bounds::{Bounds4, LightBounds, NodeBounds};
 use glam::Vec3;
 
-/// Depth below which nodes are split at the median (count), so the tree is at most
-/// `MEDIAN_DEPTH` + 32 levels deep for up to 2³² leaves.
+/// Depth below which nodes are split at the median (count), so the binary tree is at most
+/// `MEDIAN_DEPTH` + 32 levels deep for up to 2³² leaves, and the 4-wide one half that: its
+/// trails (2 bits per level) fit in 64 bits.
 const MEDIAN_DEPTH: u32 = 30;
 const BUCKETS: usize = 12;
 /// The largest f32 below 1, for rescaled sample numbers.
@@ -40,6 +47,7 @@ pub struct Emitter {
     pub bounds: LightBounds,
 }
 
+/// A node of the binary tree the build makes before collapsing it.
 #[derive(Clone, Debug)]
 struct Node {
     bounds: NodeBounds,
@@ -48,17 +56,32 @@ struct Node {
     leaf: bool,
 }
 
+/// A node of the 4-wide tree: its children's bounds side by side and what each child is.
+#[derive(Clone, Debug)]
+struct Node4 {
+    bounds: Bounds4,
+    /// Per child: the index of a node (interior child) or of an emitter (leaf child).
+    child: [u32; 4],
+    /// Bit i: child i is a leaf.
+    leaves: u8,
+    /// Children in use (lanes 0..count).
+    count: u8,
+}
+
 /// Where an emitter sits in the tree.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Trail {
-    /// Bit k: the branch taken at depth k (0 = first child).
+    /// Bits 2k, 2k + 1: the child (0–3) taken at depth k.
     pub bits: u64,
     pub depth: u32,
 }
 
 #[derive(Clone, Debug, Default)]
 pub struct LightBvh {
-    nodes: Vec<Node>,
+    /// The 4-wide tree, root first; empty when there are fewer than two emitters.
+    nodes: Vec<Node4>,
+    /// With exactly one emitter: its bounds (the tree is empty).
+    single: Option<NodeBounds>,
     emitters: Vec<Emitter>,
     trails: Vec<Trail>,
 }
@@ -74,13 +97,21 @@ impl LightBvh {
             })
             .collect();
         let mut bvh = LightBvh {
-            nodes: Vec::with_capacity(2 * emitters.len()),
+            nodes: Vec::new(),
+            single: None,
             trails: vec![Trail::default(); emitters.len()],
             emitters,
         };
-        if !bvh.emitters.is_empty() {
-            let mut items: Vec<u32> = (0..bvh.emitters.len() as u32).collect();
-            bvh.build_node(&mut items, Trail::default());
+        match bvh.emitters.len() {
+            0 => {}
+            1 => bvh.single = Some(NodeBounds::from(&bvh.emitters[0].bounds)),
+            n => {
+                let mut binary = Vec::with_capacity(2 * n);
+                let mut items: Vec<u32> = (0..n as u32).collect();
+                bvh.build_node(&mut binary, &mut items, 0);
+                bvh.nodes.reserve(n);
+                bvh.collapse(&binary, 0, Trail::default());
+            }
         }
         bvh
     }
@@ -94,18 +125,18 @@ impl LightBvh {
         &self.emitters
     }
 
-    /// Number of nodes and the deepest leaf's depth.
+    /// Number of (4-wide) nodes and the deepest leaf's depth in them.
     pub fn stats(&self) -> (usize, u32) {
         let depth = self.trails.iter().map(|t| t.depth).max().unwrap_or(0);
         (self.nodes.len(), depth)
     }
 
-    fn build_node(&mut self, items: &mut [u32], trail: Trail) -> u32 {
-        let at = self.nodes.len() as u32;
+    /// The binary tree over `items`, appended to `out`; returns its root's index.
+    fn build_node(&self, out: &mut Vec<Node>, items: &mut [u32], depth: u32) -> u32 {
+        let at = out.len() as u32;
         if items.len() == 1 {
             let e = items[0];
-            self.trails[e as usize] = trail;
-            self.nodes.push(Node {
+            out.push(Node {
                 bounds: NodeBounds::from(&self.emitters[e as usize].bounds),
                 index: e,
                 leaf: true,
@@ -117,29 +148,61 @@ impl LightBvh {
             .map(|&e| self.emitters[e as usize].bounds)
             .reduce(|a, b| LightBounds::union(&a, &b))
             .expect("a node has emitters");
-        self.nodes.push(Node {
+        out.push(Node {
             bounds: NodeBounds::from(&bounds),
             index: 0,
             leaf: false,
         });
-        let mid = self.split(items, &bounds, trail.depth);
+        let mid = self.split(items, &bounds, depth);
         let (left, right) = items.split_at_mut(mid);
-        self.build_node(
-            left,
-            Trail {
-                bits: trail.bits,
-                depth: trail.depth + 1,
-            },
-        );
-        let second = self.build_node(
-            right,
-            Trail {
-                bits: trail.bits | 1u64 << trail.depth,
-                depth: trail.depth + 1,
-            },
-        );
-        self.nodes[at as usize].index = second;
+        self.build_node(out, left, depth + 1);
+        let second = self.build_node(out, right, depth + 1);
+        out[at as usize].index = second;
         at
+    }
+
+    /// The 4-wide node for the binary interior node `b` (its grandchildren, or a child that is
+    /// a leaf), appended with all its descendants; returns its index.
+    fn collapse(&mut self, binary: &[Node], b: usize, trail: Trail) -> u32 {
+        let at = self.nodes.len();
+        self.nodes.push(Node4 {
+            bounds: Bounds4::default(),
+            child: [0; 4],
+            leaves: 0,
+            count: 0,
+        });
+        let mut kids: Vec<usize> = Vec::with_capacity(4);
+        for c in [b + 1, binary[b].index as usize] {
+            if binary[c].leaf {
+                kids.push(c);
+            } else {
+                kids.push(c + 1);
+                kids.push(binary[c].index as usize);
+            }
+        }
+        let mut bounds = Bounds4::default();
+        let (mut child, mut leaves) = ([0u32; 4], 0u8);
+        for (i, &k) in kids.iter().enumerate() {
+            bounds.set(i, &binary[k].bounds);
+            let t = Trail {
+                bits: trail.bits | (i as u64) << (2 * trail.depth),
+                depth: trail.depth + 1,
+            };
+            if binary[k].leaf {
+                leaves |= 1 << i;
+                child[i] = binary[k].index;
+                self.trails[binary[k].index as usize] = t;
+            } else {
+                child[i] = self.collapse(binary, k, t);
+            }
+        }
+        self.nodes[at] = Node4 {
+            bounds,
+            child,
+            leaves,
+            count: kids.len() as u8,
+        };
+        at as u32
     }
 
     /// Reorder `items` into two non-empty groups; returns the size of the first.
@@ -227,55 +290,67 @@ impl LightBvh {
         mid
     }
 
-    /// Probability of the first child at interior node `at` for a receiver at `p` with normal
-    /// `n`. The node's own bounds are looser than its children's, so it may light p while
-    /// neither child can: the choice then goes by power, so the probabilities still sum to 1
-    /// (the leaves so chosen send nothing to p).
+    /// The importances of node `at`'s children for a receiver at `p` with normal `n`, and
+    /// their sum; where every child's is zero (the node's bounds are looser than its
+    /// children's, so it may light p while none of them can) the choice goes by power, so
+    /// the probabilities still sum to 1 (the leaves so chosen send nothing to p). None at the
+    /// root when no child can light p, or for a non-finite sum.
     #[inline]
-    fn first_probability(&self, at: usize, p: Vec3, n: Option<Vec3>) -> Option<f32> {
-        let (a, b) = (
-            &self.nodes[at + 1],
-            &self.nodes[self.nodes[at].index as usize],
-        );
-        let (mut i0, mut i1) = (a.bounds.importance(p, n), b.bounds.importance(p, n));
-        if i0 + i1 == 0.0 {
-            (i0, i1) = (a.bounds.phi, b.bounds.phi);
+    fn weights(&self, at: usize, p: Vec3, n: Option<Vec3>) -> Option<([f32; 4], f32)> {
+        let node = &self.nodes[at];
+        let mut w = node.bounds.importance(p, n);
+        let mut sum = (w[0] + w[1]) + (w[2] + w[3]);
+        if sum == 0.0 {
+            if at == 0 {
+                return None;
+            }
+            w = node.bounds.phi;
+            sum = (w[0] + w[1]) + (w[2] + w[3]);
         }
-        let sum = i0 + i1;
-        (sum > 0.0 && sum.is_finite()).then(|| i0 / sum)
-    }
-
-    fn root_lights(&self, p: Vec3, n: Option<Vec3>) -> bool {
-        self.nodes
-            .first()
-            .is_some_and(|r| r.bounds.importance(p, n) > 0.0)
+        (sum > 0.0 && sum.is_finite()).then_some((w, sum))
     }
 
     /// Choose an emitter for a receiver at `p` (m) with unit normal `n` from `u` ∈ [0, 1):
     /// its index into [`LightBvh::emitters`] and its probability; None if no emitter can light
     /// p.
-    pub fn sample(&self, p: Vec3, n: Option<Vec3>, mut u: f32) -> Option<(usize, f32)> {
-        if !self.root_lights(p, n) {
+    pub fn sample(&self, p: Vec3, n: Option<Vec3>, u: f32) -> Option<(usize, f32)> {
+        if let Some(b) = &self.single {
+            return (b.importance(p, n) > 0.0).then_some((0, 1.0));
+        }
+        if self.nodes.is_empty() {
             return None;
         }
         let mut at = 0usize;
         let mut pmf = 1.0f32;
+        let mut u = u;
         loop {
+            let (w, sum) = self.weights(at, p, n)?;
             let node = &self.nodes[at];
-            if node.leaf {
-                return (pmf > 0.0).then_some((node.index as usize, pmf));
+            // The child whose share of [0, sum) holds u·sum; the last child with a weight
+            // takes what rounding leaves beyond the cumulative sum.
+            let target = u * sum;
+            let mut acc = 0.0f32;
+            let mut k = usize::MAX;
+            for (i, &wi) in w.iter().enumerate().take(node.count as usize) {
+                if wi > 0.0 {
+                    k = i;
+                    if target < acc + wi {
+                        break;
+                    }
+                    acc += wi;
+                }
             }
-            let p0 = self.first_probability(at, p, n)?;
-            if u < p0 {
-                pmf *= p0;
-                u = (u / p0).min(ONE_MINUS_EPSILON);
-                at += 1;
-            } else {
-                let p1 = 1.0 - p0;
-                pmf *= p1;
-                u = ((u - p0) / p1).min(ONE_MINUS_EPSILON);
-                at = node.index as usize;
+            if k == usize::MAX {
+                return None;
             }
+            let wk = w[k];
+            let pk = wk / sum;
+            pmf *= pk;
+            u = ((target - acc) / wk).clamp(0.0, ONE_MINUS_EPSILON);
+            if node.leaves >> k & 1 == 1 {
+                return (pmf > 0.0).then_some((node.child[k] as usize, pmf));
+            }
+            at = node.child[k] as usize;
         }
     }
 
@@ -284,24 +359,20 @@ impl LightBvh {
         let Some(trail) = self.trails.get(e) else {
             return 0.0;
         };
-        if !self.root_lights(p, n) {
-            return 0.0;
+        if let Some(b) = &self.single {
+            return if b.importance(p, n) > 0.0 { 1.0 } else { 0.0 };
         }
         let mut at = 0usize;
         let mut pmf = 1.0f32;
-        for k in 0..trail.depth {
-            let Some(p0) = self.first_probability(at, p, n) else {
+        for level in 0..trail.depth {
+            let Some((w, sum)) = self.weights(at, p, n) else {
                 return 0.0;
             };
-            if trail.bits >> k & 1 == 0 {
-                pmf *= p0;
-                at += 1;
-            } else {
-                pmf *= 1.0 - p0;
-                at = self.nodes[at].index as usize;
-            }
+            let k = (trail.bits >> (2 * level) & 3) as usize;
+            pmf *= w[k] / sum;
+            at = self.nodes[at].child[k] as usize;
         }
-        debug_assert!(self.nodes[at].leaf && self.nodes[at].index as usize == e);
+        debug_assert!(trail.depth > 0);
         pmf
     }
 }
