@@ -6,12 +6,13 @@
 # BVH's overhead where there is nothing to choose. CPU time (user + system) is robust to other
 # processes on the machine; run it on otherwise idle cores for wall times.
 #
-# Usage: bench/many_lights.sh [TARGET] [RUNS]   (build first: cargo build --release)
+# Usage: bench/many_lights.sh [TARGET] [RUNS]   (build first: cargo build --release;
+# CANDELA=PATH times another binary)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 TARGET=${1:-0.02}
 RUNS=${2:-3}
-BIN=$PWD/target/release/candela
+BIN=${CANDELA:-$PWD/target/release/candela}
 DIR=$PWD/target/many_lights
 mkdir -p "$DIR"
 [ -x "$BIN" ] || { echo "build first: cargo build --release" >&2; exit 1; }
