@@ -7,8 +7,8 @@ copies of one IES luminaire on a regular ceiling layout, with a 16 x 12 work-pla
 2.4 m square pitch (about the N = 6 office's 8 m^2 per luminaire), the grid over the whole floor.
 --n daylit is the N = 6 office without luminaires, daylit instead: an open window (no glazing)
 of WINDOW in the wall at Radiance y = 0, under a CIE overcast sky of SKY_LX horizontal
-illuminance over a ground of reflectance GROUND_RHO (gensky -c -B, Radiance's 179 lm/W; candela's
-Sky with the window as its portal). Radiance is z-up; candela is y-up. A Radiance point (X, Y, Z) is candela's
+illuminance over a ground of reflectance GROUND_RHO (Radiance: a brightfunc of the CIE formula,
+cie_overcast.cal, at 179 lm/W; candela: Sky with the window as its portal). Radiance is z-up; candela is y-up. A Radiance point (X, Y, Z) is candela's
 (X, Z, 6 - Y): a proper rotation (no mirror), so an asymmetric luminaire keeps its handedness.
 Both tools put C0 along +X and C90 along Radiance's +Y (= candela's -Z), nadir down.
 
@@ -21,6 +21,7 @@ Outputs in --out-dir:
 """
 
 import argparse
+import math
 import os
 import subprocess
 import sys
@@ -183,9 +184,14 @@ def radiance_scene(n, lum_modifiers):
         poly("wall", "wall_y0", [(0, 0, 0), (lx, 0, 0), (lx, 0, lz), (0, 0, lz)])
     poly("wall", "wall_y6", [(0, ly, 0), (0, ly, lz), (lx, ly, lz), (lx, ly, 0)])
     if n == "daylit":
-        # The sky of gensky -c (its -B is the sky's horizontal irradiance, W/m^2 at 179 lm/W)
-        # and its ground below the horizon, as glow sources seen only by ambient rays.
-        out.append(f"!gensky -ang 45 0 -c -B {SKY_LX / 179.0:.6f} -g {GROUND_RHO}")
+        # The CIE overcast sky, L = Lz (1 + 2 sin(altitude)) / 3 with Lz = 9 E_h / (7 pi), and a
+        # uniform ground of rho_g E_h / pi below the horizon, in W/sr/m^2 (179 lm/W), as glow
+        # sources seen only by ambient rays. gensky -c's skybright.cal would blend sky and ground
+        # over about 10 degrees either side of the horizon, which is not the CIE sky (it reads up
+        # to 1.8 % low at the back of this room; bench/README.md).
+        lz = 9.0 * SKY_LX / (7.0 * math.pi) / 179.0
+        lg = GROUND_RHO * SKY_LX / math.pi / 179.0
+        out.append(f"void brightfunc skyfunc\n2 skybr cie_overcast.cal\n0\n2 {lz:.8g} {lg:.8g}")
         out.append("skyfunc glow sky_glow\n0\n0\n4 1 1 1 0")
         out.append("sky_glow source sky\n0\n0\n4 0 0 1 180")
         out.append("sky_glow source ground\n0\n0\n4 0 0 -1 180")
@@ -239,6 +245,10 @@ def main():
     mods = conv[:cut].rstrip() + "\n"
     with open(os.path.join(a.out_dir, stem + ".rad"), "w") as f:
         f.write(radiance_scene(a.n, mods))
+    if a.n == "daylit":
+        with open(os.path.join(a.out_dir, "cie_overcast.cal"), "w") as f:
+            f.write("{ CIE overcast sky above the horizon (A1: zenith radiance), uniform ground below (A2) }\n"
+                    "skybr = if(Dz, A1 * (1 + 2*Dz) / 3, A2);\n")
     with open(os.path.join(a.out_dir, "points.txt"), "w") as f:
         for x, y, z in grid_points():
             f.write(f"{x:.6g} {y:.6g} {z:.6g} 0 0 1\n")

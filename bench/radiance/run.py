@@ -78,7 +78,7 @@ class Bench:
     def scene_hash(self, n):
         d = self.scene_dir(n)
         h = hashlib.sha256()
-        for name in (f"office-{n}.ron", f"office-{n}.rad", "lum.dat", "points.txt"):
+        for name in (f"office-{n}.ron", f"office-{n}.rad", "lum.dat", "points.txt") + (("cie_overcast.cal",) if n == "daylit" else ()):
             with open(os.path.join(d, name), "rb") as f:
                 h.update(f.read())
         with open(IES, "rb") as f:
