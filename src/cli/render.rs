@@ -15,8 +15,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// Options of `candela render`.
 #[derive(clap::Args)]
 pub struct RenderOpts {
-    /// Scene file (RON).
+    /// Scene file: RON, or a glTF file (.gltf, .glb) rendered as a whole scene with its camera, lights and materials (docs/scene-format.md → glTF files as scenes).
     scene: PathBuf,
+    /// glTF scene: the camera to render through, by the index of its camera node (0-based, in scene order) or by its node or camera name (default: the first camera node).
+    #[arg(long)]
+    camera: Option<String>,
+    /// Image size WIDTHxHEIGHT in pixels, e.g. 1280x720 (overrides camera.resolution; a glTF scene's default is 1024 pixels wide at its camera's aspect ratio).
+    #[arg(long, value_parser = parse_resolution)]
+    resolution: Option<Resolution>,
     /// Samples per pixel (overrides the scene's render.spp).
     #[arg(long)]
     spp: Option<u32>,
@@ -114,6 +120,22 @@ pub struct MergeOpts {
     partial: bool,
 }
 
+/// Width and height of the image, pixels.
+#[derive(Clone, Copy)]
+struct Resolution(u32, u32);
+
+/// `1280x720` (or `1280×720`) → 1280 × 720 pixels.
+fn parse_resolution(s: &str) -> Result<Resolution, String> {
+    let bad = || format!("{s:?} is not WIDTHxHEIGHT in pixels (e.g. 1280x720)");
+    let (w, h) = s.trim().split_once(['x', 'X', '×']).ok_or_else(bad)?;
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if w == 0 || h == 0 {
+        return Err(format!("{s:?}: width and height must be at least 1 pixel"));
+    }
+    Ok(Resolution(w, h))
+}
+
 /// `1%`, `0.5 %` or `0.01` → 0.01.
 fn parse_fraction(s: &str) -> Result<f64, String> {
     let t = s.trim();
@@ -148,6 +170,8 @@ impl RenderOpts {
                     "path-tracing" => candela::world::Caustics::PathTracing,
                     _ => candela::world::Caustics::LightTracing,
                 }),
+                resolution: self.resolution.map(|Resolution(w, h)| (w, h)),
+                camera: self.camera.clone(),
             },
             out: self.out.clone(),
             threads: self.threads,

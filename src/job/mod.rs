@@ -441,8 +441,12 @@ pub fn run(
             falsecolour: job.falsecolour,
         },
     )?;
-    let scene_bytes = std::fs::read(scene_path)
+    let mut scene_bytes = std::fs::read(scene_path)
         .with_context(|| format!("cannot read scene file {}", scene_path.display()))?;
+    // A glTF scene's chosen camera is part of what a render state holds.
+    if let Some(c) = &job.overrides.camera {
+        scene_bytes.extend(format!("\0--camera {c}").bytes());
+    }
     let hash = crate::state::scene_hash(&scene_bytes, &world);
     let name = scene_path
         .file_stem()

@@ -127,6 +127,7 @@ fn render<'py>(
             max_depth,
             illuminance,
             caustics,
+            ..Default::default()
         },
         out: Some(out),
         threads,

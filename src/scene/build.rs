@@ -29,6 +29,11 @@ pub struct Overrides {
     pub illuminance: bool,
     /// Override render.caustics.
     pub caustics: Option<crate::world::Caustics>,
+    /// Override camera.resolution (width, height), pixels.
+    pub resolution: Option<(u32, u32)>,
+    /// The camera of a glTF scene file: the index of its camera node (0-based, scene order) or
+    /// its node or camera name; `None` the first. Refused for a RON scene, which has one camera.
+    pub camera: Option<String>,
 }
 
 /// Largest image the renderer accepts (pixels), so a typo cannot exhaust memory.
@@ -158,19 +163,40 @@ fn check_film_memory(
     Ok(())
 }
 
-/// Load and build a scene file (for a plain render; see [`load_world_for`]).
+/// Load and build a scene file, RON or glTF (for a plain render; see [`load_world_for`]).
 pub fn load_world(path: &Path, overrides: &Overrides) -> Result<World, SceneError> {
     load_world_for(path, overrides, &RunMode::default())
 }
 
-/// Load and build a scene file to be rendered in `mode` (which sizes the memory guard).
+/// Load and build a scene file to be rendered in `mode` (which sizes the memory guard): a RON
+/// scene, or a glTF file as a whole scene ([`super::gltf_scene`]).
 pub fn load_world_for(
     path: &Path,
     overrides: &Overrides,
     mode: &RunMode,
 ) -> Result<World, SceneError> {
-    let scene = super::load(path)?;
+    let scene = if is_gltf_path(path) {
+        super::gltf_scene::scene(path, overrides.camera.as_deref(), overrides.resolution)?
+    } else {
+        if let Some(c) = &overrides.camera {
+            return Err(SceneError::Invalid {
+                path: path.to_path_buf(),
+                field: "camera".into(),
+                message: format!(
+                    "--camera {c} chooses among a glTF file's cameras; a RON scene has its one `camera`"
+                ),
+            });
+        }
+        super::load(path)?
+    };
     build_for(&scene, path, overrides, mode)
+}
+
+/// Whether a scene path is a glTF file (`.gltf`, `.glb`, any case), rendered as a whole scene.
+pub fn is_gltf_path(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
 fn object_field(i: usize, o: &ObjectDesc) -> String {
@@ -200,7 +226,11 @@ pub fn build_for(
 
     // Camera, and the film its resolution asks for.
     let illuminance = scene.render.illuminance || overrides.illuminance;
-    let camera = Camera::build(&ctx, &scene.camera, |w, h| check_film_size(&ctx, w, h))?;
+    let mut camera_desc = scene.camera.clone();
+    if let Some(r) = overrides.resolution {
+        camera_desc.resolution = r;
+    }
+    let camera = Camera::build(&ctx, &camera_desc, |w, h| check_film_size(&ctx, w, h))?;
 
     // Render settings.
     let r = &scene.render;
@@ -344,7 +374,7 @@ pub fn build_for(
             } if geometry::gltf::is_gltf(file) => {
                 let model = (file.as_str(), materials_from_file, *ke_luminance, *lights);
                 let at = format!("{field}.shape");
-                let (parts, found) = super::gltf::model_parts(
+                let (flat, shared, found) = super::gltf::model_parts(
                     &ctx,
                     &at,
                     model,
@@ -352,14 +382,28 @@ pub fn build_for(
                     &mut materials,
                 )?;
                 model_lights.extend(found);
-                (parts.into_iter())
-                    .map(|p| Part {
-                        shape: p.shape,
-                        uvs: p.uvs,
-                        material: p.material,
-                        emission: p.emission,
-                    })
-                    .collect()
+                let part = |p: super::gltf::GltfPart| Part {
+                    shape: p.shape,
+                    uvs: p.uvs,
+                    material: p.material,
+                    emission: p.emission,
+                };
+                let mut parts: Vec<Part> = flat.into_iter().map(part).collect();
+                for g in shared {
+                    if instances.is_some() {
+                        // Inside `Instances`, the model is the instanced mesh: one level.
+                        parts.extend(g.flatten(&ctx, &at)?.into_iter().map(part));
+                        continue;
+                    }
+                    let gparts = g.parts.into_iter().map(part).collect();
+                    match instance_group(&ctx, &at, gparts, g.transforms, transform.as_ref())? {
+                        Ok(group) => {
+                            add_group(i, group, &mut scene_object, &mut objects, &mut groups)
+                        }
+                        Err(copies) => parts.extend(copies),
+                    }
+                }
+                parts
             }
             ShapeDesc::Model { lights: true, .. } => {
                 return Err(ctx.err(
@@ -390,19 +434,7 @@ pub fn build_for(
         let parts = match instances {
             Some(tfs) => match instance_group(&ctx, &field, parts, tfs, transform.as_ref())? {
                 Ok(group) => {
-                    for _ in &group.transforms {
-                        for part in &group.parts {
-                            scene_object.push(i);
-                            objects.push(Object {
-                                material: part.material,
-                                light: None,
-                            });
-                        }
-                    }
-                    groups.push((
-                        objects.len() - group.transforms.len() * group.parts.len(),
-                        group,
-                    ));
+                    add_group(i, group, &mut scene_object, &mut objects, &mut groups);
                     continue;
                 }
                 Err(copies) => copies,
@@ -651,6 +683,28 @@ pub fn build_for(
         caustics,
         sources: ctx.sources.into_inner(),
     })
+}
+
+/// Adds instance group `group` of scene object `i`: a world object per part and instance, in
+/// the order [`geometry::InstanceGroup`] numbers them.
+fn add_group(
+    i: usize,
+    group: InstanceParts,
+    scene_object: &mut Vec<usize>,
+    objects: &mut Vec<Object>,
+    groups: &mut Vec<(usize, InstanceParts)>,
+) {
+    let first = objects.len();
+    for _ in &group.transforms {
+        for part in &group.parts {
+            scene_object.push(i);
+            objects.push(Object {
+                material: part.material,
+                light: None,
+            });
+        }
+    }
+    groups.push((first, group));
 }
 
 /// The site's frame from `site`.

@@ -238,7 +238,8 @@ pub fn placed(l: &GltfLight, t: Option<&crate::geometry::Transform>) -> GltfLigh
 }
 
 /// One world object made from a glTF model: a primitive placed by one node (in the model's
-/// space, before the object's transform), its texture coordinates, material and emission.
+/// space, before the object's transform), or in its mesh's own space when the mesh is
+/// instanced; its texture coordinates, material and emission.
 pub struct GltfPart {
     pub shape: crate::geometry::Shape,
     pub uvs: Option<Vec<glam::Vec2>>,
@@ -246,10 +247,40 @@ pub struct GltfPart {
     pub emission: Option<EmissionDesc>,
 }
 
-/// The parts of glTF `model` used as the `Model` shape at `field`: every primitive of every
-/// node that places a mesh, flattened to world space. Materials come from the file by the rule
-/// above, or from `overrides` by glTF material name; a primitive without a material takes the
-/// object's `fallback`. Materials made here are appended to `materials`.
+/// A glTF mesh placed by two or more nodes: its primitives that do not emit, stored once in the
+/// mesh's space, and the nodes' world transforms (in the model's space).
+pub struct GltfGroup {
+    pub parts: Vec<GltfPart>,
+    pub transforms: Vec<crate::geometry::Transform>,
+}
+
+impl GltfGroup {
+    /// The group's copies, one per node, in the model's space.
+    pub fn flatten(self, ctx: &Context, field: &str) -> Result<Vec<GltfPart>, SceneError> {
+        let mut out = Vec::with_capacity(self.parts.len() * self.transforms.len());
+        for t in &self.transforms {
+            for p in &self.parts {
+                out.push(GltfPart {
+                    shape: p
+                        .shape
+                        .to_world(t)
+                        .map_err(|e| ctx.err(field, e.to_string()))?,
+                    uvs: p.uvs.clone(),
+                    material: p.material,
+                    emission: p.emission.clone(),
+                });
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The parts of glTF `model` used as the `Model` shape at `field`. A mesh placed by one node is
+/// flattened to the model's space; a mesh placed by two or more becomes a [`GltfGroup`] (an
+/// instance per node), except its emitting primitives, flattened once per node so that each is
+/// an area light. Materials come from the file by the rule above, or from `overrides` by glTF
+/// material name; a primitive without a material takes the object's `fallback`. Materials made
+/// here are appended to `materials`.
 pub fn parts(
     ctx: &Context,
     field: &str,
@@ -258,8 +289,9 @@ pub fn parts(
     fallback: &str,
     lookup: &dyn Fn(&str, &str) -> Result<u32, SceneError>,
     materials: &mut Vec<Material>,
-) -> Result<Vec<GltfPart>, SceneError> {
+) -> Result<(Vec<GltfPart>, Vec<GltfGroup>), SceneError> {
     use crate::description::schema::MaterialRefDesc;
+    use crate::geometry::{Shape, Transform};
     let file = model.path.display();
     for name in overrides.keys() {
         if !model.materials.iter().any(|m| &m.name == name) {
@@ -277,67 +309,115 @@ pub fn parts(
     let mut cache = TextureCache::new();
     let mut ids: Vec<Option<(u32, Option<EmissionDesc>)>> = vec![None; model.materials.len()];
     let mut fallback_id = None;
+    let mut resolve = |p: &crate::geometry::gltf::GltfPrimitive,
+                       materials: &mut Vec<Material>|
+     -> Result<(u32, Option<EmissionDesc>), SceneError> {
+        Ok(match p.material {
+            None => {
+                let id = match fallback_id {
+                    Some(id) => id,
+                    None => {
+                        let id = lookup(&format!("{field}.material"), fallback).map_err(|e| {
+                            ctx.err(
+                                format!("{field}.material"),
+                                format!("'{file}' has primitives without a material; they take the object's `material`: {e}"),
+                            )
+                        })?;
+                        *fallback_id.insert(id)
+                    }
+                };
+                (id, None)
+            }
+            Some(i) => {
+                if ids[i].is_none() {
+                    let m = &model.materials[i];
+                    let over = format!("{field}.materials_from_file[{:?}]", m.name);
+                    let id = match overrides.get(&m.name) {
+                        Some(MaterialRefDesc::Named(n)) => lookup(&over, n)?,
+                        Some(MaterialRefDesc::Material(desc)) => {
+                            materials.push(Material::build(ctx, &over, desc)?);
+                            materials.len() as u32 - 1
+                        }
+                        None => {
+                            materials.push(material(ctx, field, model, m, &mut cache)?);
+                            materials.len() as u32 - 1
+                        }
+                    };
+                    ids[i] = Some((id, emission(ctx, field, model, m)?));
+                }
+                ids[i].clone().expect("set above")
+            }
+        })
+    };
+    let mut uses = vec![0usize; model.meshes.len()];
+    for inst in &model.instances {
+        uses[inst.mesh] += 1;
+    }
+    // Index into `groups` of each shared mesh's group, made at its first node.
+    let mut group_of: Vec<Option<usize>> = vec![None; model.meshes.len()];
+    let mut groups: Vec<GltfGroup> = Vec::new();
     let mut out = Vec::new();
     for inst in &model.instances {
-        let t = crate::geometry::Transform::from_affine(inst.world);
+        let t = Transform::from_affine(inst.world);
+        let at_node = |e: crate::geometry::GeometryError| {
+            ctx.err(field, format!("'{file}' node {}: {e}", inst.node))
+        };
+        let shared = uses[inst.mesh] >= 2;
+        if shared {
+            if !t.is_invertible() {
+                return Err(ctx.err(
+                    field,
+                    format!(
+                        "'{file}' node {}: its transform is singular (zero scale on some axis) or not finite",
+                        inst.node
+                    ),
+                ));
+            }
+            if let Some(g) = group_of[inst.mesh] {
+                groups[g].transforms.push(t);
+            }
+        }
+        let first = shared && group_of[inst.mesh].is_none();
+        let mut group_parts = Vec::new();
         for p in &model.meshes[inst.mesh].primitives {
             if p.mesh.indices.is_empty() {
                 continue;
             }
-            let (material, emission) = match p.material {
-                None => {
-                    let id = match fallback_id {
-                        Some(id) => id,
-                        None => {
-                            let id = lookup(&format!("{field}.material"), fallback).map_err(|e| {
-                                ctx.err(
-                                    format!("{field}.material"),
-                                    format!("'{file}' has primitives without a material; they take the object's `material`: {e}"),
-                                )
-                            })?;
-                            *fallback_id.insert(id)
-                        }
-                    };
-                    (id, None)
-                }
-                Some(i) => {
-                    if ids[i].is_none() {
-                        let m = &model.materials[i];
-                        let over = format!("{field}.materials_from_file[{:?}]", m.name);
-                        let id = match overrides.get(&m.name) {
-                            Some(MaterialRefDesc::Named(n)) => lookup(&over, n)?,
-                            Some(MaterialRefDesc::Material(desc)) => {
-                                materials.push(Material::build(ctx, &over, desc)?);
-                                materials.len() as u32 - 1
-                            }
-                            None => {
-                                materials.push(material(ctx, field, model, m, &mut cache)?);
-                                materials.len() as u32 - 1
-                            }
-                        };
-                        ids[i] = Some((id, emission(ctx, field, model, m)?));
-                    }
-                    ids[i].clone().expect("set above")
-                }
-            };
-            let shape = crate::geometry::Shape::Mesh(p.mesh.clone())
-                .to_world(&t)
-                .map_err(|e| ctx.err(field, format!("'{file}' node {}: {e}", inst.node)))?;
-            out.push(GltfPart {
-                shape,
-                uvs: p.uvs.clone(),
-                material,
-                emission,
+            let (material, emission) = resolve(p, materials)?;
+            let placed_once = !shared || emission.is_some();
+            if placed_once {
+                out.push(GltfPart {
+                    shape: Shape::Mesh(p.mesh.clone()).to_world(&t).map_err(at_node)?,
+                    uvs: p.uvs.clone(),
+                    material,
+                    emission,
+                });
+            } else if first {
+                group_parts.push(GltfPart {
+                    shape: Shape::Mesh(p.mesh.clone()),
+                    uvs: p.uvs.clone(),
+                    material,
+                    emission: None,
+                });
+            }
+        }
+        if first {
+            group_of[inst.mesh] = Some(groups.len());
+            groups.push(GltfGroup {
+                parts: group_parts,
+                transforms: vec![t],
             });
         }
     }
-    Ok(out)
+    groups.retain(|g| !g.parts.is_empty());
+    Ok((out, groups))
 }
 
 /// A `Model` object at `field` whose file is glTF: `(file, materials_from_file, ke_luminance,
 /// lights)` as the scene gives them, `(transform, fallback, lookup)` the object's transform, its
-/// `material` and the scene's material names. Returns its parts and, with `lights`, the file's
-/// lights placed by the transform (with the fields to name them by).
+/// `material` and the scene's material names. Returns its parts and instanced meshes (see
+/// [`parts`]) and, with `lights`, the file's lights placed by the transform (with the fields to
+/// name them by).
 #[allow(clippy::type_complexity)]
 pub fn model_parts(
     ctx: &Context,
@@ -354,7 +434,7 @@ pub fn model_parts(
         &dyn Fn(&str, &str) -> Result<u32, SceneError>,
     ),
     materials: &mut Vec<Material>,
-) -> Result<(Vec<GltfPart>, Vec<(String, LightDesc)>), SceneError> {
+) -> Result<(Vec<GltfPart>, Vec<GltfGroup>, Vec<(String, LightDesc)>), SceneError> {
     if ke_luminance.is_some() {
         return Err(ctx.err(
             format!("{field}.ke_luminance"),
@@ -372,6 +452,6 @@ pub fn model_parts(
             }
         }
     }
-    let parts = parts(ctx, field, &model, overrides, fallback, lookup, materials)?;
-    Ok((parts, lights))
+    let (parts, groups) = parts(ctx, field, &model, overrides, fallback, lookup, materials)?;
+    Ok((parts, groups, lights))
 }

@@ -6,6 +6,7 @@
 
 pub mod build;
 pub mod gltf;
+pub mod gltf_scene;
 
 use std::path::Path;
 

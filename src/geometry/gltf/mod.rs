@@ -116,6 +116,35 @@ pub struct GltfLight {
     pub direction: Vec3,
 }
 
+/// A glTF camera's projection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GltfProjection {
+    /// Full vertical field of view `yfov_rad` (radians) and, if the file gives it, the image's
+    /// width / height.
+    Perspective {
+        yfov_rad: f64,
+        aspect_ratio: Option<f64>,
+    },
+    Orthographic,
+}
+
+/// A camera placed by its node: glTF cameras look down the node's −Z with +Y up.
+#[derive(Clone, Debug)]
+pub struct GltfCamera {
+    pub node: usize,
+    /// The node's name, if it has one.
+    pub node_name: Option<String>,
+    /// The camera's name, if it has one.
+    pub camera_name: Option<String>,
+    pub projection: GltfProjection,
+    /// World position, m.
+    pub position: Vec3,
+    /// World view direction (the node's −Z), unit.
+    pub forward: Vec3,
+    /// World up (the node's +Y), unit.
+    pub up: Vec3,
+}
+
 /// A glTF file read (see the module docs).
 #[derive(Clone, Debug)]
 pub struct GltfModel {
@@ -125,6 +154,8 @@ pub struct GltfModel {
     pub materials: Vec<GltfMaterial>,
     pub images: Vec<GltfImage>,
     pub lights: Vec<GltfLight>,
+    /// The camera nodes of the scene, in scene order (parents before children).
+    pub cameras: Vec<GltfCamera>,
     /// Primitives left out because they are points or lines.
     pub skipped_primitives: usize,
 }
@@ -216,6 +247,7 @@ pub fn load_gltf(path: &Path) -> Result<GltfModel, GeometryError> {
         .map(|im| image(path, &im, &buffers))
         .collect::<Result<_, _>>()?;
     let lights = lights(path, &document)?;
+    let cameras = cameras(path, &document)?;
     Ok(GltfModel {
         path: path.to_path_buf(),
         meshes,
@@ -223,8 +255,57 @@ pub fn load_gltf(path: &Path) -> Result<GltfModel, GeometryError> {
         materials,
         images,
         lights,
+        cameras,
         skipped_primitives: skipped,
     })
+}
+
+/// The camera nodes of a `.gltf` or `.glb` file's scene, without reading its buffers.
+pub fn load_cameras(path: &Path) -> Result<Vec<GltfCamera>, GeometryError> {
+    let bytes =
+        limits::read_file(path, MAX_GLTF_FILE_BYTES).map_err(|source| GeometryError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        gltf::Gltf::from_slice(&bytes)
+    }))
+    .map_err(|_| parse_err(path, "the glTF parser failed on malformed input".into()))?
+    .map_err(|e| parse_err(path, e.to_string()))?;
+    cameras(path, &parsed.document)
+}
+
+fn cameras(path: &Path, doc: &gltf::Document) -> Result<Vec<GltfCamera>, GeometryError> {
+    let nodes: Vec<gltf::Node> = doc.nodes().collect();
+    let mut out = Vec::new();
+    for (i, world) in scene_nodes(path, doc)? {
+        let Some(c) = nodes[i].camera() else { continue };
+        let projection = match c.projection() {
+            gltf::camera::Projection::Perspective(p) => GltfProjection::Perspective {
+                yfov_rad: p.yfov() as f64,
+                aspect_ratio: p.aspect_ratio().map(|a| a as f64),
+            },
+            gltf::camera::Projection::Orthographic(_) => GltfProjection::Orthographic,
+        };
+        let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+        if forward == Vec3::ZERO || up == Vec3::ZERO || forward.cross(up).length() < 1e-6 {
+            return Err(parse_err(
+                path,
+                format!("node {i}'s transform leaves its camera no view direction or up"),
+            ));
+        }
+        out.push(GltfCamera {
+            node: i,
+            node_name: nodes[i].name().map(str::to_string),
+            camera_name: c.name().map(str::to_string),
+            projection,
+            position: world.transform_point3(Vec3::ZERO),
+            forward,
+            up,
+        });
+    }
+    Ok(out)
 }
 
 /// The nodes of the scene with their world transforms, parents before children.
@@ -296,6 +377,10 @@ fn check_mesh_memory(
     doc: &gltf::Document,
     instances: &[GltfInstance],
 ) -> Result<(), GeometryError> {
+    let mut uses = vec![0u64; doc.meshes().len()];
+    for i in instances {
+        uses[i.mesh] += 1;
+    }
     let mut per_mesh = Vec::new();
     let mut need = 0u64;
     for m in doc.meshes() {
@@ -308,11 +393,15 @@ fn check_mesh_memory(
             // Position, normal (12 B each), uv (8 B), index (4 B): in the file's mesh and once
             // more while it is being built.
             need = need.saturating_add(verts.saturating_mul(2 * 32) + idx.saturating_mul(8));
-            tris = tris.saturating_add(idx / 3);
+            // A shared mesh is instanced (stored once); only its emitting primitives are copied.
+            if uses[m.index()] < 2 || p.material().emissive_factor() != [0.0; 3] {
+                tris = tris.saturating_add(idx / 3);
+            }
         }
         per_mesh.push(tris);
     }
-    // A world-space copy of each instance: 3 vertices of 32 B and 12 B of indices per triangle.
+    // A world-space copy of each copied primitive: 3 vertices of 32 B and 12 B of indices per
+    // triangle.
     for i in instances {
         need = need.saturating_add(per_mesh[i.mesh].saturating_mul(108));
     }
