@@ -4,8 +4,11 @@
 //! joins or leaves a source), so the error is propagated by simulation, a parametric
 //! bootstrap: K images L + se·N(0, 1) are drawn (fixed seed), each is detected and evaluated
 //! again, and the spread of each index over the draws stands for the spread of the index of
-//! the rendered image about that of the noise-free image. The interval is the point value
-//! ± t₀.₉₇₅(K − 1)·sd. The draws also say whether the detection itself is stable: how often
+//! the rendered image about that of the noise-free image. The interval is the bias-corrected
+//! estimate (the value less its second-order bias from the noise, [`super::bias`]) ±
+//! t₀.₉₇₅(K − 1)·sd; the draws are corrected alike, so they centre on it. The sources'
+//! membership is a step function of the pixels, which no estimate corrects: pixels near the
+//! threshold must be converged for UGR and DGI to be calibrated (docs/glare.md). The draws also say whether the detection itself is stable: how often
 //! the number of sources changes, and how much luminous solid angle changes sides of the
 //! threshold.
 //!
