@@ -206,8 +206,17 @@ fn case(name: &str, scene_text: &str) {
     if name.contains("sun") {
         assert!(half < 0.01 * ev, "{name}: E_v ± {half} of {ev} lx");
     }
-    // The sun room's evaluation is still flagged untrustworthy: its glare sources' count
-    // changes between the bootstrap draws (an open defect of the interval, see docs/glare.md).
+    // With the clear sky's sun in view, a few wall pixels in the noisy indirect sunlight cross
+    // the threshold in each draw as one-pixel sources of no weight; the significant sources
+    // stay the same and the image passes every check.
+    if name == "sun" {
+        assert_eq!(
+            exr["trustworthy"],
+            Value::Bool(true),
+            "{name}: {}",
+            exr["warnings"]
+        );
+    }
     for k in ["dgp", "ev_lx"] {
         let (a, b) = (
             exr[k]["value"].as_f64().unwrap(),
@@ -389,8 +398,9 @@ fn glare_refuses_what_it_cannot_evaluate() {
 /// rate itself), and the intervals' stated standard deviation within 25 % of the errors' rms
 /// (60 errors estimate it to ±9 %). A study of about 75 s on 2 cores:
 /// `cargo test --release --test glare_cli -- --ignored --nocapture` (measured: 55 of 60, see
-/// docs/glare.md). It also prints the coverage of the UGR and DGI intervals, as they are and
-/// moved by the bias the draws show, which it does not assert (48 and 49 of 60 at 8 spp).
+/// docs/glare.md). It also prints the coverage of the UGR and DGI intervals and the mean
+/// errors of their plain values and bias-corrected estimates, which it does not assert (48 of
+/// 60 each at 8 spp: the threshold's selection of noisy pixels biases them, see docs/glare.md).
 #[test]
 #[ignore]
 fn dgp_interval_covers_the_converged_dgp_over_seeds() {
@@ -418,7 +428,9 @@ fn dgp_interval_covers_the_converged_dgp_over_seeds() {
     let truth_all = render(2048, 1_000_000);
     let truth = truth_all["dgp"].clone();
     let t = truth["value"].as_f64().unwrap();
-    let mut other = [(0u32, 0u32, 0.0f64); 2];
+    // Per index: intervals covering the converged value, Σ and Σ² of the plain value's error,
+    // Σ and Σ² of the bias-corrected estimate's error.
+    let mut other = [(0u32, [0.0f64; 4]); 2];
     let mut covered = 0;
     let trials = 60;
     let (mut err2, mut sd2, mut err) = (0.0, 0.0, 0.0);
@@ -428,11 +440,15 @@ fn dgp_interval_covers_the_converged_dgp_over_seeds() {
             let (x, tx) = (&all[key], truth_all[key]["value"].as_f64().unwrap());
             let f = |v: &Value, i: usize| v.as_array().unwrap()[i].as_f64().unwrap();
             let (lo, hi) = (f(&x["ci95"], 0), f(&x["ci95"], 1));
-            let v = x["value"].as_f64().unwrap();
-            let b = 0.5 * (f(&x["quantiles95"], 0) + f(&x["quantiles95"], 1)) - v;
+            let (v, est) = (
+                x["value"].as_f64().unwrap(),
+                x["estimate"].as_f64().unwrap(),
+            );
             o.0 += (lo <= tx && tx <= hi) as u32;
-            o.1 += (lo - b <= tx && tx <= hi - b) as u32;
-            o.2 += v - tx;
+            for (k, e) in [v - tx, est - tx].into_iter().enumerate() {
+                o.1[2 * k] += e;
+                o.1[2 * k + 1] += e * e;
+            }
         }
         let d = all["dgp"].clone();
         let ci = d["ci95"].as_array().unwrap();
@@ -453,11 +469,13 @@ fn dgp_interval_covers_the_converged_dgp_over_seeds() {
         err / n
     );
     for (o, key) in other.iter().zip(["UGR", "DGI"]) {
+        let mean_se = |s: f64, s2: f64| (s / n, ((s2 / n - (s / n).powi(2)) / n).sqrt());
+        let (m, se) = mean_se(o.1[0], o.1[1]);
+        let (mc, sec) = mean_se(o.1[2], o.1[3]);
         println!(
-            "{key}: covered {}/{trials}, bias-corrected {}/{trials}, mean error {:+.4}",
-            o.0,
-            o.1,
-            o.2 / n
+            "{key}: covered {}/{trials}; mean error of the value {m:+.4} ± {se:.4}, of the \
+             estimate {mc:+.4} ± {sec:.4}",
+            o.0
         );
     }
     assert!(covered >= 53, "{covered}/{trials}");

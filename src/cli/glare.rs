@@ -134,6 +134,7 @@ fn parse_task(text: &str) -> anyhow::Result<(usize, usize, f64)> {
 fn interval_json(i: &Interval) -> serde_json::Value {
     serde_json::json!({
         "value": i.value,
+        "estimate": i.estimate,
         "ci95": [i.low(), i.high()],
         "quantiles95": [i.quantiles.0, i.quantiles.1],
     })
@@ -179,8 +180,9 @@ fn text(g: &UncertainGlare, has_errors: bool) -> String {
     let row = |name: &str, i: &Interval, digits: usize| {
         if has_errors {
             format!(
-                "{name:<4} {:.digits$}  (95 % CI {:.digits$} … {:.digits$})\n",
+                "{name:<4} {:.digits$}  (noise-free estimate {:.digits$}, 95 % CI {:.digits$} … {:.digits$})\n",
                 i.value,
+                i.estimate,
                 i.low(),
                 i.high()
             )

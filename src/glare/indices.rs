@@ -267,6 +267,15 @@ pub fn evaluate(img: &GlareImage, opt: &GlareOptions) -> Result<GlareResult, Ima
 /// Evaluate the geometry of `img` with luminances `lum` (cd/m², one per pixel); `img` must be
 /// valid.
 pub fn evaluate_luminance(img: &GlareImage, lum: &[f64], opt: &GlareOptions) -> GlareResult {
+    evaluate_detected(img, lum, opt).0
+}
+
+/// [`evaluate_luminance`] with the detection it evaluated (the sources' pixels).
+pub(crate) fn evaluate_detected(
+    img: &GlareImage,
+    lum: &[f64],
+    opt: &GlareOptions,
+) -> (GlareResult, Detection) {
     let (view, up) = img.frame();
     let det: Detection = detect(img, lum, &opt.detect);
     let ev = vertical_illuminance(img, lum);
@@ -313,7 +322,7 @@ pub fn evaluate_luminance(img: &GlareImage, lum: &[f64], opt: &GlareOptions) -> 
         }
     };
     let d = dgr(det.mean_luminance_cd_m2, &terms);
-    GlareResult {
+    let result = GlareResult {
         dgp: dgp(ev, &terms, &opt.dgp, opt.low_light_correction),
         dgi: dgi(background, &terms),
         ugr: if terms.is_empty() {
@@ -330,7 +339,8 @@ pub fn evaluate_luminance(img: &GlareImage, lum: &[f64], opt: &GlareOptions) -> 
         mean_luminance_cd_m2: det.mean_luminance_cd_m2,
         threshold_cd_m2: det.threshold_cd_m2,
         sources: reports,
-    }
+    };
+    (result, det)
 }
 
 /// The right-handed frame (right, up, view) of a line of sight and an up vector, for callers

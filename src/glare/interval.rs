@@ -4,8 +4,11 @@
 //! joins or leaves a source), so the error is propagated by simulation, a parametric
 //! bootstrap: K images L + se·N(0, 1) are drawn (fixed seed), each is detected and evaluated
 //! again, and the spread of each index over the draws stands for the spread of the index of
-//! the rendered image about that of the noise-free image. The interval is the point value
-//! ± t₀.₉₇₅(K − 1)·sd. The draws also say whether the detection itself is stable: how often
+//! the rendered image about that of the noise-free image. The interval is the bias-corrected
+//! estimate (the value less its second-order bias from the noise, [`super::bias`]) ±
+//! t₀.₉₇₅(K − 1)·sd; the draws are corrected alike, so they centre on it. The sources'
+//! membership is a step function of the pixels, which no estimate corrects: pixels near the
+//! threshold must be converged for UGR and DGI to be calibrated (docs/glare.md). The draws also say whether the detection itself is stable: how often
 //! the number of sources changes, and how much luminous solid angle changes sides of the
 //! threshold.
 //!
@@ -15,8 +18,9 @@
 //! (see [`UncertainOptions::max_dgp_half_width`] and the stability checks), and it covers
 //! the noise of the image only, not the bias of a biased renderer or of the DGP model.
 
+use super::bias::{bias, CORRECTED};
 use super::image::{GlareImage, ImageError};
-use super::indices::{evaluate_luminance, GlareOptions, GlareResult};
+use super::indices::{evaluate_detected, GlareOptions, GlareResult};
 use crate::meter::t95;
 use crate::sampling::mix64;
 
@@ -33,8 +37,8 @@ pub struct UncertainOptions {
     /// Largest 95 % half-width of UGR for a trustworthy result (default 0.5, a sixth of the
     /// 3-unit steps of the UGR limits).
     pub max_ugr_half_width: f64,
-    /// Largest share of the draws whose number of sources differs from the image's own
-    /// (default 0.05).
+    /// Largest share of the draws whose number of significant sources (see
+    /// [`significant_sources`]) differs from the image's own (default 0.05).
     pub max_source_count_changes: f64,
     /// Largest mean share of the glare sources' L·ω that changes sides of the threshold in a
     /// draw (default 0.05).
@@ -57,20 +61,25 @@ impl Default for UncertainOptions {
 /// An index with its 95 % interval.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Interval {
-    /// The index of the image itself.
+    /// The index of the image itself, as evalglare computes it from these pixels.
     pub value: f64,
+    /// The index of the noise-free image estimated from this one: `value` less its
+    /// second-order bias from the pixels' noise (DGP, DGI, UGR, CGI; the same as `value` for
+    /// E_v and VCP, and without standard errors). The interval is centred on it.
+    pub estimate: f64,
     /// Half-width of the 95 % interval: t₀.₉₇₅(K − 1) × the standard deviation over the draws.
     pub half_width: f64,
-    /// 2.5 % and 97.5 % quantiles of the index over the draws (for skewed cases).
+    /// 2.5 % and 97.5 % quantiles of the bias-corrected index over the draws (for skewed
+    /// cases).
     pub quantiles: (f64, f64),
 }
 
 impl Interval {
     pub fn low(&self) -> f64 {
-        self.value - self.half_width
+        self.estimate - self.half_width
     }
     pub fn high(&self) -> f64 {
-        self.value + self.half_width
+        self.estimate + self.half_width
     }
     pub fn contains(&self, x: f64) -> bool {
         (self.low()..=self.high()).contains(&x)
@@ -87,7 +96,8 @@ pub struct UncertainGlare {
     pub vcp: Interval,
     pub cgi: Interval,
     pub ev_lx: Interval,
-    /// Share of the draws whose number of sources differs from the image's own.
+    /// Share of the draws whose number of significant sources ([`significant_sources`])
+    /// differs from the image's own.
     pub source_count_changes: f64,
     /// Mean over the draws of the L·ω (of the image's own luminances) of the pixels whose
     /// glare membership differs from the image's, over the L·ω of the image's glare pixels.
@@ -96,6 +106,27 @@ pub struct UncertainGlare {
     pub trustworthy: bool,
     /// The limits that were passed, in words.
     pub warnings: Vec<String>,
+}
+
+/// Share of Σ L_s² ω_s / P_s² (the sum of UGR, CGI and, by default, DGP) a source must carry
+/// to count as significant.
+pub const SIGNIFICANT_SHARE: f64 = 0.01;
+
+/// The number of sources that carry at least [`SIGNIFICANT_SHARE`] of Σ L_s² ω_s / P_s².
+///
+/// A noisy image has pixels just below the threshold (a wall in indirect sunlight, a
+/// luminaire's edge) of which a few cross it in each draw, each a source of one pixel whose
+/// share of the sum is negligible (10⁻¹¹ beside the sun's disk); counting every source would
+/// flag such an image in every draw although its indices do not move.
+pub fn significant_sources(r: &GlareResult) -> usize {
+    let term = |s: &super::indices::SourceReport| {
+        (s.luminance_cd_m2 / s.position_index).powi(2) * s.solid_angle_sr
+    };
+    let total: f64 = r.sources.iter().map(term).sum();
+    r.sources
+        .iter()
+        .filter(|s| term(s) >= SIGNIFICANT_SHARE * total)
+        .count()
 }
 
 /// A standard normal deviate from two 64-bit hashes (Box–Muller).
@@ -107,13 +138,14 @@ fn normal(seed: u64, draw: u64, pixel: u64) -> f64 {
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
-fn interval(value: f64, draws: &mut [f64]) -> Interval {
+fn interval(value: f64, estimate: f64, draws: &mut [f64]) -> Interval {
     let k = draws.len();
     if k < 2 {
         return Interval {
             value,
+            estimate,
             half_width: if k == 0 { 0.0 } else { f64::INFINITY },
-            quantiles: (value, value),
+            quantiles: (estimate, estimate),
         };
     }
     let mean = draws.iter().sum::<f64>() / k as f64;
@@ -126,6 +158,7 @@ fn interval(value: f64, draws: &mut [f64]) -> Interval {
     };
     Interval {
         value,
+        estimate,
         half_width: t95((k - 1) as u32) * var.sqrt(),
         quantiles: (q(0.025), q(0.975)),
     }
@@ -138,7 +171,12 @@ pub fn evaluate_uncertain(
     u: &UncertainOptions,
 ) -> Result<UncertainGlare, ImageError> {
     img.validate()?;
-    let base = evaluate_luminance(img, &img.luminance_cd_m2, opt);
+    let (base, base_det) = evaluate_detected(img, &img.luminance_cd_m2, opt);
+    // Second-order bias of DGP, DGI, UGR, CGI (in this order) from the pixels' noise.
+    let base_bias = match &img.stderr_cd_m2 {
+        Some(se) => bias(img, &img.luminance_cd_m2, se, &base_det, &base, opt),
+        None => [0.0; CORRECTED],
+    };
     let glare_flag = |r: &GlareResult, lum: &[f64]| -> Vec<bool> {
         // Pixels of the detected sources, recovered from the threshold (sources are exactly
         // the valid pixels above it).
@@ -147,6 +185,7 @@ pub fn evaluate_uncertain(
             .collect()
     };
     let base_flag = glare_flag(&base, &img.luminance_cd_m2);
+    let base_significant = significant_sources(&base);
     let lw = |i: usize| img.luminance_cd_m2[i] * img.solid_angle_sr[i];
     let base_lw: f64 = (0..img.len()).filter(|&i| base_flag[i]).map(lw).sum();
     let k = if img.stderr_cd_m2.is_some() {
@@ -162,8 +201,11 @@ pub fn evaluate_uncertain(
         for i in 0..img.len() {
             lum[i] = img.luminance_cd_m2[i] + se[i] * normal(u.seed, d as u64, i as u64);
         }
-        let r = evaluate_luminance(img, &lum, opt);
-        if r.sources.len() != base.sources.len() {
+        let (r, det) = evaluate_detected(img, &lum, opt);
+        // A draw adds the image's noise again, so its bias from the noise-free image is
+        // twice the image's: less 2b, the draws centre on the image's corrected value.
+        let b = bias(img, &lum, se, &det, &r, opt);
+        if significant_sources(&r) != base_significant {
             count_changes += 1;
         }
         let flag = glare_flag(&r, &lum);
@@ -178,16 +220,21 @@ pub fn evaluate_uncertain(
         } else {
             0.0
         };
-        for (s, v) in series
-            .iter_mut()
-            .zip([r.dgp, r.dgi, r.ugr, r.vcp, r.cgi, r.ev_lx])
-        {
+        let values = [
+            r.dgp - 2.0 * b[0],
+            r.dgi - 2.0 * b[1],
+            r.ugr - 2.0 * b[2],
+            r.vcp,
+            r.cgi - 2.0 * b[3],
+            r.ev_lx,
+        ];
+        for (s, v) in series.iter_mut().zip(values) {
             s.push(v);
         }
     }
     let [mut a, mut b, mut c, mut e, mut f, mut g] = series;
-    let out_dgp = interval(base.dgp, &mut a);
-    let out_ugr = interval(base.ugr, &mut c);
+    let out_dgp = interval(base.dgp, base.dgp - base_bias[0], &mut a);
+    let out_ugr = interval(base.ugr, base.ugr - base_bias[2], &mut c);
     let (changes, flip) = if k > 0 {
         (count_changes as f64 / k as f64, flip_sum / k as f64)
     } else {
@@ -208,7 +255,7 @@ pub fn evaluate_uncertain(
     }
     if changes > u.max_source_count_changes {
         warnings.push(format!(
-            "the number of glare sources changes in {:.0} % of the draws",
+            "the number of significant glare sources changes in {:.0} % of the draws",
             100.0 * changes
         ));
     }
@@ -219,10 +266,10 @@ pub fn evaluate_uncertain(
         ));
     }
     Ok(UncertainGlare {
-        dgi: interval(base.dgi, &mut b),
-        vcp: interval(base.vcp, &mut e),
-        cgi: interval(base.cgi, &mut f),
-        ev_lx: interval(base.ev_lx, &mut g),
+        dgi: interval(base.dgi, base.dgi - base_bias[1], &mut b),
+        vcp: interval(base.vcp, base.vcp, &mut e),
+        cgi: interval(base.cgi, base.cgi - base_bias[3], &mut f),
+        ev_lx: interval(base.ev_lx, base.ev_lx, &mut g),
         dgp: out_dgp,
         ugr: out_ugr,
         result: base,

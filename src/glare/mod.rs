@@ -8,6 +8,7 @@
 //! - [`indices`]: position index, vertical illuminance and the indices DGP, DGI, UGR, VCP, CGI;
 //! - [`interval`]: the intervals, by simulation, and the verdict on a too-noisy image.
 
+pub(crate) mod bias;
 pub mod file;
 pub mod image;
 pub mod indices;
@@ -20,5 +21,7 @@ pub use indices::{
     evaluate, evaluate_luminance, position_index, Background, DgpCoefficients, GlareOptions,
     GlareResult, SourceReport, SourceTerm,
 };
-pub use interval::{evaluate_uncertain, Interval, UncertainGlare, UncertainOptions};
+pub use interval::{
+    evaluate_uncertain, significant_sources, Interval, UncertainGlare, UncertainOptions,
+};
 pub use sources::{DetectOptions, Task, Threshold};

@@ -222,7 +222,11 @@ fn summarise(img: &GlareImage, lum: &[f64], view: [f64; 3], pixels: Vec<usize>) 
     }
     let mut direction = super::image::normalize(mean_dir).unwrap_or(img.direction[pixels[0]]);
     if lw > 0.0 {
-        let (col, yb) = ((sx / lw) as usize, (sy / lw) as usize);
+        // A centre on a whole pixel coordinate (a source of one pixel, or one symmetric about
+        // a pixel's centre) is that pixel: without the nudge, rounding of the weighted mean
+        // sends it to the pixel before in some images and not in others.
+        let nudge = 1e-9;
+        let (col, yb) = ((sx / lw + nudge) as usize, (sy / lw + nudge) as usize);
         if col < img.width && yb < img.height {
             let q = (img.height - 1 - yb) * img.width + col;
             if img.valid(q) {
