@@ -10,7 +10,7 @@
 use super::coated::Coated;
 use super::conductor::ConductorAt;
 use super::microfacet::Microfacet;
-use super::Material;
+use super::{Material, MaterialFlags};
 use crate::description::context::{Context, SceneError};
 use crate::description::schema::{DistributionDesc, MaskingDesc};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths, N_LAMBDA};
@@ -52,6 +52,8 @@ pub struct MetalRough {
     mf: Vec<Microfacet>,
     /// Per roughness step: the coat, for the steps with r < 0.5.
     coats: Vec<Option<Arc<Coated>>>,
+    /// [`MaterialFlags::DELTA`] when a hit can resolve to a smooth metal or coat.
+    flags: MaterialFlags,
 }
 
 impl MetalRough {
@@ -102,7 +104,21 @@ impl MetalRough {
                     .then(|| Arc::new(Coated::new(DenseSpectrum::constant(0.5), ior as f32, mf[q])))
             })
             .collect();
+        // Reachable roughness steps: the texture's range of G (all 256 bilinear values between).
+        let (r_lo, r_hi) = match &texture {
+            Some(t) => {
+                let (a, b) = t.channel_range(0);
+                (a as usize, b as usize)
+            }
+            None => (0, 0),
+        };
+        let flags = if (r_lo..=r_hi).any(|q| mf[q].effectively_smooth()) {
+            MaterialFlags::DELTA
+        } else {
+            MaterialFlags::NONE
+        };
         Ok(MetalRough {
+            flags,
             base,
             metallic,
             roughness,
@@ -110,6 +126,11 @@ impl MetalRough {
             mf,
             coats,
         })
+    }
+
+    /// What its hits can be: [`MaterialFlags::DELTA`] if any can be a smooth metal or coat.
+    pub fn flags(&self) -> MaterialFlags {
+        self.flags
     }
 
     /// Heap memory of the textures' texels and the coats' tables, bytes.

@@ -367,8 +367,8 @@ impl Material {
             Material::Coated(m) => m.flags(),
             Material::CoatedAt(m, _) => m.flags(),
             Material::ConductorAt(m) => m.flags(),
-            // Unresolved: what its hits can be (smooth metal and coats among them).
-            Material::MetalRough(_) => MaterialFlags::DELTA,
+            // Unresolved: what its hits can be.
+            Material::MetalRough(m) => m.flags(),
             Material::NormalMapped(m) => m.inner.flags(),
             Material::Black => MaterialFlags::BLACK,
         }
