@@ -228,9 +228,8 @@ impl Coated {
         self.e(wo.z)
     }
 
-    fn diffuse(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
+    fn diffuse(&self, wo: Vec3, wi: Vec3, rho: SampledSpectrum) -> SampledSpectrum {
         let k = self.t(wo.z) as f64 * self.t(wi.z) as f64 * std::f64::consts::FRAC_1_PI;
-        let rho = self.base.sample(wl);
         let mut f = SampledSpectrum::ZERO;
         for i in 0..crate::spectrum::N_LAMBDA {
             let r = rho[i] as f64;
@@ -270,10 +269,15 @@ impl Coated {
     }
 
     pub fn eval(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
+        self.eval_base(wo, wi, self.base.sample(wl))
+    }
+
+    /// [`Coated::eval`] with the base reflectance `rho` (per lane) in place of `base`.
+    pub fn eval_base(&self, wo: Vec3, wi: Vec3, rho: SampledSpectrum) -> SampledSpectrum {
         if !same_hemisphere(wo, wi) {
             return SampledSpectrum::ZERO;
         }
-        let mut f = self.diffuse(wo, wi, wl);
+        let mut f = self.diffuse(wo, wi, rho);
         if !self.mf.effectively_smooth() {
             f += SampledSpectrum::splat(self.specular(wo, wi));
         }
@@ -299,6 +303,17 @@ impl Coated {
         u: Vec2,
         wl: &SampledWavelengths,
     ) -> Option<BsdfSample> {
+        self.sample_base(wo, uc, u, self.base.sample(wl))
+    }
+
+    /// [`Coated::sample`] with the base reflectance `rho` (per lane) in place of `base`.
+    pub fn sample_base(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        rho: SampledSpectrum,
+    ) -> Option<BsdfSample> {
         if wo.z == 0.0 {
             return None;
         }
@@ -320,7 +335,7 @@ impl Coated {
             }
             return Some(BsdfSample {
                 wi,
-                f: self.eval(wo, wi, wl),
+                f: self.eval_base(wo, wi, rho),
                 pdf,
                 specular: false,
             });
@@ -335,7 +350,7 @@ impl Coated {
         }
         Some(BsdfSample {
             wi,
-            f: self.eval(wo, wi, wl),
+            f: self.eval_base(wo, wi, rho),
             pdf,
             specular: false,
         })

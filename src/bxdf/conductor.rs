@@ -59,68 +59,144 @@ impl Conductor {
     }
 
     pub fn eval(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> SampledSpectrum {
-        if !same_hemisphere(wo, wi) || self.mf.effectively_smooth() {
-            return SampledSpectrum::ZERO;
-        }
-        let (co, ci) = (wo.z.abs(), wi.z.abs());
-        // On the +z side, as `pdf` and the sampling work.
-        let (wo_u, wi_u) = (flip_up(wo), flip_up(wi));
-        let wm = (wo_u + wi_u).normalize_or_zero();
-        if wm == Vec3::ZERO || co == 0.0 || ci == 0.0 {
-            return SampledSpectrum::ZERO;
-        }
-        // A back-facing microfacet reflects nothing (and `pdf` is 0 there). Rounding makes
-        // the half vector tilt so far only for grazing pairs of nearly opposite azimuth.
-        let cos_o = wo_u.dot(wm);
-        if cos_o <= 0.0 || wi_u.dot(wm) <= 0.0 {
-            return SampledSpectrum::ZERO;
-        }
-        let v = self.mf.d(wm) * self.mf.g(wo_u, wi_u, wm) / (4.0 * co * ci);
-        self.fresnel(cos_o, wl) * v
+        eval_with(&self.mf, wo, wi, |c| self.fresnel(c, wl))
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        if self.mf.effectively_smooth() {
-            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-            let c = wi.z.abs();
-            return Some(BsdfSample {
-                wi,
-                f: self.fresnel(c, wl) / c,
-                pdf: 1.0,
-                specular: true,
-            });
-        }
-        let wi = sample_microfacet_reflection(&self.mf, wo, u)?;
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.eval(wo, wi, wl),
-            pdf,
-            specular: false,
-        })
+        sample_with(&self.mf, wo, u, |c| self.fresnel(c, wl))
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !same_hemisphere(wo, wi) || self.mf.effectively_smooth() {
-            return 0.0;
-        }
-        let (wo_u, wi_u) = (flip_up(wo), flip_up(wi));
-        let wm = (wo_u + wi_u).normalize_or_zero();
-        if wm == Vec3::ZERO {
-            return 0.0;
-        }
-        let c = wo_u.dot(wm);
-        if c <= 0.0 {
-            return 0.0;
-        }
-        self.mf.pdf_wm(wo_u, wm) / (4.0 * c)
+        pdf_with(&self.mf, wo, wi)
     }
+}
+
+/// A conductor of index n = 1 and extinction k per lane of the path's wavelengths (a
+/// textured glTF metal at one hit: k from its base colour, as [`Material::MetalRough`]
+/// resolves it).
+#[derive(Clone, Copy, Debug)]
+pub struct ConductorAt {
+    pub mf: Microfacet,
+    pub k: SampledSpectrum,
+}
+
+impl ConductorAt {
+    /// The extinction coefficient k = 2√(F₀/(1 − F₀)) that gives a conductor of n = 1 the
+    /// normal-incidence reflectance F₀ (capped at `max`): F₀ = k²/(4 + k²).
+    #[inline]
+    pub fn k_of_reflectance(f0: f64, max: f64) -> f64 {
+        let f0 = f0.clamp(0.0, max);
+        2.0 * (f0 / (1.0 - f0)).sqrt()
+    }
+
+    #[inline]
+    fn fresnel(&self, cos: f32) -> SampledSpectrum {
+        let mut f = SampledSpectrum::ZERO;
+        for i in 0..N_LAMBDA {
+            f[i] = fr_conductor(cos.abs(), 1.0, self.k[i]);
+        }
+        f
+    }
+
+    pub fn flags(&self) -> MaterialFlags {
+        if self.mf.effectively_smooth() {
+            MaterialFlags::ALL_DELTA
+        } else {
+            MaterialFlags::NONE
+        }
+    }
+
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
+        eval_with(&self.mf, wo, wi, |c| self.fresnel(c))
+    }
+
+    pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+        sample_with(&self.mf, wo, u, |c| self.fresnel(c))
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        pdf_with(&self.mf, wo, wi)
+    }
+}
+
+/// f(wo, wi) of a conductor of roughness `mf` and Fresnel reflectance `fresnel(cos θ)`.
+#[inline]
+fn eval_with(
+    mf: &Microfacet,
+    wo: Vec3,
+    wi: Vec3,
+    fresnel: impl Fn(f32) -> SampledSpectrum,
+) -> SampledSpectrum {
+    if !same_hemisphere(wo, wi) || mf.effectively_smooth() {
+        return SampledSpectrum::ZERO;
+    }
+    let (co, ci) = (wo.z.abs(), wi.z.abs());
+    // On the +z side, as `pdf` and the sampling work.
+    let (wo_u, wi_u) = (flip_up(wo), flip_up(wi));
+    let wm = (wo_u + wi_u).normalize_or_zero();
+    if wm == Vec3::ZERO || co == 0.0 || ci == 0.0 {
+        return SampledSpectrum::ZERO;
+    }
+    // A back-facing microfacet reflects nothing (and `pdf` is 0 there). Rounding makes
+    // the half vector tilt so far only for grazing pairs of nearly opposite azimuth.
+    let cos_o = wo_u.dot(wm);
+    if cos_o <= 0.0 || wi_u.dot(wm) <= 0.0 {
+        return SampledSpectrum::ZERO;
+    }
+    let v = mf.d(wm) * mf.g(wo_u, wi_u, wm) / (4.0 * co * ci);
+    fresnel(cos_o) * v
+}
+
+/// BSDF sampling of a conductor (see [`eval_with`]).
+#[inline]
+fn sample_with(
+    mf: &Microfacet,
+    wo: Vec3,
+    u: Vec2,
+    fresnel: impl Fn(f32) -> SampledSpectrum,
+) -> Option<BsdfSample> {
+    if wo.z == 0.0 {
+        return None;
+    }
+    if mf.effectively_smooth() {
+        let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+        let c = wi.z.abs();
+        return Some(BsdfSample {
+            wi,
+            f: fresnel(c) / c,
+            pdf: 1.0,
+            specular: true,
+        });
+    }
+    let wi = sample_microfacet_reflection(mf, wo, u)?;
+    let pdf = pdf_with(mf, wo, wi);
+    if pdf <= 0.0 {
+        return None;
+    }
+    Some(BsdfSample {
+        wi,
+        f: eval_with(mf, wo, wi, fresnel),
+        pdf,
+        specular: false,
+    })
+}
+
+/// Density of [`sample_with`].
+#[inline]
+fn pdf_with(mf: &Microfacet, wo: Vec3, wi: Vec3) -> f32 {
+    if !same_hemisphere(wo, wi) || mf.effectively_smooth() {
+        return 0.0;
+    }
+    let (wo_u, wi_u) = (flip_up(wo), flip_up(wi));
+    let wm = (wo_u + wi_u).normalize_or_zero();
+    if wm == Vec3::ZERO {
+        return 0.0;
+    }
+    let c = wo_u.dot(wm);
+    if c <= 0.0 {
+        return 0.0;
+    }
+    mf.pdf_wm(wo_u, wm) / (4.0 * c)
 }
 
 #[inline]

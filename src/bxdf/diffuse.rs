@@ -104,8 +104,7 @@ impl TexturedDiffuse {
             ));
         }
         let mut t = crate::texture::Texture::load(path).map_err(|e| e.to_string())?;
-        t.scale = Vec2::from(uv_scale);
-        t.offset = Vec2::from(uv_offset);
+        t.uv = crate::texture::scale_offset(uv_scale, uv_offset);
         t.wrap = wrap;
         Ok(TexturedDiffuse {
             texture: std::sync::Arc::new(t),

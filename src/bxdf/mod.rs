@@ -23,7 +23,9 @@ pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
 pub mod ior;
+pub mod metal_rough;
 pub mod microfacet;
+pub mod normal_map;
 pub mod oren_nayar;
 pub mod phong;
 pub mod thin_dielectric;
@@ -34,7 +36,7 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
 pub use coated::Coated;
-pub use conductor::Conductor;
+pub use conductor::{Conductor, ConductorAt};
 pub use dielectric::Dielectric;
 pub use diffuse::{Diffuse, TexturedDiffuse};
 pub use ior::{ConductorIor, Ior};
@@ -67,6 +69,18 @@ pub enum Material {
     ThinDielectric(ThinDielectric),
     /// Diffuse base under a smooth dielectric coating ("plastic").
     Coated(Coated),
+    /// A coat with its base reflectance already sampled at the path's wavelengths (a
+    /// [`Material::MetalRough`] at one hit).
+    CoatedAt(std::sync::Arc<Coated>, SampledSpectrum),
+    /// A conductor of n = 1 with k sampled at the path's wavelengths (a
+    /// [`Material::MetalRough`] at one hit).
+    ConductorAt(ConductorAt),
+    /// glTF's metallic-roughness material with textures; integrators resolve it at each hit
+    /// with [`Material::at_texture`].
+    MetalRough(std::sync::Arc<metal_rough::MetalRough>),
+    /// A material whose shading normal a tangent-space normal map perturbs; integrators take
+    /// it apart with [`Material::normal_map`] before anything else.
+    NormalMapped(std::sync::Arc<normal_map::NormalMapped>),
     /// Absorbs everything (an emitter that reflects nothing, or a light-trap).
     Black,
 }
@@ -216,8 +230,50 @@ impl Material {
     ///   (default 0), both scaled down together where `Kd + Ks` exceeds 1;
     /// * else [`Diffuse`] of reflectance `Kd` (default 0.8).
     ///
-    /// Colours are linear sRGB in [0, 1] upsampled to smooth spectra.
+    /// Colours are linear sRGB in [0, 1] upsampled to smooth spectra. A `norm` map puts the
+    /// material under that tangent-space normal map ([`Material::NormalMapped`]).
     pub fn from_mtl(
+        ctx: &Context,
+        field: &str,
+        m: &crate::geometry::mtl::MtlMaterial,
+    ) -> Result<Self, SceneError> {
+        let inner = Self::from_mtl_unmapped(ctx, field, m)?;
+        let Some(map) = &m.norm else {
+            return Ok(inner);
+        };
+        let at = format!(
+            "{field} (`norm` of material {:?}, '{}' line {})",
+            m.name,
+            m.file.display(),
+            m.line
+        );
+        let path = m
+            .file
+            .parent()
+            .unwrap_or(std::path::Path::new(""))
+            .join(&map.file);
+        let uv = crate::texture::scale_offset(map.scale, map.offset);
+        if !(uv.is_finite() && map.bump.is_finite()) {
+            return Err(ctx.err(at, "its -s, -o and -bm must be finite"));
+        }
+        let mut tex = crate::texture::bytes::ByteTexture::<3>::load(&path, [0, 1, 2])
+            .map_err(|e| ctx.err(&at, e.to_string()))?;
+        tex.uv = uv;
+        tex.wrap = if map.clamp {
+            crate::texture::Wrap::Clamp
+        } else {
+            crate::texture::Wrap::Repeat
+        };
+        Ok(Material::NormalMapped(std::sync::Arc::new(
+            normal_map::NormalMapped {
+                inner,
+                map: tex,
+                scale: map.bump,
+            },
+        )))
+    }
+
+    fn from_mtl_unmapped(
         ctx: &Context,
         field: &str,
         m: &crate::geometry::mtl::MtlMaterial,
@@ -309,7 +365,22 @@ impl Material {
             Material::Dielectric(m) => m.flags(),
             Material::ThinDielectric(_) => ThinDielectric::FLAGS,
             Material::Coated(m) => m.flags(),
+            Material::CoatedAt(m, _) => m.flags(),
+            Material::ConductorAt(m) => m.flags(),
+            // Unresolved: what its hits can be.
+            Material::MetalRough(m) => m.flags(),
+            Material::NormalMapped(m) => m.inner.flags(),
             Material::Black => MaterialFlags::BLACK,
+        }
+    }
+
+    /// The material under a normal map and the map, for a [`Material::NormalMapped`]; else the
+    /// material itself and `None`.
+    #[inline]
+    pub fn normal_map(&self) -> (&Material, Option<&normal_map::NormalMapped>) {
+        match self {
+            Material::NormalMapped(m) => (&m.inner, Some(m)),
+            m => (m, None),
         }
     }
 
@@ -322,6 +393,8 @@ impl Material {
             Material::TexturedDiffuse(t) => {
                 Some(Material::DiffuseAt(t.texture.reflectance(tex, wl)))
             }
+            Material::MetalRough(m) => Some(m.at(tex, wl)),
+            Material::NormalMapped(m) => m.inner.at_texture(tex, wl),
             _ => None,
         }
     }
@@ -332,8 +405,10 @@ impl Material {
     /// agree on the wavelengths they carry.
     #[inline]
     pub fn prepare(&self, wl: &mut SampledWavelengths) {
-        if let Material::Dielectric(d) = self {
-            d.prepare(wl);
+        match self {
+            Material::Dielectric(d) => d.prepare(wl),
+            Material::NormalMapped(m) => m.inner.prepare(wl),
+            _ => {}
         }
     }
 
@@ -353,6 +428,10 @@ impl Material {
             Material::Dielectric(m) => m.eval(wo, wi, wl),
             Material::ThinDielectric(_) => SampledSpectrum::ZERO,
             Material::Coated(m) => m.eval(wo, wi, wl),
+            Material::CoatedAt(m, rho) => m.eval_base(wo, wi, *rho),
+            Material::ConductorAt(m) => m.eval(wo, wi),
+            Material::MetalRough(m) => m.at(Vec2::splat(0.5), wl).eval(wo, wi, wl),
+            Material::NormalMapped(m) => m.inner.eval(wo, wi, wl),
             Material::Black => SampledSpectrum::ZERO,
         }
     }
@@ -376,6 +455,10 @@ impl Material {
             Material::Dielectric(m) => m.sample(wo, uc, u, wl),
             Material::ThinDielectric(m) => m.sample(wo, uc, wl),
             Material::Coated(m) => m.sample(wo, uc, u, wl),
+            Material::CoatedAt(m, rho) => m.sample_base(wo, uc, u, *rho),
+            Material::ConductorAt(m) => m.sample(wo, u),
+            Material::MetalRough(m) => m.at(Vec2::splat(0.5), wl).sample(wo, uc, u, wl),
+            Material::NormalMapped(m) => m.inner.sample(wo, uc, u, wl),
             Material::Black => None,
         }
     }
@@ -391,6 +474,10 @@ impl Material {
             Material::Dielectric(m) => m.pdf(wo, wi, wl),
             Material::ThinDielectric(_) => 0.0,
             Material::Coated(m) => m.pdf(wo, wi),
+            Material::CoatedAt(m, _) => m.pdf(wo, wi),
+            Material::ConductorAt(m) => m.pdf(wo, wi),
+            Material::MetalRough(m) => m.at(Vec2::splat(0.5), wl).pdf(wo, wi, wl),
+            Material::NormalMapped(m) => m.inner.pdf(wo, wi, wl),
             Material::Black => 0.0,
         }
     }
@@ -403,6 +490,7 @@ impl Material {
     #[inline]
     pub fn eta_scale(&self, wo: Vec3, wi: Vec3, wl: &SampledWavelengths) -> f32 {
         match self {
+            Material::NormalMapped(m) => m.inner.eta_scale(wo, wi, wl),
             Material::Dielectric(d) if wo.z * wi.z < 0.0 => {
                 let eta = d.eta(wl);
                 let etap = if wo.z > 0.0 { eta } else { 1.0 / eta };
@@ -429,6 +517,7 @@ impl Material {
     ) -> Option<SampledSpectrum> {
         match self {
             Material::ThinDielectric(m) => Some(m.transmittance(cos, wl)),
+            Material::NormalMapped(m) => m.inner.straight_transmittance(cos, wl),
             _ => None,
         }
     }

@@ -44,6 +44,7 @@ mod query;
 mod robust;
 mod sample;
 mod scene;
+mod tangent;
 mod traverse;
 
 pub use bvh::BUILD_PEAK_BYTES_PER_PRIM;

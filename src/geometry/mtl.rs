@@ -1,5 +1,6 @@
 //! Wavefront MTL material libraries: the statements candela maps to materials (`Kd`, `Ks`,
-//! `Ns`, `d`/`Tr`, `Ni`, `Ke`, `map_Kd` and its `-s`, `-o`, `-clamp` options), read with the
+//! `Ns`, `d`/`Tr`, `Ni`, `Ke`, `map_Kd` and the tangent-space normal map `norm`, with their
+//! `-s`, `-o`, `-clamp` options and `norm`'s `-bm`), read with the
 //! file and line of every error. Other statements (`Ka`, `illum`, `Tf`, other maps, PBR
 //! extensions) are skipped; how the kept ones become materials is in `scene::build` and
 //! docs/scene-format.md.
@@ -7,7 +8,7 @@
 use super::GeometryError;
 use std::path::{Path, PathBuf};
 
-/// A diffuse texture map (`map_Kd`) with its options.
+/// A texture map (`map_Kd`, `norm`) with its options.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MtlMap {
     /// The image file, relative to the MTL file's directory as written.
@@ -18,6 +19,8 @@ pub struct MtlMap {
     pub offset: [f32; 2],
     /// `-clamp on`: clamp instead of repeating.
     pub clamp: bool,
+    /// `-bm f`: a normal map's scale of x and y (default 1).
+    pub bump: f32,
 }
 
 /// One `newmtl` block: the statements candela uses, as written (not yet checked for range).
@@ -35,6 +38,8 @@ pub struct MtlMaterial {
     pub ni: Option<f64>,
     pub ke: Option<[f64; 3]>,
     pub map_kd: Option<MtlMap>,
+    /// A tangent-space normal map.
+    pub norm: Option<MtlMap>,
 }
 
 fn syntax(path: &Path, line: usize, message: String) -> GeometryError {
@@ -97,14 +102,15 @@ fn scalar(path: &Path, line: usize, stmt: &str, args: &[&str]) -> Result<f64, Ge
     }
 }
 
-/// `map_Kd [options] file`: `-s`, `-o` (1 to 3 numbers; the first two are used), `-clamp on|off`;
-/// other options are skipped with their arguments.
-fn map(path: &Path, line: usize, args: &[&str]) -> Result<MtlMap, GeometryError> {
+/// `map_Kd [options] file` (or `norm`, named by `stmt`): `-s`, `-o` (1 to 3 numbers; the first
+/// two are used), `-clamp on|off`, `-bm f`; other options are skipped with their arguments.
+fn map(path: &Path, line: usize, stmt: &str, args: &[&str]) -> Result<MtlMap, GeometryError> {
     let mut m = MtlMap {
         file: String::new(),
         scale: [1.0, 1.0],
         offset: [0.0, 0.0],
         clamp: false,
+        bump: 1.0,
     };
     let mut i = 0;
     let numbers = |i: &mut usize, max: usize| -> Vec<f64> {
@@ -130,7 +136,7 @@ fn map(path: &Path, line: usize, args: &[&str]) -> Result<MtlMap, GeometryError>
                     return Err(syntax(
                         path,
                         line,
-                        format!("`map_Kd {opt}` expects 1 to 3 numbers"),
+                        format!("`{stmt} {opt}` expects 1 to 3 numbers"),
                     ));
                 }
                 let uv = [v[0] as f32, *v.get(1).unwrap_or(&v[0]) as f32];
@@ -151,7 +157,7 @@ fn map(path: &Path, line: usize, args: &[&str]) -> Result<MtlMap, GeometryError>
                         return Err(syntax(
                             path,
                             line,
-                            format!("`map_Kd {opt}` expects on or off"),
+                            format!("`{stmt} {opt}` expects on or off"),
                         ))
                     }
                 };
@@ -163,7 +169,11 @@ fn map(path: &Path, line: usize, args: &[&str]) -> Result<MtlMap, GeometryError>
             "-mm" => {
                 numbers(&mut i, 2);
             }
-            "-bm" | "-boost" | "-texres" => {
+            "-bm" => match numbers(&mut i, 1).first() {
+                Some(&b) => m.bump = b as f32,
+                None => return Err(syntax(path, line, format!("`{stmt} -bm` expects a number"))),
+            },
+            "-boost" | "-texres" => {
                 numbers(&mut i, 1);
             }
             "-imfchan" => i += 1,
@@ -171,14 +181,14 @@ fn map(path: &Path, line: usize, args: &[&str]) -> Result<MtlMap, GeometryError>
                 return Err(syntax(
                     path,
                     line,
-                    format!("unknown `map_Kd` option {opt:?}"),
+                    format!("unknown `{stmt}` option {opt:?}"),
                 ))
             }
         }
     }
     m.file = args[i.min(args.len())..].join(" ");
     if m.file.is_empty() {
-        return Err(syntax(path, line, "`map_Kd` names no image file".into()));
+        return Err(syntax(path, line, format!("`{stmt}` names no image file")));
     }
     Ok(m)
 }
@@ -220,7 +230,7 @@ pub fn parse_mtl(path: &Path, bytes: &[u8]) -> Result<Vec<MtlMaterial>, Geometry
         }
         let known = matches!(
             stmt,
-            "Kd" | "Ks" | "Ke" | "Ns" | "Ni" | "d" | "Tr" | "map_Kd"
+            "Kd" | "Ks" | "Ke" | "Ns" | "Ni" | "d" | "Tr" | "map_Kd" | "norm"
         );
         let Some(m) = out.last_mut() else {
             if known {
@@ -244,7 +254,8 @@ pub fn parse_mtl(path: &Path, bytes: &[u8]) -> Result<Vec<MtlMaterial>, Geometry
                 m.d = Some(scalar(path, line, stmt, args)?)
             }
             "Tr" => m.d = Some(1.0 - scalar(path, line, stmt, args)?),
-            "map_Kd" => m.map_kd = Some(map(path, line, args)?),
+            "map_Kd" => m.map_kd = Some(map(path, line, stmt, args)?),
+            "norm" => m.norm = Some(map(path, line, stmt, args)?),
             _ => {}
         }
     }

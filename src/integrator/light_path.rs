@@ -212,6 +212,11 @@ pub fn trace_light_path(
         };
         let object = world.objects[hit.object as usize];
         let material = &world.materials[object.material as usize];
+        let (material, normal_map) = material.normal_map();
+        let hit = match normal_map {
+            Some(m) => super::normal_mapped(world, m, hit),
+            None => hit,
+        };
         let textured;
         let material = match material.at_texture(hit.tex, &wl) {
             Some(m) => {
@@ -244,7 +249,9 @@ pub fn trace_light_path(
             if let Some(c) = camera.connect(hit.p, Vec2::new(lx, ly), filter.radius()) {
                 let cos_cam = c.wi.dot(hit.ng).abs();
                 let mut l = SampledSpectrum::ZERO;
-                if want_l {
+                let leak = normal_map.is_some()
+                    && crate::bxdf::normal_map::leaks(wo_world, c.wi, hit.ns, hit.ng);
+                if want_l && !leak {
                     let wi = frame.to_local(c.wi);
                     // Radiance convention: out toward the camera, in from the light.
                     let f = material.eval(wi, wo, &wl);
@@ -334,6 +341,11 @@ pub fn trace_light_path(
             return;
         }
         let wi_world = frame.to_world(bs.wi);
+        if normal_map.is_some()
+            && crate::bxdf::normal_map::leaks(wo_world, wi_world, hit.ns, hit.ng)
+        {
+            return;
+        }
         // Adjoint BSDF: f·|cos|/pdf with the refraction's 1/η′² undone, and the
         // shading-normal correction.
         let k = bs.wi.z.abs() / bs.pdf

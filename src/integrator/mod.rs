@@ -37,3 +37,18 @@ pub fn survival_probability(throughput: f32) -> f32 {
         0.0
     }
 }
+
+/// `hit` with its shading normal perturbed by the normal map `m` (in the tangent frame of the
+/// hit primitive's texture coordinates); unchanged where the primitive gives no such frame
+/// (spheres, disks, instanced meshes).
+#[inline]
+pub fn normal_mapped(
+    world: &crate::world::World,
+    m: &crate::bxdf::normal_map::NormalMapped,
+    mut hit: crate::geometry::Hit,
+) -> crate::geometry::Hit {
+    if let Some((dpdu, dpdv)) = world.geometry.texture_derivatives(&hit) {
+        hit.ns = m.shading_normal(hit.tex, hit.ns, hit.ng, dpdu, dpdv);
+    }
+    hit
+}

@@ -197,6 +197,11 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
         }
 
         let material = &world.materials[object.material as usize];
+        let (material, normal_map) = material.normal_map();
+        let hit = match normal_map {
+            Some(m) => crate::integrator::normal_mapped(world, m, hit),
+            None => hit,
+        };
         let textured;
         let material = match material.at_texture(hit.tex, wl) {
             Some(m) => {
@@ -261,7 +266,9 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
         if let Some((k, prim, p_select)) = light_sample {
             let light = &world.lights[k];
             if let Some(ls) = light.sample_li_prim(&world.geometry, hit.p, prim, u_prim, u_pt, wl) {
-                if ls.pdf > 0.0 && !ls.li.is_black() {
+                let leak = normal_map.is_some()
+                    && crate::bxdf::normal_map::leaks(wo_world, ls.wi, hit.ns, hit.ng);
+                if ls.pdf > 0.0 && !ls.li.is_black() && !leak {
                     let wi = frame.to_local(ls.wi);
                     let f = material.eval(wo, wi, wl) * wi.z.abs();
                     if !f.is_black() {
@@ -293,6 +300,11 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
             break;
         };
         if bs.pdf.is_nan() || bs.pdf <= 0.0 {
+            break;
+        }
+        if normal_map.is_some()
+            && crate::bxdf::normal_map::leaks(wo_world, frame.to_world(bs.wi), hit.ns, hit.ng)
+        {
             break;
         }
         beta *= bs.f * (bs.wi.z.abs() / bs.pdf);

@@ -6,14 +6,19 @@
 //! Rec. 709 Y). Lights keep glTF's photometric units: cd for point and spot, lx for directional.
 
 use crate::bxdf::diffuse::TexturedDiffuse;
+use crate::bxdf::metal_rough::{BaseColour, MetalRough, MAX_METAL_REFLECTANCE};
+use crate::bxdf::normal_map::NormalMapped;
 use crate::bxdf::Material;
 use crate::description::context::{Context, Role, SceneError};
 use crate::description::schema::{
     Amount, DistributionDesc, EmissionDesc, IorDesc, LightDesc, MaskingDesc, MaterialDesc,
     SpectrumDesc,
 };
-use crate::geometry::gltf::{GltfImage, GltfLight, GltfLightKind, GltfMaterial, GltfModel};
-use crate::texture::{Texture, Wrap};
+use crate::geometry::gltf::{
+    GltfImage, GltfLight, GltfLightKind, GltfMaterial, GltfModel, GltfTextureRef,
+};
+use crate::texture::bytes::ByteTexture;
+use crate::texture::{Texture, TextureError, Wrap};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -22,11 +27,50 @@ fn luma(c: [f64; 3]) -> f64 {
     0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
 
-/// Largest normal-incidence reflectance given to a conductor (its k is 2√(R/(1 − R)), finite).
-const MAX_METAL_REFLECTANCE: f64 = 0.999;
+/// Textures already decoded, so materials sharing an image share it: reflectance textures by
+/// (image, tint bits), metallic-roughness and normal maps by image.
+#[derive(Default)]
+pub struct TextureCache {
+    colour: HashMap<(usize, [u32; 3]), Arc<Texture>>,
+    metal_rough: HashMap<usize, Arc<ByteTexture<2>>>,
+    normal: HashMap<usize, Arc<ByteTexture<3>>>,
+}
 
-/// Textures already decoded, by (image, tint bits), so materials sharing one share it.
-pub type TextureCache = HashMap<(usize, [u32; 3]), Arc<Texture>>;
+impl TextureCache {
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+/// Decodes image `image` of `model` with `decode(label, bytes)`.
+fn with_image<T>(
+    model: &GltfModel,
+    image: usize,
+    decode: impl Fn(&std::path::Path, &[u8]) -> Result<T, TextureError>,
+) -> Result<T, String> {
+    match model.images.get(image) {
+        Some(GltfImage::File(p)) => crate::limits::read_file(p, 4 << 30)
+            .map_err(|e| format!("cannot use texture image '{}': {e}.", p.display()))
+            .and_then(|b| decode(p, &b).map_err(|e| e.to_string())),
+        Some(GltfImage::Bytes { label, bytes }) => decode(label, bytes).map_err(|e| e.to_string()),
+        None => Err(format!("image {image} does not exist")),
+    }
+}
+
+/// `t`'s wrap mode and UV map on a copy of `texture`.
+fn with_sampler<T: Clone>(
+    texture: &T,
+    t: &GltfTextureRef,
+    set: impl Fn(&mut T, Wrap, glam::Affine2),
+) -> T {
+    let mut tex = texture.clone();
+    set(
+        &mut tex,
+        if t.clamp { Wrap::Clamp } else { Wrap::Repeat },
+        t.uv,
+    );
+    tex
+}
 
 /// The candela material of glTF material `m` of `model`; errors at `field` name the material.
 pub fn material(
@@ -56,11 +100,118 @@ pub fn material(
     let metallic = unit("metallicFactor", m.metallic)?;
     let roughness = unit("roughnessFactor", m.roughness)?;
     let transmission = unit("transmissionFactor", m.transmission)?;
+    let inner =
+        if transmission < 0.5 && (m.base_texture.is_some() || m.metal_rough_texture.is_some()) {
+            textured(ctx, &at, model, m, cache, rgb, (metallic, roughness))?
+        } else {
+            untextured(ctx, &at, m, rgb, (metallic, roughness, transmission))?
+        };
+    let Some((t, scale)) = &m.normal_texture else {
+        return Ok(inner);
+    };
+    let map = match cache.normal.get(&t.image) {
+        Some(map) => map.clone(),
+        None => {
+            let map = with_image(model, t.image, |p, b| ByteTexture::decode(p, b, [0, 1, 2]))
+                .map_err(|e| ctx.err(&at, format!("normalTexture: {e}")))?;
+            let map = Arc::new(map);
+            cache.normal.insert(t.image, map.clone());
+            map
+        }
+    };
+    Ok(Material::NormalMapped(Arc::new(NormalMapped {
+        inner,
+        map: with_sampler(&*map, t, |m, w, uv| {
+            m.wrap = w;
+            m.uv = uv;
+        }),
+        scale: *scale,
+    })))
+}
+
+/// A material with a base-colour or metallic-roughness texture (not transmissive): a textured
+/// Lambertian where the factors make it one everywhere and only the base colour is textured,
+/// else [`MetalRough`], which applies the rule per hit.
+fn textured(
+    ctx: &Context,
+    at: &str,
+    model: &GltfModel,
+    m: &GltfMaterial,
+    cache: &mut TextureCache,
+    rgb: [f64; 3],
+    (metallic, roughness): (f64, f64),
+) -> Result<Material, SceneError> {
+    let base = match &m.base_texture {
+        Some(t) => {
+            let tint = rgb.map(|v| v as f32);
+            let key = (t.image, tint.map(f32::to_bits));
+            let texture = match cache.colour.get(&key) {
+                Some(tex) => tex.clone(),
+                None => {
+                    let tex = with_image(model, t.image, |p, b| Texture::decode(p, b, tint))
+                        .map_err(|e| ctx.err(at, e))?;
+                    let tex = Arc::new(tex);
+                    cache.colour.insert(key, tex.clone());
+                    tex
+                }
+            };
+            let tex = with_sampler(&*texture, t, |x, w, uv| {
+                x.wrap = w;
+                x.uv = uv;
+            });
+            if m.metal_rough_texture.is_none() && metallic < 0.5 && roughness >= 0.5 {
+                return Ok(Material::TexturedDiffuse(TexturedDiffuse {
+                    texture: Arc::new(tex),
+                }));
+            }
+            BaseColour::Texture(Arc::new(tex))
+        }
+        None => BaseColour::Spectrum(ctx.spectrum(
+            at,
+            &SpectrumDesc::Rgb(rgb[0], rgb[1], rgb[2]),
+            Role::Reflectance,
+        )?),
+    };
+    let mr = match &m.metal_rough_texture {
+        Some(t) => {
+            let map = match cache.metal_rough.get(&t.image) {
+                Some(map) => map.clone(),
+                None => {
+                    let map = with_image(model, t.image, |p, b| ByteTexture::decode(p, b, [1, 2]))
+                        .map_err(|e| ctx.err(at, format!("metallicRoughnessTexture: {e}")))?;
+                    let map = Arc::new(map);
+                    cache.metal_rough.insert(t.image, map.clone());
+                    map
+                }
+            };
+            Some(with_sampler(&*map, t, |x, w, uv| {
+                x.wrap = w;
+                x.uv = uv;
+            }))
+        }
+        None => None,
+    };
+    if !(m.ior.is_finite() && m.ior >= 1.0) {
+        return Err(ctx.err(at, format!("ior {} must be ≥ 1", m.ior)));
+    }
+    let mr = MetalRough::build(ctx, at, base, (metallic, roughness), mr, m.ior)?;
+    Ok(Material::MetalRough(Arc::new(mr)))
+}
+
+/// The material of an untextured (or transmissive) glTF material, by the rule in the module
+/// docs.
+fn untextured(
+    ctx: &Context,
+    at: &str,
+    m: &GltfMaterial,
+    rgb: [f64; 3],
+    (metallic, roughness, transmission): (f64, f64, f64),
+) -> Result<Material, SceneError> {
     // glTF's roughness is perceptual: the microfacet α is its square.
     let alpha = (roughness * roughness) as f32;
     let desc = if transmission >= 0.5 {
         if !(m.ior.is_finite() && m.ior >= 1.0) {
-            return Err(ctx.err(&at, format!("ior {} must be ≥ 1", m.ior)));
+            return Err(ctx.err(at, format!("ior {} must be ≥ 1", m.ior)));
         }
         MaterialDesc::Dielectric {
             // KHR_materials_ior's 1.0 means "no refraction": the thinnest interface candela has.
@@ -71,7 +222,7 @@ pub fn material(
         }
     } else if metallic >= 0.5 {
         let r = ctx.spectrum(
-            &at,
+            at,
             &SpectrumDesc::Rgb(rgb[0], rgb[1], rgb[2]),
             Role::Reflectance,
         )?;
@@ -91,43 +242,13 @@ pub fn material(
             distribution: DistributionDesc::Ggx,
             masking: MaskingDesc::default(),
         }
-    } else if let Some(t) = &m.base_texture {
-        let tint = rgb.map(|v| v as f32);
-        let key = (t.image, tint.map(f32::to_bits));
-        let texture = match cache.get(&key) {
-            Some(tex) => tex.clone(),
-            None => {
-                let loaded = match model.images.get(t.image) {
-                    Some(GltfImage::File(p)) => crate::limits::read_file(p, 4 << 30)
-                        .map_err(|e| format!("cannot use texture image '{}': {e}.", p.display()))
-                        .and_then(|b| Texture::decode(p, &b, tint).map_err(|e| e.to_string())),
-                    Some(GltfImage::Bytes { label, bytes }) => {
-                        Texture::decode(label, bytes, tint).map_err(|e| e.to_string())
-                    }
-                    None => Err(format!("image {} does not exist", t.image)),
-                };
-                let tex = Arc::new(loaded.map_err(|e| ctx.err(&at, e))?);
-                cache.insert(key, tex.clone());
-                tex
-            }
-        };
-        let mut tex = (*texture).clone();
-        tex.scale = t.uv_scale.into();
-        tex.offset = t.uv_offset.into();
-        tex.wrap = if t.clamp { Wrap::Clamp } else { Wrap::Repeat };
-        if !(tex.scale.is_finite() && tex.offset.is_finite()) {
-            return Err(ctx.err(&at, "the texture transform is not finite"));
-        }
-        return Ok(Material::TexturedDiffuse(TexturedDiffuse {
-            texture: Arc::new(tex),
-        }));
     } else if roughness >= 0.5 {
         MaterialDesc::Diffuse {
             reflectance: SpectrumDesc::Rgb(rgb[0], rgb[1], rgb[2]),
         }
     } else {
         if !(m.ior.is_finite() && m.ior >= 1.0) {
-            return Err(ctx.err(&at, format!("ior {} must be ≥ 1", m.ior)));
+            return Err(ctx.err(at, format!("ior {} must be ≥ 1", m.ior)));
         }
         MaterialDesc::Coated {
             base: SpectrumDesc::Rgb(rgb[0], rgb[1], rgb[2]),
@@ -136,7 +257,7 @@ pub fn material(
             distribution: DistributionDesc::Ggx,
         }
     };
-    Material::build(ctx, &at, &desc)
+    Material::build(ctx, at, &desc)
 }
 
 /// The emission of glTF material `m`: front faces of luminance `strength · Y(emissive)` cd/m²

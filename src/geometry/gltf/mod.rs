@@ -49,12 +49,13 @@ pub struct GltfInstance {
     pub world: Affine3A,
 }
 
-/// A base-colour texture reference, its transform already in candela's texture convention.
+/// A texture reference, its transform already in candela's texture convention.
 #[derive(Clone, Debug)]
 pub struct GltfTextureRef {
     pub image: usize,
-    pub uv_scale: [f32; 2],
-    pub uv_offset: [f32; 2],
+    /// `KHR_texture_transform` as a map of candela's coordinates
+    /// ([`crate::texture::gltf_uv_map`]); the identity without it.
+    pub uv: glam::Affine2,
     /// Both wrap modes are CLAMP_TO_EDGE.
     pub clamp: bool,
 }
@@ -68,6 +69,10 @@ pub struct GltfMaterial {
     /// Linear RGBA.
     pub base_colour: [f64; 4],
     pub base_texture: Option<GltfTextureRef>,
+    /// Roughness in G, metallic in B (linear), multiplying the factors.
+    pub metal_rough_texture: Option<GltfTextureRef>,
+    /// A tangent-space normal map and its `scale`.
+    pub normal_texture: Option<(GltfTextureRef, f32)>,
     pub metallic: f64,
     /// Perceptual roughness (α = roughness²).
     pub roughness: f64,
@@ -544,48 +549,95 @@ fn primitive(
     })
 }
 
+/// `KHR_texture_transform`'s (offset, rotation in rad, scale, texCoord) of a texture reference.
+type Transform = ([f32; 2], f32, [f32; 2], Option<u32>);
+
+/// A texture reference of material `m` (`what` names the texture in messages): its set of
+/// texture coordinates must be 0, its transform finite.
 fn texture_ref(
     path: &Path,
-    info: &gltf::texture::Info,
+    what: &str,
     m: usize,
+    (tex, tex_coord, transform): (gltf::Texture, u32, Option<Transform>),
 ) -> Result<GltfTextureRef, GeometryError> {
-    if info.tex_coord() != 0 {
+    if tex_coord != 0 {
         return Err(parse_err(
             path,
-            format!(
-                "material {m}'s base colour texture uses TEXCOORD_{}; candela reads set 0",
-                info.tex_coord()
-            ),
+            format!("material {m}'s {what} uses TEXCOORD_{tex_coord}; candela reads set 0"),
         ));
     }
-    let tex = info.texture();
-    let (mut scale, mut offset) = ([1.0f32, 1.0], [0.0f32, 0.0]);
-    if let Some(t) = info.texture_transform() {
-        if t.rotation() != 0.0 {
+    let mut uv = glam::Affine2::IDENTITY;
+    if let Some((offset, rotation, scale, set)) = transform {
+        if set.is_some_and(|c| c != 0) {
             return Err(parse_err(
                 path,
-                format!("material {m}'s base colour texture is rotated (KHR_texture_transform), which candela does not support"),
+                format!("material {m}'s {what} transform selects another TEXCOORD set"),
             ));
         }
-        if t.tex_coord().is_some_and(|c| c != 0) {
+        uv = crate::texture::gltf_uv_map(offset, rotation, scale);
+        if !uv.is_finite() {
             return Err(parse_err(
                 path,
-                format!("material {m}'s texture transform selects another TEXCOORD set"),
+                format!("material {m}'s {what} transform is not finite"),
             ));
         }
-        (scale, offset) = (t.scale(), t.offset());
     }
-    // glTF maps uv' = uv·s + o with v down; candela's v is 1 − v (see GltfPrimitive::uvs):
-    // 1 − ((1 − v)·s + o) = v·s + (1 − s − o).
-    let uv_offset = [offset[0], 1.0 - scale[1] - offset[1]];
     use gltf::texture::WrappingMode::ClampToEdge;
     let s = tex.sampler();
     Ok(GltfTextureRef {
         image: tex.source().index(),
-        uv_scale: scale,
-        uv_offset,
+        uv,
         clamp: s.wrap_s() == ClampToEdge && s.wrap_t() == ClampToEdge,
     })
+}
+
+/// A `textureInfo`'s texture, set and transform.
+fn info_parts(info: gltf::texture::Info) -> (gltf::Texture, u32, Option<Transform>) {
+    let t = info
+        .texture_transform()
+        .map(|t| (t.offset(), t.rotation(), t.scale(), t.tex_coord()));
+    (info.texture(), info.tex_coord(), t)
+}
+
+/// The `KHR_texture_transform` of a normal texture, which the `gltf` crate leaves as JSON.
+fn normal_transform(
+    path: &Path,
+    m: usize,
+    n: &gltf::material::NormalTexture,
+) -> Result<Option<Transform>, GeometryError> {
+    let Some(v) = n.extension_value("KHR_texture_transform") else {
+        return Ok(None);
+    };
+    let bad = || {
+        parse_err(
+            path,
+            format!("material {m}'s normal texture has a malformed KHR_texture_transform"),
+        )
+    };
+    let pair = |key: &str, default: [f32; 2]| -> Result<[f32; 2], GeometryError> {
+        match v.get(key) {
+            None => Ok(default),
+            Some(a) => {
+                let a = a.as_array().filter(|a| a.len() == 2).ok_or_else(bad)?;
+                let x = |i: usize| a[i].as_f64().map(|x| x as f32).ok_or_else(bad);
+                Ok([x(0)?, x(1)?])
+            }
+        }
+    };
+    let rotation = match v.get("rotation") {
+        None => 0.0,
+        Some(r) => r.as_f64().ok_or_else(bad)? as f32,
+    };
+    let set = match v.get("texCoord") {
+        None => None,
+        Some(c) => Some(c.as_u64().ok_or_else(bad)? as u32),
+    };
+    Ok(Some((
+        pair("offset", [0.0, 0.0])?,
+        rotation,
+        pair("scale", [1.0, 1.0])?,
+        set,
+    )))
 }
 
 fn material(path: &Path, m: &gltf::Material) -> Result<GltfMaterial, GeometryError> {
@@ -593,7 +645,30 @@ fn material(path: &Path, m: &gltf::Material) -> Result<GltfMaterial, GeometryErr
     let pbr = m.pbr_metallic_roughness();
     let f = |v: f32| v as f64;
     let base_texture = match pbr.base_color_texture() {
-        Some(t) => Some(texture_ref(path, &t, i)?),
+        Some(t) => Some(texture_ref(path, "base colour texture", i, info_parts(t))?),
+        None => None,
+    };
+    let metal_rough_texture = match pbr.metallic_roughness_texture() {
+        Some(t) => Some(texture_ref(
+            path,
+            "metallic-roughness texture",
+            i,
+            info_parts(t),
+        )?),
+        None => None,
+    };
+    let normal_texture = match m.normal_texture() {
+        Some(n) => {
+            let parts = (n.texture(), n.tex_coord(), normal_transform(path, i, &n)?);
+            let scale = n.scale();
+            if !scale.is_finite() {
+                return Err(parse_err(
+                    path,
+                    format!("material {i}'s normal texture scale {scale} is not finite"),
+                ));
+            }
+            Some((texture_ref(path, "normal texture", i, parts)?, scale))
+        }
         None => None,
     };
     Ok(GltfMaterial {
@@ -601,6 +676,8 @@ fn material(path: &Path, m: &gltf::Material) -> Result<GltfMaterial, GeometryErr
         index: i,
         base_colour: pbr.base_color_factor().map(f),
         base_texture,
+        metal_rough_texture,
+        normal_texture,
         metallic: f(pbr.metallic_factor()),
         roughness: f(pbr.roughness_factor()),
         transmission: m.transmission().map_or(0.0, |t| f(t.transmission_factor())),

@@ -3,12 +3,15 @@
 //! reflectance spectrum per texel by [`crate::spectrum::rgb_upsample`]: each texel keeps the
 //! three sigmoid coefficients of its spectrum (12 bytes, [`BYTES_PER_TEXEL`]), not the
 //! spectrum. A lookup filters bilinearly, evaluating the four texels' spectra at the path's
-//! wavelengths. Texture coordinates are transformed as `uv · scale + offset`, then wrapped
-//! (repeated or clamped); v = 0 is the bottom row of the image, as in OBJ files.
+//! wavelengths. Texture coordinates go through a 2×3 affine map ([`UvMap`]: scale, rotation,
+//! offset), then are wrapped (repeated or clamped); v = 0 is the bottom row of the image, as in
+//! OBJ files. Scalar and normal maps (one to three linear 8-bit channels) are in [`bytes`].
+
+pub mod bytes;
 
 use crate::spectrum::rgb_upsample::fit_linear_srgb;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, N_LAMBDA};
-use glam::Vec2;
+use glam::{Affine2, Vec2};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -19,7 +22,7 @@ pub const BYTES_PER_TEXEL: u64 = 12;
 pub const MAX_TEXELS: u64 = 1 << 28;
 
 /// Largest image file read.
-const MAX_TEXTURE_FILE_BYTES: u64 = 4 << 30;
+pub(crate) const MAX_TEXTURE_FILE_BYTES: u64 = 4 << 30;
 
 /// Peak bytes per texel while loading, with room to spare: the decoded image (up to 16 B for
 /// 16-bit RGBA), its 8-bit copy (3 B), the linear colours (12 B), the colour index (4 B), the
@@ -57,14 +60,63 @@ pub struct Texture {
     /// [`T_MIN_NM`]; ±∞ in a2 for the exact constants 1 and 0.
     coeffs: Vec<[f32; 3]>,
     pub wrap: Wrap,
-    /// Texture coordinates are `uv · scale + offset` before wrapping.
-    pub scale: Vec2,
-    pub offset: Vec2,
+    /// Texture coordinates are mapped by it before wrapping.
+    pub uv: UvMap,
+}
+
+/// The affine map applied to texture coordinates before wrapping (identity by default).
+pub type UvMap = Affine2;
+
+/// `uv · scale + offset`.
+pub fn scale_offset(scale: [f32; 2], offset: [f32; 2]) -> UvMap {
+    Affine2::from_scale_angle_translation(Vec2::from(scale), 0.0, Vec2::from(offset))
+}
+
+/// glTF's `KHR_texture_transform` (uv′ = T(offset)·R(rotation)·S(scale)·uv, the rotation's
+/// matrix [[cos, −sin], [sin, cos]] as the extension's GLSL gives it, in glTF's coordinates
+/// whose v runs down the image) as a map of candela's coordinates (v up, v_candela =
+/// 1 − v_glTF): F·M·F with F(u, v) = (u, 1 − v).
+pub fn gltf_uv_map(offset: [f32; 2], rotation_rad: f32, scale: [f32; 2]) -> UvMap {
+    let m =
+        Affine2::from_scale_angle_translation(Vec2::from(scale), rotation_rad, Vec2::from(offset));
+    let flip = Affine2::from_cols(Vec2::X, -Vec2::Y, Vec2::Y);
+    flip * m * flip
+}
+
+/// The bilinear footprint of texture coordinates `tex` on a `width × height` image: the two
+/// columns and two rows (top row 0) and their weights.
+#[inline(always)]
+pub(crate) fn footprint(
+    uv: &UvMap,
+    wrap: Wrap,
+    width: u32,
+    height: u32,
+    tex: Vec2,
+) -> ([usize; 2], [usize; 2], [f32; 2], [f32; 2]) {
+    let uv = uv.transform_point2(tex);
+    let x = uv.x * width as f32 - 0.5;
+    let y = (1.0 - uv.y) * height as f32 - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = match (x - x0, y - y0) {
+        (fx, fy) if fx.is_finite() && fy.is_finite() => (fx, fy),
+        _ => (0.0, 0.0),
+    };
+    let (xi, yi) = (x0 as i64, y0 as i64);
+    let index = |i: i64, n: u32| match wrap {
+        Wrap::Repeat => i.rem_euclid(n as i64) as usize,
+        Wrap::Clamp => i.clamp(0, n as i64 - 1) as usize,
+    };
+    (
+        [index(xi, width), index(xi + 1, width)],
+        [index(yi, height), index(yi + 1, height)],
+        [1.0 - fx, fx],
+        [1.0 - fy, fy],
+    )
 }
 
 /// Refuses an image of `w × h` texels that is empty, over [`MAX_TEXELS`] or too large for the
 /// memory available.
-fn check_size(path: &Path, w: u64, h: u64) -> Result<(), TextureError> {
+pub(crate) fn check_size(path: &Path, w: u64, h: u64) -> Result<(), TextureError> {
     let err = |message: String| TextureError {
         path: path.to_path_buf(),
         message,
@@ -123,8 +175,7 @@ impl Texture {
             height,
             coeffs: ids.iter().map(|&i| fitted[i as usize]).collect(),
             wrap: Wrap::Repeat,
-            scale: Vec2::ONE,
-            offset: Vec2::ZERO,
+            uv: UvMap::IDENTITY,
         }
     }
 
@@ -166,39 +217,8 @@ impl Texture {
     /// texel's linear colour multiplied by `tint` (in [0, 1]) before upsampling; `path` names it
     /// in messages. Checked as [`Texture::load`].
     pub fn decode(path: &Path, bytes: &[u8], tint: [f32; 3]) -> Result<Texture, TextureError> {
-        let err = |message: String| TextureError {
-            path: path.to_path_buf(),
-            message,
-        };
-        let check = |w: u64, h: u64| check_size(path, w, h);
-        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|e| err(e.to_string()))?;
-        match reader.format() {
-            Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
-            _ => {
-                return Err(err(
-                    "it is not a PNG, JPEG or OpenEXR image (judged by its first bytes)".into(),
-                ))
-            }
-        }
-        let (w, h) = reader
-            .into_dimensions()
-            .map_err(|e| err(format!("cannot read its header: {e}")))?;
-        check(w as u64, h as u64)?;
-        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|e| err(e.to_string()))?;
-        let mut limits = image::Limits::default();
-        limits.max_image_width = Some(w);
-        limits.max_image_height = Some(h);
-        limits.max_alloc = Some((w as u64 * h as u64).saturating_mul(16).max(1 << 20));
-        reader.limits(limits);
-        let img = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))
-            .map_err(|_| err("the image decoder failed on malformed input".into()))?
-            .map_err(|e| err(e.to_string()))?;
-        let rgb = img.to_rgb8();
-        drop(img);
+        let rgb = decode_rgb8(path, bytes)?;
+        let (w, h) = rgb.dimensions();
         let lut: Vec<f32> = (0..=255u8)
             .map(|v| crate::colour::rgb::srgb_decode(v as f64 / 255.0) as f32)
             .collect();
@@ -236,40 +256,16 @@ impl Texture {
         0.5 + 0.5 * x / (1.0 + x * x).sqrt()
     }
 
-    #[inline(always)]
-    fn wrap_index(&self, i: i64, n: u32) -> usize {
-        match self.wrap {
-            Wrap::Repeat => i.rem_euclid(n as i64) as usize,
-            Wrap::Clamp => i.clamp(0, n as i64 - 1) as usize,
-        }
-    }
-
     /// Reflectance at texture coordinates `tex` (bilinear), per wavelength of `wl`.
     pub fn reflectance(&self, tex: Vec2, wl: &SampledWavelengths) -> SampledSpectrum {
-        let uv = tex * self.scale + self.offset;
-        let x = uv.x * self.width as f32 - 0.5;
-        let y = (1.0 - uv.y) * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = match (x - x0, y - y0) {
-            (fx, fy) if fx.is_finite() && fy.is_finite() => (fx, fy),
-            _ => (0.0, 0.0),
-        };
-        let (xi, yi) = (x0 as i64, y0 as i64);
-        let cols = [
-            self.wrap_index(xi, self.width),
-            self.wrap_index(xi + 1, self.width),
-        ];
-        let rows = [
-            self.wrap_index(yi, self.height),
-            self.wrap_index(yi + 1, self.height),
-        ];
+        let (cols, rows, wxs, wys) = footprint(&self.uv, self.wrap, self.width, self.height, tex);
         let mut t = [0.0f32; N_LAMBDA];
         for (t, l) in t.iter_mut().zip(wl.lambda.iter()) {
             *t = (l - T_MIN_NM as f32) * (1.0 / T_SPAN_NM as f32);
         }
         let mut out = SampledSpectrum::ZERO;
-        for (r, wy) in rows.iter().zip([1.0 - fy, fy]) {
-            for (c, wx) in cols.iter().zip([1.0 - fx, fx]) {
+        for (r, wy) in rows.iter().zip(wys) {
+            for (c, wx) in cols.iter().zip(wxs) {
                 let w = wx * wy;
                 if w == 0.0 {
                     continue;
@@ -282,6 +278,43 @@ impl Texture {
         }
         out
     }
+}
+
+/// The 8-bit RGB texels of a PNG or JPEG image (alpha dropped), after the checks of
+/// [`Texture::load`]; `path` names it in messages.
+pub(crate) fn decode_rgb8(path: &Path, bytes: &[u8]) -> Result<image::RgbImage, TextureError> {
+    let err = |message: String| TextureError {
+        path: path.to_path_buf(),
+        message,
+    };
+    let check = |w: u64, h: u64| check_size(path, w, h);
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| err(e.to_string()))?;
+    match reader.format() {
+        Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+        _ => {
+            return Err(err(
+                "it is not a PNG, JPEG or OpenEXR image (judged by its first bytes)".into(),
+            ))
+        }
+    }
+    let (w, h) = reader
+        .into_dimensions()
+        .map_err(|e| err(format!("cannot read its header: {e}")))?;
+    check(w as u64, h as u64)?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| err(e.to_string()))?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(w);
+    limits.max_image_height = Some(h);
+    limits.max_alloc = Some((w as u64 * h as u64).saturating_mul(16).max(1 << 20));
+    reader.limits(limits);
+    let img = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))
+        .map_err(|_| err("the image decoder failed on malformed input".into()))?
+        .map_err(|e| err(e.to_string()))?;
+    Ok(img.to_rgb8())
 }
 
 /// Normalised sigmoid coefficients of the smooth spectrum of a linear-sRGB colour in [0, 1].
@@ -343,6 +376,62 @@ mod tests {
             assert!((mid.0[k] as f64 - mean).abs() < 1e-5);
             let want = t.texel_reflectance(0, 1, l);
             assert!((corner.0[k] as f64 - want).abs() < 1e-5);
+        }
+    }
+}
+
+#[cfg(test)]
+mod uv_map_tests {
+    use super::bytes::ByteTexture;
+    use super::*;
+
+    /// The extension's formula written out in glTF's coordinates: u′ = oₓ + cos·sₓ·u −
+    /// sin·s_y·v, v′ = o_y + sin·sₓ·u + cos·s_y·v.
+    fn by_hand(o: [f32; 2], r: f32, s: [f32; 2], g: Vec2) -> Vec2 {
+        let (sin, cos) = r.sin_cos();
+        Vec2::new(
+            o[0] + cos * s[0] * g.x - sin * s[1] * g.y,
+            o[1] + sin * s[0] * g.x + cos * s[1] * g.y,
+        )
+    }
+
+    #[test]
+    fn gltf_map_is_the_extensions_formula_with_v_flipped() {
+        let (o, r, s) = ([0.3, -0.2], 0.7, [1.5, 0.5]);
+        let map = gltf_uv_map(o, r, s);
+        for c in [Vec2::ZERO, Vec2::new(0.2, 0.9), Vec2::new(-1.3, 2.5)] {
+            let g = by_hand(o, r, s, Vec2::new(c.x, 1.0 - c.y));
+            let want = Vec2::new(g.x, 1.0 - g.y);
+            assert!((map.transform_point2(c) - want).length() < 1e-5, "{c}");
+        }
+        // Without rotation it is the scale and offset candela had: v·s + (1 − s − o).
+        let m = gltf_uv_map([0.25, 0.5], 0.0, [2.0, 3.0]);
+        let want = scale_offset([2.0, 3.0], [0.25, 1.0 - 3.0 - 0.5]);
+        assert!(m.abs_diff_eq(want, 1e-6));
+    }
+
+    #[test]
+    fn rotated_texture_equals_the_image_rotated_beforehand() {
+        // A 90° rotation reads image I at glTF (u′, v′) = (−v, u): texel (row j, column i) of
+        // the pre-rotated image P is texel (row i, column N − 1 − j) of I.
+        let n = 4u32;
+        let value = |row: u32, col: u32| [(row * n + col) as u8 * 13];
+        let i_img: Vec<[u8; 1]> = (0..n * n).map(|k| value(k / n, k % n)).collect();
+        let p_img: Vec<[u8; 1]> = (0..n * n).map(|k| value(k % n, n - 1 - k / n)).collect();
+        let mut rotated = ByteTexture::<1>::from_texels(n, n, i_img);
+        rotated.uv = gltf_uv_map([0.0, 0.0], std::f32::consts::FRAC_PI_2, [1.0, 1.0]);
+        let pre = ByteTexture::<1>::from_texels(n, n, p_img);
+        for row in 0..n {
+            for col in 0..n {
+                // Texel centre in candela's coordinates (v up from the bottom row).
+                let c = Vec2::new(
+                    (col as f32 + 0.5) / n as f32,
+                    1.0 - (row as f32 + 0.5) / n as f32,
+                );
+                let (a, b) = (rotated.lookup(c)[0], pre.lookup(c)[0]);
+                assert!((a - b).abs() < 1e-4, "row {row} col {col}: {a} vs {b}");
+                assert!((b - pre.texel(col, row)[0]).abs() < 1e-6);
+            }
         }
     }
 }
