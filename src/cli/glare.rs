@@ -59,6 +59,23 @@ impl GlareArgs {
 
 /// Runs the command: the text (or JSON) to print.
 pub fn run(args: &GlareArgs) -> anyhow::Result<String> {
+    let (g, has_errors) = evaluate(args)?;
+    Ok(if args.json {
+        json(&g)
+    } else {
+        text(&g, has_errors)
+    })
+}
+
+/// One evaluation printed both ways: the text and the JSON (for `render --glare
+/// --report-html`, which prints the one and embeds the other).
+pub fn run_text_and_json(args: &GlareArgs) -> anyhow::Result<(String, String)> {
+    let (g, has_errors) = evaluate(args)?;
+    Ok((text(&g, has_errors), json(&g)))
+}
+
+/// The evaluation `args` asks for, and whether the image has per-pixel standard errors.
+fn evaluate(args: &GlareArgs) -> anyhow::Result<(UncertainGlare, bool)> {
     let mut opt = GlareOptions::default();
     if let Some(b) = args.threshold {
         if !(b.is_finite() && b > 0.0) {
@@ -104,11 +121,7 @@ pub fn run(args: &GlareArgs) -> anyhow::Result<String> {
     };
     let g = evaluate_uncertain(&img, &opt, &u)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.image.display()))?;
-    Ok(if args.json {
-        json(&g)
-    } else {
-        text(&g, img.stderr_cd_m2.is_some())
-    })
+    Ok((g, img.stderr_cd_m2.is_some()))
 }
 
 /// `X,Y,ANGLE`: a pixel (whole numbers) and an opening angle in radians.

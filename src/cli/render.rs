@@ -420,18 +420,18 @@ pub fn render(a: &RenderOpts) -> Result<()> {
     if let Some(w) = &out.truncation {
         eprintln!("warning: {w}");
     }
+    // One glare evaluation (its draws are the costly part) serves the printout and the page.
+    let mut glare_json = None;
     if a.glare {
-        let report =
-            super::glare::run(&super::glare::GlareArgs::defaults_for(out.exr_path.clone()))?;
+        let args = super::glare::GlareArgs::defaults_for(out.exr_path.clone());
+        let (report, json) = super::glare::run_text_and_json(&args)?;
         say!("glare of {}:\n{}", shown(&out.exr_path), report.trim_end());
+        glare_json = Some(json);
     }
     if a.report_html {
-        let glare = if a.glare {
-            let mut args = super::glare::GlareArgs::defaults_for(out.exr_path.clone());
-            args.json = true;
-            Some(serde_json::from_str(&super::glare::run(&args)?)?)
-        } else {
-            None
+        let glare = match &glare_json {
+            Some(j) => Some(serde_json::from_str(j)?),
+            None => None,
         };
         let html = out.exr_path.with_extension("html");
         let r = candela::report::html::write_html_report(
