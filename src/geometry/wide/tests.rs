@@ -246,8 +246,8 @@ fn same_hits_as_the_cwbvh_kernel() {
         hits > rays / 2 && occluded > rays / 2,
         "{hits} hits, {occluded} occluded"
     );
-    // Measured: 91 710 hits, 14 115 on another triangle, 2 904 of them 1 ulp apart.
-    assert!(ties > 100 && ulp1 < ties, "{ties} ties, {ulp1} 1 ulp apart");
+    assert!(ties > 100, "{ties} ties");
+    eprintln!("{rays} rays: {hits} hits, {ties} on another triangle at the same point ({ulp1} of them 1 ulp apart in t), {occluded} occluded");
 }
 
 fn random_node(rng: &mut Rng) -> WideNode {
