@@ -1,9 +1,8 @@
 //! Building the scene BVH: primitives from the shapes (validated, zero-area triangles
 //! dropped), their padded bounds, a binary BVH over them (obvhs's PLOC and reinsertion for
 //! ordinary inputs; a top-down SAH build of bounded height for the inputs PLOC handles badly),
-//! candela's 8-wide layout converted from it (`wide`), and the primitives laid out in leaf
-//! order. The top level over instances is obvhs's CWBVH (8-wide, compressed nodes) instead,
-//! with empty child slots made unhittable.
+//! obvhs's CWBVH (8-wide, compressed nodes) from it with empty child slots made unhittable, and
+//! the primitives laid out in leaf order.
 //!
 //! Any set of valid primitives builds in O(n log n)-ish time into a tree at most
 //! [`MAX_DEPTH`] − 1 levels deep: PLOC gives up on inputs that would make it quadratic
@@ -14,7 +13,6 @@ mod sah;
 
 use super::prim::Prim;
 use super::robust::gamma;
-use super::wide::{WideBvh, MAX_BLOCKS};
 use super::{GeometryError, SceneGeometry, Shape};
 use glam::Vec3;
 use obvhs::aabb::Aabb;
@@ -39,6 +37,7 @@ pub const BUILD_PEAK_BYTES_PER_PRIM: u64 = 300;
 
 /// obvhs's `BvhBuildParams::medium_build()` values for the steps after PLOC.
 const REINSERTION_BATCH_RATIO: f32 = 0.05;
+const MAX_PRIMS_PER_LEAF: u32 = 3;
 
 /// Depth of a CWBVH (1 for a single root node; 0 if empty).
 pub(super) fn cwbvh_depth(bvh: &CwBvh) -> u32 {
@@ -77,7 +76,7 @@ fn bvh2_height(bvh: &Bvh2, limit: u32) -> Option<u32> {
 
 /// The binary tree over `aabbs` (not empty): obvhs's PLOC and reinsertion where PLOC finishes
 /// in reasonable time and the result is not too deep, else the top-down build.
-pub(super) fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
+fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
     if let Some(mut bvh2) = ploc::build(aabbs) {
         obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
             &mut bvh2,
@@ -116,30 +115,6 @@ pub(super) fn build_cwbvh(aabbs: &[Aabb], max_prims_per_leaf: u32) -> CwBvh {
         }
     }
     bvh
-}
-
-/// Refuses a wide BVH too deep for the traversal stack (which the binary tree's height bound
-/// already excludes) or with more blocks than its leaf references can address.
-fn check_wide(bvh: &WideBvh, n: usize) -> Result<(), GeometryError> {
-    let depth = bvh.depth();
-    if depth as usize >= MAX_DEPTH {
-        return Err(GeometryError::InvalidShape {
-            shape: "scene",
-            object: 0,
-            message: format!(
-                "internal error: the BVH over {n} primitives is {depth} levels deep (at most {} supported)",
-                MAX_DEPTH - 1
-            ),
-        });
-    }
-    if bvh.blocks.len() > MAX_BLOCKS {
-        return Err(GeometryError::InvalidShape {
-            shape: "scene",
-            object: 0,
-            message: format!("too many primitives ({n}) for the BVH's leaf references"),
-        });
-    }
-    Ok(())
 }
 
 /// Refuses a CWBVH too deep for the traversal stack (which the binary tree's height bound
@@ -390,16 +365,17 @@ impl SceneGeometry {
         } else {
             (lo, hi)
         };
-        let (mut bvh, order) = if prims.is_empty() {
-            (WideBvh::default(), Vec::new())
+        let mut bvh = if prims.is_empty() {
+            CwBvh::default()
         } else {
-            WideBvh::from_bvh2(&build_bvh2(&aabbs))
+            build_cwbvh(&aabbs, MAX_PRIMS_PER_LEAF)
         };
+        // The traversal stack's bound, which the binary tree's height already guarantees.
+        check_depth(&bvh, prims.len())?;
         drop(aabbs);
-        check_wide(&bvh, prims.len())?;
 
         // Lay primitives out in leaf order so the traversal indexes them directly.
-        let order = &order;
+        let order = &bvh.primitive_indices;
         let mut others = Vec::new();
         let tris: Vec<[Vec3; 3]> = order
             .iter()
@@ -424,7 +400,9 @@ impl SceneGeometry {
         } else {
             Vec::new()
         };
-        bvh.fill_blocks(&tris);
+        // Traversal only needs the node array once the primitives are in leaf order.
+        bvh.primitive_indices = Vec::new();
+        bvh.exact_node_aabbs = None;
         let mut by_obj: Vec<(u32, u32)> = prim_object
             .iter()
             .enumerate()

@@ -45,7 +45,6 @@ mod robust;
 mod sample;
 mod scene;
 mod traverse;
-mod wide;
 
 pub use bvh::BUILD_PEAK_BYTES_PER_PRIM;
 pub(crate) use desc::mesh_err;

@@ -2,9 +2,8 @@
 //! any hit for shadow rays (optionally letting some objects' primitives through), the
 //! per-primitive leaf tests they run, and a brute-force reference.
 
-use super::instance::InstanceSet;
 use super::prim::{Prim, PrimT, RayPre};
-use super::wide::{block_candidates, traverse, BlockTest};
+use super::traverse::{prefetch, traverse, LeafTest};
 use super::{Hit, SceneGeometry};
 use glam::{Vec3, Vec3A};
 
@@ -106,13 +105,6 @@ fn intersect_triangle_simd<const KZ: usize>(
     }
 }
 
-/// A closest hit: on a primitive stored flat (the ray's test data and (primitive, t, a, b)),
-/// or in an instance.
-enum Found<'a> {
-    Flat(RayPre, (u32, f32, f32, f32)),
-    Instanced(&'a InstanceSet, (u32, RayPre, u32, PrimT)),
-}
-
 impl SceneGeometry {
     #[inline(always)]
     fn ray_ok(origin: Vec3, dir: Vec3, t_max: f32) -> bool {
@@ -129,54 +121,6 @@ impl SceneGeometry {
     /// This is [`SceneGeometry::intersect_basic`]'s traversal followed by the full hit record
     /// (point, unit normals, shading normal, error bounds).
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
-        Some(match self.closest_any(origin, dir, t_max)? {
-            Found::Flat(pre, (prim, t, a, b)) => self.make_hit(prim, &pre, t, a, b),
-            Found::Instanced(set, h) => set.make_hit(h, dir),
-        })
-    }
-
-    /// The closest hit as Embree's `rtcIntersect1` reports it: `t`, the surface parameters,
-    /// the unnormalized geometric normal, and the primitive and object ids. Same hits and
-    /// conventions as [`SceneGeometry::intersect`], without building the full [`Hit`].
-    pub fn intersect_basic(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<RayHit> {
-        Some(match self.closest_any(origin, dir, t_max)? {
-            Found::Flat(_, (prim, t, u, v)) => {
-                let tri = &self.tris[prim as usize];
-                let ng = if tri[0].x.is_nan() {
-                    self.prim(prim).normal_at(origin + t * dir)
-                } else {
-                    (tri[1] - tri[0]).cross(tri[2] - tri[0])
-                };
-                RayHit {
-                    t,
-                    u,
-                    v,
-                    ng,
-                    prim,
-                    object: self.prim_object[prim as usize],
-                }
-            }
-            Found::Instanced(set, h) => {
-                let (ng, object) = set.basic(&h);
-                let (_, _, prim, (t, mut u, mut v)) = h;
-                if set.mirrored(&h) {
-                    std::mem::swap(&mut u, &mut v);
-                }
-                RayHit {
-                    t,
-                    u,
-                    v,
-                    ng,
-                    prim,
-                    object,
-                }
-            }
-        })
-    }
-
-    /// The closest hit among the primitives stored flat and the instances.
-    #[inline(always)]
-    fn closest_any(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Found<'_>> {
         if !Self::ray_ok(origin, dir, t_max) {
             return None;
         }
@@ -189,10 +133,59 @@ impl SceneGeometry {
         if let Some(set) = &self.instances {
             let t = flat.map_or(t_max, |f| f.1);
             if let Some(h) = set.closest(origin, dir, t) {
-                return Some(Found::Instanced(set, h));
+                return Some(set.make_hit(h, dir));
             }
         }
-        Some(Found::Flat(pre, flat?))
+        let (prim, t, a, b) = flat?;
+        Some(self.make_hit(prim, &pre, t, a, b))
+    }
+
+    /// The closest hit as Embree's `rtcIntersect1` reports it: `t`, the surface parameters,
+    /// the unnormalized geometric normal, and the primitive and object ids. Same hits and
+    /// conventions as [`SceneGeometry::intersect`], without building the full [`Hit`].
+    pub fn intersect_basic(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<RayHit> {
+        if !Self::ray_ok(origin, dir, t_max) {
+            return None;
+        }
+        let pre = RayPre::new(origin, dir);
+        let flat = if self.tris.is_empty() {
+            None
+        } else {
+            self.closest_dyn(&pre, t_max)
+        };
+        if let Some(set) = &self.instances {
+            let t = flat.map_or(t_max, |f| f.1);
+            if let Some(h) = set.closest(origin, dir, t) {
+                let (ng, object) = set.basic(&h);
+                let (_, _, prim, (t, mut u, mut v)) = h;
+                if set.mirrored(&h) {
+                    std::mem::swap(&mut u, &mut v);
+                }
+                return Some(RayHit {
+                    t,
+                    u,
+                    v,
+                    ng,
+                    prim,
+                    object,
+                });
+            }
+        }
+        let (prim, t, u, v) = flat?;
+        let tri = &self.tris[prim as usize];
+        let ng = if tri[0].x.is_nan() {
+            self.prim(prim).normal_at(origin + t * dir)
+        } else {
+            (tri[1] - tri[0]).cross(tri[2] - tri[0])
+        };
+        Some(RayHit {
+            t,
+            u,
+            v,
+            ng,
+            prim,
+            object: self.prim_object[prim as usize],
+        })
     }
 
     /// Closest-hit traversal: (primitive, t, a, b) of the closest hit.
@@ -212,24 +205,23 @@ impl SceneGeometry {
             pre: &'a RayPre,
             best: (u32, f32, f32, f32),
         }
-        impl<const KZ: usize> BlockTest for Closest<'_, KZ> {
+        impl<const KZ: usize> LeafTest for Closest<'_, KZ> {
             #[inline(always)]
-            fn leaf(&mut self, first: u32, count: u32, mut t_max: f32) -> Option<f32> {
-                for b in first..first + count {
-                    // SAFETY: leaf references index `blocks`.
-                    let block = unsafe { self.geo.bvh.blocks.get_unchecked(b as usize) };
-                    let mut m = block_candidates::<KZ>(block, self.pre);
-                    while m != 0 {
-                        let id = block.first + m.trailing_zeros();
-                        m &= m - 1;
-                        if let Some((t, a, b)) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max)
-                        {
-                            self.best = (id, t, a, b);
-                            t_max = t;
-                        }
+            fn leaf(&mut self, first: u32, unary: u32, mut t_max: f32) -> Option<f32> {
+                let (mut id, mut u) = (first, unary);
+                while u != 0 {
+                    if let Some((t, a, b)) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max) {
+                        self.best = (id, t, a, b);
+                        t_max = t;
                     }
+                    id += 1;
+                    u >>= 1;
                 }
                 Some(t_max)
+            }
+            #[inline(always)]
+            fn prefetch(&self, first: u32) {
+                prefetch(self.geo.tris.as_ptr().wrapping_add(first as usize) as *const u8);
             }
         }
         let mut c = Closest::<KZ> {
@@ -237,18 +229,13 @@ impl SceneGeometry {
             pre,
             best: (u32::MAX, t_max, 0.0, 0.0),
         };
-        traverse::<true>(&self.bvh, pre.o, pre.d, t_max, &mut c);
+        traverse::<true>(&self.bvh.nodes, pre.o, pre.d, t_max, &mut c);
         (c.best.0 != u32::MAX).then_some(c.best)
     }
 
     /// Ray test of primitive `id` (a leaf primitive id from the traversal).
     #[inline(always)]
-    pub(super) fn prim_intersect<const KZ: usize>(
-        &self,
-        id: u32,
-        pre: &RayPre,
-        t_max: f32,
-    ) -> Option<PrimT> {
+    fn prim_intersect<const KZ: usize>(&self, id: u32, pre: &RayPre, t_max: f32) -> Option<PrimT> {
         debug_assert!((id as usize) < self.tris.len());
         // SAFETY: leaf primitive ids index `tris` (same length as the builder's input).
         let v = unsafe { self.tris.get_unchecked(id as usize) };
@@ -411,25 +398,25 @@ impl SceneGeometry {
             pass: F,
             hit: bool,
         }
-        impl<F: FnMut(u32, &RayPre, PrimT) -> bool, const KZ: usize> BlockTest for AnyHit<'_, F, KZ> {
+        impl<F: FnMut(u32, &RayPre, PrimT) -> bool, const KZ: usize> LeafTest for AnyHit<'_, F, KZ> {
             #[inline(always)]
-            fn leaf(&mut self, first: u32, count: u32, t_max: f32) -> Option<f32> {
-                for b in first..first + count {
-                    // SAFETY: leaf references index `blocks`.
-                    let block = unsafe { self.geo.bvh.blocks.get_unchecked(b as usize) };
-                    let mut m = block_candidates::<KZ>(block, self.pre);
-                    while m != 0 {
-                        let id = block.first + m.trailing_zeros();
-                        m &= m - 1;
-                        if let Some(h) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max) {
-                            if !(self.pass)(id, self.pre, h) {
-                                self.hit = true;
-                                return None;
-                            }
+            fn leaf(&mut self, first: u32, unary: u32, t_max: f32) -> Option<f32> {
+                let (mut id, mut u) = (first, unary);
+                while u != 0 {
+                    if let Some(h) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max) {
+                        if !(self.pass)(id, self.pre, h) {
+                            self.hit = true;
+                            return None;
                         }
                     }
+                    id += 1;
+                    u >>= 1;
                 }
                 Some(t_max)
+            }
+            #[inline(always)]
+            fn prefetch(&self, first: u32) {
+                prefetch(self.geo.tris.as_ptr().wrapping_add(first as usize) as *const u8);
             }
         }
         let mut a = AnyHit::<_, KZ> {
@@ -438,7 +425,7 @@ impl SceneGeometry {
             pass,
             hit: false,
         };
-        traverse::<false>(&self.bvh, pre.o, pre.d, t_max, &mut a);
+        traverse::<false>(&self.bvh.nodes, pre.o, pre.d, t_max, &mut a);
         a.hit
     }
 

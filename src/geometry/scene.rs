@@ -2,14 +2,16 @@
 //! objects and their primitives, bounds and size statistics. Building it is in `bvh`, ray
 //! queries in `query` (over the node walk in `traverse`), primitive sampling in `sample`.
 
+use super::bvh::cwbvh_depth;
 use super::instance::InstanceSet;
 use super::prim::Prim;
-use super::wide::{WideBvh, BLOCK_BYTES, NODE_BYTES};
 use glam::Vec3;
+use obvhs::cwbvh::node::CwBvhNode;
+use obvhs::cwbvh::CwBvh;
 
 /// All primitives of the scene in one BVH.
 pub struct SceneGeometry {
-    pub(super) bvh: WideBvh,
+    pub(super) bvh: CwBvh,
     /// Primitives in BVH leaf order; the primitive id is the index into this array. Triangles
     /// are stored inline (their vertices); any other primitive as a marker (NaN first
     /// coordinate, then its index into `others` as the bits of the second vertex's x).
@@ -77,20 +79,19 @@ impl SceneGeometry {
 
     /// Depth of the BVH (number of node levels).
     pub fn bvh_depth(&self) -> u32 {
-        self.bvh.depth()
+        cwbvh_depth(&self.bvh)
     }
 
-    /// Number of BVH nodes (224 bytes each; the leaves' triangle blocks, 160 bytes per 4
-    /// triangles, are not counted).
+    /// Number of CWBVH nodes (80 bytes each).
     pub fn node_count(&self) -> usize {
         self.bvh.nodes.len()
     }
 
-    /// Approximate heap memory in bytes (BVH nodes and triangle blocks, primitive data, per-primitive ids, normals,
+    /// Approximate heap memory in bytes (BVH nodes, primitive data, per-primitive ids, normals,
     /// instances and their meshes).
     pub fn memory_bytes(&self) -> usize {
-        self.bvh.nodes.capacity() * NODE_BYTES
-            + self.bvh.blocks.capacity() * BLOCK_BYTES
+        self.bvh.nodes.capacity() * std::mem::size_of::<CwBvhNode>()
+            + self.bvh.primitive_indices.capacity() * 4
             + self.tris.capacity() * std::mem::size_of::<[Vec3; 3]>()
             + self.others.capacity() * std::mem::size_of::<Prim>()
             + self.prim_object.capacity() * 4

@@ -674,7 +674,7 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
         args.build_reps.max(1)
     );
     println!(
-        "| candela (8-wide float nodes, leaves of ≤ 8 triangles in blocks of 4, from obvhs's medium BVH2 build, no pre-splits; {} nodes, depth {}) | {:.3} | {:.1} | {:.1} |",
+        "| candela (obvhs CWBVH8, medium build, no pre-splits; {} nodes, depth {}) | {:.3} | {:.1} | {:.1} |",
         geo.node_count(),
         geo.bvh_depth(),
         candela_build,
