@@ -156,6 +156,17 @@ fn disc_image(background: f64, source: f64, rel_se: f64) -> GlareImage {
 }
 
 /// A standard normal deviate (Box–Muller on a 64-bit hash), independent of the library's.
+/// `img` with each pixel moved by its standard error times a standard normal number of
+/// stream `t`.
+fn perturbed(img: &GlareImage, t: u64) -> GlareImage {
+    let mut out = img.clone();
+    let se = img.stderr_cd_m2.as_ref().unwrap();
+    for (i, l) in out.luminance_cd_m2.iter_mut().enumerate() {
+        *l += se[i] * gauss(t, i as u64);
+    }
+    out
+}
+
 fn gauss(seed: u64, i: u64) -> f64 {
     let h = |x: u64| {
         let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
@@ -182,11 +193,7 @@ fn dgp_interval_covers_the_truth_95_percent_of_the_time() {
     let trials = 1000;
     let (mut dgp_hits, mut ugr_hits, mut width) = (0, 0, 0.0);
     for t in 0..trials {
-        let mut img = truth_img.clone();
-        let se = img.stderr_cd_m2.clone().unwrap();
-        for (i, l) in img.luminance_cd_m2.iter_mut().enumerate() {
-            *l += se[i] * gauss(t, i as u64);
-        }
+        let img = perturbed(&truth_img, t);
         let u = UncertainOptions {
             draws: 24,
             seed: 1000 + t,
@@ -284,11 +291,7 @@ fn noisy_source_trials(r: f64, trials: u64) -> ([[f64; 4]; 2], [u32; 2], GlareRe
     assert_eq!(truth.sources.len(), 1);
     let (mut sums, mut hits) = ([[0.0f64; 4]; 2], [0u32; 2]);
     for t in 0..trials {
-        let mut img = truth_img.clone();
-        let se = img.stderr_cd_m2.clone().unwrap();
-        for (i, l) in img.luminance_cd_m2.iter_mut().enumerate() {
-            *l += se[i] * gauss(7_000 + t, i as u64);
-        }
+        let img = perturbed(&truth_img, 7_000 + t);
         let u = UncertainOptions {
             draws: 8,
             seed: 5000 + t,

@@ -86,20 +86,7 @@ fn write(meshes: &[Vec<Prim>], json: &Value, dir: &Path, name: &str) {
     j["accessors"] = json!(accessors);
     if name.ends_with(".glb") {
         j["buffers"] = json!([{"byteLength": bin.len()}]);
-        let mut text = serde_json::to_vec(&j).unwrap();
-        while text.len() % 4 != 0 {
-            text.push(b' ');
-        }
-        let mut out = b"glTF".to_vec();
-        out.extend(2u32.to_le_bytes());
-        out.extend(((12 + 8 + text.len() + 8 + bin.len()) as u32).to_le_bytes());
-        out.extend((text.len() as u32).to_le_bytes());
-        out.extend(b"JSON");
-        out.extend(text);
-        out.extend((bin.len() as u32).to_le_bytes());
-        out.extend(b"BIN\0");
-        out.extend(&bin);
-        std::fs::write(dir.join(name), out).unwrap();
+        std::fs::write(dir.join(name), common::glb(&j, &bin)).unwrap();
     } else {
         let uri = format!("data:application/octet-stream;base64,{}", base64(&bin));
         j["buffers"] = json!([{"byteLength": bin.len(), "uri": uri}]);

@@ -395,3 +395,22 @@ pub fn assert_blocks_agree(a: &Film, b: &Film, block: usize, names: (&str, &str)
     }
     worst
 }
+
+/// A binary glTF (`.glb`) of the JSON `j` and the buffer `bin`: the 12-byte header, the JSON
+/// chunk padded with spaces to 4 bytes, and the BIN chunk.
+pub fn glb(j: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+    let mut text = serde_json::to_vec(j).unwrap();
+    while text.len() % 4 != 0 {
+        text.push(b' ');
+    }
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + text.len() + 8 + bin.len()) as u32).to_le_bytes());
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(text);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}

@@ -179,21 +179,25 @@ impl GltfModel {
     }
 }
 
-/// Loads a `.gltf` or `.glb` file (see the module docs). The scene is the file's default
-/// scene, else its first, else every node without a parent.
-pub fn load_gltf(path: &Path) -> Result<GltfModel, GeometryError> {
+/// The file read (within its size limit) and parsed; a parser panic on malformed input
+/// becomes an error naming the file.
+fn parse_file(path: &Path) -> Result<gltf::Gltf, GeometryError> {
     let bytes =
         limits::read_file(path, MAX_GLTF_FILE_BYTES).map_err(|source| GeometryError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         gltf::Gltf::from_slice(&bytes)
     }))
     .map_err(|_| parse_err(path, "the glTF parser failed on malformed input".into()))?
-    .map_err(|e| parse_err(path, e.to_string()))?;
-    drop(bytes);
-    let gltf::Gltf { document, blob } = parsed;
+    .map_err(|e| parse_err(path, e.to_string()))
+}
+
+/// Loads a `.gltf` or `.glb` file (see the module docs). The scene is the file's default
+/// scene, else its first, else every node without a parent.
+pub fn load_gltf(path: &Path) -> Result<GltfModel, GeometryError> {
+    let gltf::Gltf { document, blob } = parse_file(path)?;
     for ext in document.extensions_required() {
         if !matches!(
             ext,
@@ -267,17 +271,7 @@ pub fn load_gltf(path: &Path) -> Result<GltfModel, GeometryError> {
 
 /// The camera nodes of a `.gltf` or `.glb` file's scene, without reading its buffers.
 pub fn load_cameras(path: &Path) -> Result<Vec<GltfCamera>, GeometryError> {
-    let bytes =
-        limits::read_file(path, MAX_GLTF_FILE_BYTES).map_err(|source| GeometryError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        gltf::Gltf::from_slice(&bytes)
-    }))
-    .map_err(|_| parse_err(path, "the glTF parser failed on malformed input".into()))?
-    .map_err(|e| parse_err(path, e.to_string()))?;
-    cameras(path, &parsed.document)
+    cameras(path, &parse_file(path)?.document)
 }
 
 fn cameras(path: &Path, doc: &gltf::Document) -> Result<Vec<GltfCamera>, GeometryError> {
