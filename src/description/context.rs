@@ -246,7 +246,7 @@ impl Context<'_> {
             SpectrumDesc::Texture { .. } => {
                 return Err(self.err(
                     field,
-                    "an image texture can only be a `Diffuse` material's reflectance",
+                    "an image texture can only be a `Diffuse` material's reflectance or an object's emission spectrum",
                 ));
             }
             SpectrumDesc::Rgb(..) | SpectrumDesc::Srgb(..) => {

@@ -365,8 +365,10 @@ pub enum SpectrumDesc {
     /// An sRGB colour as encoded in images and colour pickers (IEC 61966-2-1 transfer function,
     /// components in [0, 1]); decoded to linear sRGB, then as `Rgb`.
     Srgb(f64, f64, f64),
-    /// An image texture (only as a `Diffuse` material's reflectance): each texel's colour
-    /// upsampled as `Srgb` (PNG, JPEG) or `Rgb` (OpenEXR); docs/scene-format.md → textures.
+    /// An image texture, only as a `Diffuse` material's reflectance (each texel's colour
+    /// upsampled as `Srgb` (PNG, JPEG) or `Rgb` (OpenEXR)) or as an object's emission spectrum
+    /// (each texel emitting the amount × its luminance, with its colour's shape);
+    /// docs/scene-format.md → textures.
     Texture {
         /// PNG, JPEG (sRGB) or OpenEXR (linear) image, relative to the scene file.
         file: String,
@@ -621,6 +623,11 @@ pub struct EmissionDesc {
     /// Emit from both faces (default: only the front face).
     #[serde(default)]
     pub two_sided: bool,
+    /// An emission texture given by a model file (glTF `emissiveTexture`, OBJ `map_Ke`), not
+    /// by scene text: each texel emits `amount` × its luminance Y with its colour's shape, and
+    /// `spectrum` is unused.
+    #[serde(skip)]
+    pub texture: Option<std::sync::Arc<crate::texture::emission::EmissionTexture>>,
 }
 
 /// A window or skylight opening of an environment light: the parallelogram

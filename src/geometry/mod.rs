@@ -392,11 +392,13 @@ impl Shape {
     }
 }
 
-/// A point on a surface with its unit front-face geometric normal.
+/// A point on a surface with its unit front-face geometric normal and texture coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfacePoint {
     pub p: Vec3,
     pub n: Vec3,
+    /// Texture coordinates there, as a hit at the point reports them ([`Hit::tex`]).
+    pub tex: Vec2,
 }
 
 /// A ray–surface intersection.
@@ -440,6 +442,7 @@ impl Hit {
         SurfacePoint {
             p: self.p,
             n: self.ng,
+            tex: self.tex,
         }
     }
 }

@@ -1,5 +1,5 @@
 //! Wavefront MTL material libraries: the statements candela maps to materials (`Kd`, `Ks`,
-//! `Ns`, `d`/`Tr`, `Ni`, `Ke`, `map_Kd` and the tangent-space normal map `norm`, with their
+//! `Ns`, `d`/`Tr`, `Ni`, `Ke`, `map_Kd`, `map_Ke` and the tangent-space normal map `norm`, with their
 //! `-s`, `-o`, `-clamp` options and `norm`'s `-bm`), read with the
 //! file and line of every error. Other statements (`Ka`, `illum`, `Tf`, other maps, PBR
 //! extensions) are skipped; how the kept ones become materials is in `scene::build` and
@@ -38,6 +38,8 @@ pub struct MtlMaterial {
     pub ni: Option<f64>,
     pub ke: Option<[f64; 3]>,
     pub map_kd: Option<MtlMap>,
+    /// An emission colour map, multiplying `ke`.
+    pub map_ke: Option<MtlMap>,
     /// A tangent-space normal map.
     pub norm: Option<MtlMap>,
 }
@@ -230,7 +232,7 @@ pub fn parse_mtl(path: &Path, bytes: &[u8]) -> Result<Vec<MtlMaterial>, Geometry
         }
         let known = matches!(
             stmt,
-            "Kd" | "Ks" | "Ke" | "Ns" | "Ni" | "d" | "Tr" | "map_Kd" | "norm"
+            "Kd" | "Ks" | "Ke" | "Ns" | "Ni" | "d" | "Tr" | "map_Kd" | "map_Ke" | "norm"
         );
         let Some(m) = out.last_mut() else {
             if known {
@@ -255,6 +257,7 @@ pub fn parse_mtl(path: &Path, bytes: &[u8]) -> Result<Vec<MtlMaterial>, Geometry
             }
             "Tr" => m.d = Some(1.0 - scalar(path, line, stmt, args)?),
             "map_Kd" => m.map_kd = Some(map(path, line, stmt, args)?),
+            "map_Ke" => m.map_ke = Some(map(path, line, stmt, args)?),
             "norm" => m.norm = Some(map(path, line, stmt, args)?),
             _ => {}
         }

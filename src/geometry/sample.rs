@@ -24,8 +24,58 @@ impl SceneGeometry {
     /// w.r.t. area is `1 / prim_area(prim)`. `u` ∈ [0,1)². The point's error bound is
     /// [`super::point_error_bound`] (it is computed in f64).
     pub fn sample_prim(&self, prim: u32, u: Vec2) -> SurfacePoint {
-        let (p, n) = self.prim(prim).sample_area(u);
-        SurfacePoint { p, n }
+        let pr = self.prim(prim);
+        let (p, n) = pr.sample_area(u);
+        SurfacePoint {
+            p,
+            n,
+            tex: self.tex_at(prim, &pr, p, n, u),
+        }
+    }
+
+    /// Texture coordinates of the point `p` (front normal `n`) that [`Prim::sample_area`] made
+    /// from `u` on primitive `prim`: those a hit there reports ([`Hit::tex`]), i.e. a mesh's
+    /// interpolated `vt` where it has them, else the surface's own parameters.
+    fn tex_at(&self, prim: u32, pr: &Prim, p: Vec3, n: Vec3, u: Vec2) -> Vec2 {
+        use std::f64::consts::{PI, TAU};
+        let turn = |phi: f64| (if phi < 0.0 { phi + TAU } else { phi } / TAU) as f32;
+        match *pr {
+            Prim::Triangle(_) => {
+                // The barycentrics sample_area used.
+                let (b0, b1, b2) = crate::sampling::uniform_triangle(u.x as f64, u.y as f64);
+                match self.prim_uvs.get(prim as usize) {
+                    Some(idx) if idx[0] != u32::MAX => {
+                        let b = Vec3::new(b0 as f32, b1 as f32, b2 as f32);
+                        b.x * self.uvs[idx[0] as usize]
+                            + b.y * self.uvs[idx[1] as usize]
+                            + b.z * self.uvs[idx[2] as usize]
+                    }
+                    _ => Vec2::new(b1 as f32, b2 as f32),
+                }
+            }
+            Prim::Quad { .. } => u,
+            Prim::Sphere { .. } => {
+                let n = n.as_dvec3();
+                Vec2::new(
+                    turn(n.y.atan2(n.x)),
+                    (n.z.clamp(-1.0, 1.0).acos() / PI) as f32,
+                )
+            }
+            Prim::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                let nd = normal.as_dvec3().normalize();
+                let mut rel = p.as_dvec3() - center.as_dvec3();
+                rel -= rel.dot(nd) * nd;
+                let (tu, tv) = super::prim::basis(nd);
+                Vec2::new(
+                    (rel.length() / radius as f64) as f32,
+                    turn(rel.dot(tv).atan2(rel.dot(tu))),
+                )
+            }
+        }
     }
 
     /// For a sphere seen from outside: (sinθmax², 1 − cosθmax) of the cone it subtends.
@@ -89,18 +139,17 @@ impl SceneGeometry {
                 if !(pdf.is_finite() && pdf > 0.0) {
                     return None;
                 }
-                return Some((
-                    SurfacePoint {
-                        p: p.as_vec3(),
-                        n: n.as_vec3(),
-                    },
-                    pdf,
-                ));
+                let (p, n) = (p.as_vec3(), n.as_vec3());
+                let tex = self.tex_at(prim, &pr, p, n, u);
+                return Some((SurfacePoint { p, n, tex }, pdf));
             }
         }
         let (p, n) = pr.sample_area(u);
         let pdf = Self::area_to_solid_angle(pr.area(), reference, p, n);
-        (pdf > 0.0 && pdf.is_finite()).then_some((SurfacePoint { p, n }, pdf))
+        (pdf > 0.0 && pdf.is_finite()).then(|| {
+            let tex = self.tex_at(prim, &pr, p, n, u);
+            (SurfacePoint { p, n, tex }, pdf)
+        })
     }
 
     fn area_to_solid_angle(area: f32, reference: Vec3, p: Vec3, n: Vec3) -> f32 {

@@ -141,8 +141,9 @@ pub fn luminaire_views(
                 }
             }
             Light::Area(a) => {
-                let lum = luminous_integral(&a.radiance);
-                let (mut w, mut e, mut sum) = (0.0, 0.0, Vec3::ZERO);
+                // A textured emitter's luminance varies: the source's is the mean over its
+                // solid angle.
+                let (mut w, mut e, mut lw, mut sum) = (0.0, 0.0, 0.0, Vec3::ZERO);
                 for &prim in &a.prims {
                     let da = world.geometry.prim_area(prim) as f64 / (GRID * GRID) as f64;
                     for j in 0..GRID {
@@ -162,13 +163,16 @@ pub fn luminaire_views(
                                 continue;
                             }
                             let dw = da * cos_l / r2;
+                            let lum = a.luminance_at(sp.tex);
                             w += dw;
+                            lw += lum * dw;
                             e += lum * cos_e * dw;
                             sum += dir * dw as f32;
                         }
                     }
                 }
                 e_dir += e;
+                let lum = if w > 0.0 { lw / w } else { 0.0 };
                 if w > 0.0 && lum > 0.0 {
                     out.push(view_of(i, arr(sum.normalize()), lum, w, e));
                 }

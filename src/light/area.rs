@@ -1,5 +1,6 @@
 //! Area light: Lambertian emission from the primitives of one scene object (its `emission`),
-//! given by the surface's luminance or the object's flux.
+//! given by the surface's luminance or the object's flux, the same everywhere on it or varying
+//! over it by an emission texture ([`EmissionTexture`]).
 
 use super::{EmissionPoint, LightFlags, LightSample};
 use crate::description::context::{Context, Role, SceneError};
@@ -8,7 +9,22 @@ use crate::geometry::{Hit, SceneGeometry};
 use crate::photometry::luminous_integral;
 use crate::sampling::pick_from_cdf;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use crate::texture::emission::EmissionTexture;
 use glam::{Vec2, Vec3};
+use std::sync::Arc;
+
+/// The spectral shape of an emission: one spectrum for the whole surface, or an emission
+/// texture (a shape and a luminance per texel).
+#[derive(Clone, Debug)]
+pub enum EmissionShape {
+    Spectrum(DenseSpectrum),
+    Texture(Arc<EmissionTexture>),
+}
+
+/// Most points per primitive at which a textured light's mean luminance is estimated.
+const MEAN_POINTS_MAX: usize = 64 * 64;
+/// Most points over all of a textured light's primitives.
+const MEAN_POINTS_TOTAL: usize = 1 << 22;
 
 #[derive(Clone, Debug)]
 pub struct AreaLight {
@@ -20,8 +36,15 @@ pub struct AreaLight {
     pub cdf: Vec<f32>,
     /// Total area of `prims`, m².
     pub total_area: f32,
-    /// Radiance L_e(λ), W·m⁻²·sr⁻¹·nm⁻¹, the same at every point and direction.
+    /// Radiance L_e(λ), W·m⁻²·sr⁻¹·nm⁻¹, the same at every point and direction; with a
+    /// texture, that of a texel of luminance Y = 1 and colour white.
     pub radiance: DenseSpectrum,
+    /// The emission texture and the luminance (cd/m²) of a texel of Y = 1: the radiance at a
+    /// point is this times the texture's there.
+    texture: Option<(Arc<EmissionTexture>, f32)>,
+    /// Per primitive (as `prims`) of a textured light: its mean luminance, cd/m², estimated
+    /// from points on it (for light selection and the flux only, never for radiance).
+    prim_luminance: Vec<f32>,
     /// Emits from both faces (otherwise only from the front face).
     pub two_sided: bool,
 }
@@ -49,23 +72,47 @@ impl AreaLight {
         ctx: &Context,
         field: &str,
         e: &EmissionDesc,
-    ) -> Result<DenseSpectrum, SceneError> {
-        ctx.spectrum(
-            &format!("{field}.emission.spectrum"),
+    ) -> Result<EmissionShape, SceneError> {
+        let sfield = format!("{field}.emission.spectrum");
+        if let Some(t) = &e.texture {
+            return Ok(EmissionShape::Texture(t.clone()));
+        }
+        if let crate::description::schema::SpectrumDesc::Texture {
+            file,
+            uv_scale,
+            uv_offset,
+            wrap,
+        } = &e.spectrum
+        {
+            if !(uv_scale.iter().chain(uv_offset)).all(|v| v.is_finite()) {
+                return Err(ctx.err(
+                    sfield,
+                    format!("uv_scale {uv_scale:?} and uv_offset {uv_offset:?} must be finite"),
+                ));
+            }
+            let mut t = EmissionTexture::load(&ctx.resolve(file), [1.0; 3])
+                .map_err(|err| ctx.err(&sfield, err.to_string()))?;
+            t.uv = crate::texture::scale_offset(*uv_scale, *uv_offset);
+            t.wrap = *wrap;
+            return Ok(EmissionShape::Texture(Arc::new(t)));
+        }
+        Ok(EmissionShape::Spectrum(ctx.spectrum(
+            &sfield,
             &e.spectrum,
             Role::Emission,
-        )
+        )?))
     }
 
     /// The light of scene object `object` (`field` names it, e.g. `objects[3] "lamp"`) from its
     /// `emission` and spectral shape `s` ([`AreaLight::spectrum`]), once the geometry is built:
-    /// amount `Luminance(cd/m²)` or `Flux(lm)` of the whole object.
+    /// amount `Luminance(cd/m²)` or `Flux(lm)` of the whole object; with a texture,
+    /// `Luminance(cd/m²)` of a texel of Y = 1.
     pub fn build(
         ctx: &Context,
         field: &str,
         object: u32,
         e: &EmissionDesc,
-        s: &DenseSpectrum,
+        s: &EmissionShape,
         geometry: &SceneGeometry,
     ) -> Result<Self, SceneError> {
         let two_sided = e.two_sided;
@@ -82,6 +129,44 @@ impl AreaLight {
             ));
         }
         let afield = format!("{field}.emission.amount");
+        let cdf = crate::sampling::cdf_from_weights(&areas);
+        let s = match s {
+            EmissionShape::Spectrum(s) => s,
+            EmissionShape::Texture(t) => {
+                let l = match e.amount {
+                    Amount::Luminance(l) => ctx.nonneg(&afield, l)?,
+                    other => {
+                        return Err(ctx.err(
+                            afield,
+                            format!("{other:?} is not an amount for a textured emission; use Luminance(cd/m²), the luminance of a white texel"),
+                        ))
+                    }
+                };
+                let peak = l * t.max_luminance();
+                if !(peak as f32).is_finite() {
+                    return Err(ctx.err(
+                        afield,
+                        format!("{l} cd/m² makes the brightest texel {peak:e} cd/m², beyond single precision"),
+                    ));
+                }
+                let d65 = crate::colour::tables::named_spectrum("D65").expect("D65 ships");
+                let d65 = DenseSpectrum::from_fn(|nm| d65.value(nm));
+                let radiance =
+                    ctx.scaled_emission(&format!("{field}.emission.spectrum"), &afield, &d65, l)?;
+                let mut light = Self {
+                    object,
+                    prims,
+                    cdf,
+                    total_area: total as f32,
+                    radiance,
+                    texture: Some((t.clone(), l as f32)),
+                    prim_luminance: Vec::new(),
+                    two_sided,
+                };
+                light.prim_luminance = light.mean_luminances(geometry);
+                return Ok(light);
+            }
+        };
         let luminance = match e.amount {
             Amount::Luminance(l) => ctx.nonneg(&afield, l)?,
             Amount::Flux(phi) => ctx.nonneg(&afield, phi)? / flux_lm(1.0, total, sides(two_sided)),
@@ -94,15 +179,71 @@ impl AreaLight {
         };
         let radiance =
             ctx.scaled_emission(&format!("{field}.emission.spectrum"), &afield, s, luminance)?;
-        let cdf = crate::sampling::cdf_from_weights(&areas);
         Ok(Self {
             object,
             prims,
             cdf,
             total_area: total as f32,
             radiance,
+            texture: None,
+            prim_luminance: Vec::new(),
             two_sided,
         })
+    }
+
+    /// A textured light's mean luminance on each primitive (cd/m²): the mean over a grid of
+    /// stratified points (up to [`MEAN_POINTS_MAX`] per primitive, [`MEAN_POINTS_TOTAL`] in all).
+    fn mean_luminances(&self, geom: &SceneGeometry) -> Vec<f32> {
+        let side = ((MEAN_POINTS_TOTAL / self.prims.len().max(1)).min(MEAN_POINTS_MAX) as f64)
+            .sqrt()
+            .max(1.0) as usize;
+        use rayon::prelude::*;
+        self.prims
+            .par_iter()
+            .map(|&prim| {
+                let mut sum = 0.0f64;
+                for j in 0..side {
+                    for k in 0..side {
+                        let u = Vec2::new(
+                            (j as f32 + 0.5) / side as f32,
+                            (k as f32 + 0.5) / side as f32,
+                        );
+                        sum += self.luminance_at(geom.sample_prim(prim, u).tex);
+                    }
+                }
+                (sum / (side * side) as f64) as f32
+            })
+            .collect()
+    }
+
+    /// Whether the emission varies over the surface by a texture.
+    pub fn is_textured(&self) -> bool {
+        self.texture.is_some()
+    }
+
+    /// Radiance (W·m⁻²·sr⁻¹·nm⁻¹) leaving the surface where its texture coordinates are `tex`.
+    #[inline]
+    pub fn radiance_at(&self, tex: Vec2, wl: &SampledWavelengths) -> SampledSpectrum {
+        match &self.texture {
+            None => self.radiance.sample(wl),
+            Some((t, l)) => t.radiance(tex, wl) * *l,
+        }
+    }
+
+    /// Luminance (cd/m²) of the surface where its texture coordinates are `tex`.
+    pub fn luminance_at(&self, tex: Vec2) -> f64 {
+        match &self.texture {
+            None => luminous_integral(&self.radiance),
+            Some((t, l)) => t.luminance(tex) * *l as f64,
+        }
+    }
+
+    /// Mean luminance (cd/m²) of the `k`-th of `prims` (estimated for a textured light).
+    pub fn prim_mean_luminance(&self, k: usize) -> f64 {
+        match &self.texture {
+            None => luminous_integral(&self.radiance),
+            Some(_) => self.prim_luminance[k] as f64,
+        }
     }
 
     /// A point uniform by area (`uc` chooses the primitive, `u` the point).
@@ -112,6 +253,7 @@ impl AreaLight {
         EmissionPoint {
             p: sp.p,
             n: Some(sp.n),
+            tex: sp.tex,
             inv_pdf: self.total_area,
         }
     }
@@ -126,7 +268,7 @@ impl AreaLight {
     ) -> SampledSpectrum {
         let cos = at.n.map_or(0.0, |n| n.dot(dir));
         if cos > 0.0 || (self.two_sided && cos < 0.0) {
-            self.radiance.sample(wl) * cos.abs()
+            self.radiance_at(at.tex, wl) * cos.abs()
         } else {
             SampledSpectrum::ZERO
         }
@@ -170,7 +312,7 @@ impl AreaLight {
         }
         Some(LightSample {
             wi,
-            li: self.radiance.sample(wl),
+            li: self.radiance_at(sp.tex, wl),
             pdf: pdf_sa,
             dist,
             point: Some((sp.p, sp.n)),
@@ -188,19 +330,17 @@ impl AreaLight {
     /// Radiance leaving the surface toward the viewer, given the hit.
     pub fn emitted(&self, hit: &Hit, wl: &SampledWavelengths) -> SampledSpectrum {
         if hit.front_face || self.two_sided {
-            self.radiance.sample(wl)
+            self.radiance_at(hit.tex, wl)
         } else {
             SampledSpectrum::ZERO
         }
     }
 
-    /// Luminous flux, lm.
+    /// Luminous flux, lm (estimated from points for a textured light).
     pub fn power_lm(&self, geom: &SceneGeometry) -> f64 {
-        let area: f64 = self.prims.iter().map(|&p| geom.prim_area(p) as f64).sum();
-        flux_lm(
-            luminous_integral(&self.radiance),
-            area,
-            sides(self.two_sided),
-        )
+        let la: f64 = (0..self.prims.len())
+            .map(|k| geom.prim_area(self.prims[k]) as f64 * self.prim_mean_luminance(k))
+            .sum();
+        flux_lm(la, 1.0, sides(self.two_sided))
     }
 }

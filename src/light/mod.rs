@@ -28,7 +28,7 @@ use crate::geometry::{Hit, SceneGeometry};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
-pub use area::AreaLight;
+pub use area::{AreaLight, EmissionShape};
 pub use distant::DistantLight;
 pub use environment::EnvironmentLight;
 pub use goniometric::GoniometricLight;
@@ -115,6 +115,8 @@ pub struct EmissionPoint {
     pub p: Vec3,
     /// Front normal of an area light's surface (None for point-like sources).
     pub n: Option<Vec3>,
+    /// Texture coordinates of the point on an area light (zero for point-like sources).
+    pub tex: glam::Vec2,
     /// 1 / (density of the point w.r.t. area) for area lights (their area), 1 for point-like
     /// sources.
     pub inv_pdf: f32,
@@ -148,6 +150,7 @@ impl Light {
             Some(EmissionPoint {
                 p,
                 n: None,
+                tex: glam::Vec2::ZERO,
                 inv_pdf: 1.0,
             })
         };
@@ -245,6 +248,7 @@ impl Light {
         let at = EmissionPoint {
             p: position,
             n: None,
+            tex: glam::Vec2::ZERO,
             inv_pdf: 1.0,
         };
         let intensity = self.emission_toward(&at, -wi, wl);

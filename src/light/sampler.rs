@@ -266,9 +266,22 @@ pub fn emitters(lights: &[Light], geom: &SceneGeometry) -> Vec<Emitter> {
                 ))
             }
             Light::Area(a) => {
-                let luminance = luminous_integral(&a.radiance);
                 let sides = if a.two_sided { 2.0 } else { 1.0 };
-                for &prim in &a.prims {
+                // A textured light's primitives by their estimated mean luminance, floored at a
+                // thousandth of the light's mean so that none that might emit is never chosen.
+                let floor = if a.is_textured() {
+                    let (mut la, mut area) = (0.0, 0.0);
+                    for (k, &prim) in a.prims.iter().enumerate() {
+                        let ak = geom.prim_area(prim) as f64;
+                        la += ak * a.prim_mean_luminance(k);
+                        area += ak;
+                    }
+                    1e-3 * la / area.max(f64::MIN_POSITIVE)
+                } else {
+                    0.0
+                };
+                for (k, &prim) in a.prims.iter().enumerate() {
+                    let luminance = a.prim_mean_luminance(k).max(floor);
                     let ((lo, hi), normal) = geom.prim_bounds_normal(prim);
                     let area = geom.prim_area(prim) as f64;
                     let axes = normal.map_or(Cone::SPHERE, |w| Cone { w, cos_theta: 1.0 });

@@ -7,7 +7,6 @@ use crate::description::context::{Context, SceneError};
 use crate::description::schema::*;
 use crate::geometry::{self, SceneGeometry, Shape, Transform};
 use crate::light::{AreaLight, Light, LightFlags, LightSampler, LightSamplerKind};
-use crate::spectrum::DenseSpectrum;
 use crate::world::{Object, RenderSettings, World};
 use glam::Vec3;
 use std::collections::HashMap;
@@ -304,7 +303,8 @@ pub fn build_for(
     let mut shape_uvs: Vec<Option<Vec<glam::Vec2>>> = Vec::new();
     let mut scene_object: Vec<usize> = Vec::with_capacity(scene.objects.len());
     let mut objects = Vec::with_capacity(scene.objects.len());
-    let mut pending_area: Vec<(u32, String, EmissionDesc, DenseSpectrum)> = Vec::new();
+    let mut pending_area: Vec<(u32, String, EmissionDesc, crate::light::EmissionShape)> =
+        Vec::new();
     let mut model_lights: Vec<(String, LightDesc)> = Vec::new();
     let mut groups: Vec<(usize, InstanceParts)> = Vec::new();
     let lookup = |field: &str, name: &str| -> Result<u32, SceneError> {

@@ -18,6 +18,7 @@ use crate::geometry::gltf::{
     GltfImage, GltfLight, GltfLightKind, GltfMaterial, GltfModel, GltfTextureRef,
 };
 use crate::texture::bytes::ByteTexture;
+use crate::texture::emission::EmissionTexture;
 use crate::texture::{Texture, TextureError, Wrap};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -34,6 +35,7 @@ pub struct TextureCache {
     colour: HashMap<(usize, [u32; 3]), Arc<Texture>>,
     metal_rough: HashMap<usize, Arc<ByteTexture<2>>>,
     normal: HashMap<usize, Arc<ByteTexture<3>>>,
+    emissive: HashMap<(usize, [u32; 3]), Arc<EmissionTexture>>,
 }
 
 impl TextureCache {
@@ -261,13 +263,15 @@ fn untextured(
 }
 
 /// The emission of glTF material `m`: front faces of luminance `strength · Y(emissive)` cd/m²
-/// with the colour of `emissive` (scaled to a peak of 1) as its spectral shape; `None` when
-/// `emissive` is black.
+/// with the colour of `emissive` (scaled to a peak of 1) as its spectral shape; with an
+/// `emissiveTexture`, per texel `strength · Y(c)` with the shape of c = `emissive` × the
+/// texel's linear colour. `None` when `emissive` is black.
 pub fn emission(
     ctx: &Context,
     field: &str,
     model: &GltfModel,
     m: &GltfMaterial,
+    cache: &mut TextureCache,
 ) -> Result<Option<EmissionDesc>, SceneError> {
     let e = m.emissive;
     let at = || {
@@ -294,10 +298,46 @@ pub fn emission(
     if peak == 0.0 || s == 0.0 {
         return Ok(None);
     }
-    Ok(Some(EmissionDesc {
-        spectrum: SpectrumDesc::Rgb(e[0] / peak, e[1] / peak, e[2] / peak),
-        amount: Amount::Luminance(s * luma(e)),
-        two_sided: false,
+    let texture = match &m.emissive_texture {
+        None => None,
+        Some(t) => {
+            let tint = e.map(|v| v as f32);
+            let key = (t.image, tint.map(f32::to_bits));
+            let texture = match cache.emissive.get(&key) {
+                Some(tex) => tex.clone(),
+                None => {
+                    let tex =
+                        with_image(model, t.image, |p, b| EmissionTexture::decode(p, b, tint))
+                            .map_err(|err| ctx.err(at(), err))?;
+                    let tex = Arc::new(tex);
+                    cache.emissive.insert(key, tex.clone());
+                    tex
+                }
+            };
+            let wrap = if t.clamp { Wrap::Clamp } else { Wrap::Repeat };
+            Some(if texture.wrap == wrap && texture.uv == t.uv {
+                texture
+            } else {
+                Arc::new(with_sampler(&*texture, t, |x, w, uv| {
+                    x.wrap = w;
+                    x.uv = uv;
+                }))
+            })
+        }
+    };
+    Ok(Some(match texture {
+        None => EmissionDesc {
+            spectrum: SpectrumDesc::Rgb(e[0] / peak, e[1] / peak, e[2] / peak),
+            amount: Amount::Luminance(s * luma(e)),
+            two_sided: false,
+            texture: None,
+        },
+        Some(t) => EmissionDesc {
+            spectrum: SpectrumDesc::Rgb(1.0, 1.0, 1.0),
+            amount: Amount::Luminance(s),
+            two_sided: false,
+            texture: Some(t),
+        },
     }))
 }
 
@@ -464,7 +504,7 @@ pub fn parts(
                             materials.len() as u32 - 1
                         }
                     };
-                    ids[i] = Some((id, emission(ctx, field, model, m)?));
+                    ids[i] = Some((id, emission(ctx, field, model, m, &mut cache)?));
                 }
                 ids[i].clone().expect("set above")
             }

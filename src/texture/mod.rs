@@ -8,6 +8,7 @@
 //! OBJ files. Scalar and normal maps (one to three linear 8-bit channels) are in [`bytes`].
 
 pub mod bytes;
+pub mod emission;
 
 use crate::spectrum::rgb_upsample::fit_linear_srgb;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, N_LAMBDA};
@@ -184,52 +185,20 @@ impl Texture {
     /// image over [`MAX_TEXELS`] or one that would not fit in the memory available (checked
     /// from its header, before decoding) is an error naming the file.
     pub fn load(path: &Path) -> Result<Texture, TextureError> {
-        let err = |message: String| TextureError {
-            path: path.to_path_buf(),
-            message,
-        };
-        let bytes = crate::limits::read_file(path, MAX_TEXTURE_FILE_BYTES)
-            .map_err(|e| err(e.to_string()))?;
-        let check = |w: u64, h: u64| check_size(path, w, h);
-        if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-            drop(bytes);
-            let layers = crate::output::read_exr(path).map_err(|e| err(e.to_string()))?;
-            check(layers.width as u64, layers.height as u64)?;
-            let ch = |name: &str| {
-                layers
-                    .channel(name)
-                    .ok_or_else(|| err(format!("the OpenEXR image has no channel {name:?}")))
-            };
-            let (r, g, b) = (ch("R")?, ch("G")?, ch("B")?);
-            let texels: Vec<[f32; 3]> = (0..r.len())
-                .map(|i| [r[i], g[i], b[i]].map(|v| if v.is_finite() { v } else { 0.0 }))
-                .collect();
-            return Ok(Texture::from_linear_rgb(
-                layers.width as u32,
-                layers.height as u32,
-                &texels,
-            ));
-        }
-        Self::decode(path, &bytes, [1.0; 3])
+        let bytes =
+            crate::limits::read_file(path, MAX_TEXTURE_FILE_BYTES).map_err(|e| TextureError {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })?;
+        let (w, h, texels) = linear_texels(path, &bytes, [1.0; 3])?;
+        Ok(Texture::from_linear_rgb(w, h, &texels))
     }
 
     /// A texture from the bytes of a PNG or JPEG image (sRGB-encoded; alpha ignored), each
     /// texel's linear colour multiplied by `tint` (in [0, 1]) before upsampling; `path` names it
     /// in messages. Checked as [`Texture::load`].
     pub fn decode(path: &Path, bytes: &[u8], tint: [f32; 3]) -> Result<Texture, TextureError> {
-        let rgb = decode_rgb8(path, bytes)?;
-        let (w, h) = rgb.dimensions();
-        let lut: Vec<f32> = (0..=255u8)
-            .map(|v| crate::colour::rgb::srgb_decode(v as f64 / 255.0) as f32)
-            .collect();
-        let texels: Vec<[f32; 3]> = rgb
-            .pixels()
-            .map(|p| {
-                let c = p.0.map(|v| lut[v as usize]);
-                [c[0] * tint[0], c[1] * tint[1], c[2] * tint[2]]
-            })
-            .collect();
-        drop(rgb);
+        let (w, h, texels) = linear_texels(path, bytes, tint)?;
         Ok(Texture::from_linear_rgb(w, h, &texels))
     }
 
@@ -278,6 +247,51 @@ impl Texture {
         }
         out
     }
+}
+
+/// The linear-sRGB colours of an image's texels (top row first) times `tint`, with its width
+/// and height: an OpenEXR file's R, G, B as they are (non-finite values as 0; read from
+/// `path`, which `bytes` came from), or a PNG's or JPEG's decoded with the sRGB transfer
+/// function (alpha ignored). Checked as [`Texture::load`]; `path` names the image in messages.
+pub(crate) fn linear_texels(
+    path: &Path,
+    bytes: &[u8],
+    tint: [f32; 3],
+) -> Result<(u32, u32, Vec<[f32; 3]>), TextureError> {
+    let err = |message: String| TextureError {
+        path: path.to_path_buf(),
+        message,
+    };
+    if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        let layers = crate::output::read_exr(path).map_err(|e| err(e.to_string()))?;
+        check_size(path, layers.width as u64, layers.height as u64)?;
+        let ch = |name: &str| {
+            layers
+                .channel(name)
+                .ok_or_else(|| err(format!("the OpenEXR image has no channel {name:?}")))
+        };
+        let (r, g, b) = (ch("R")?, ch("G")?, ch("B")?);
+        let texels = (0..r.len())
+            .map(|i| {
+                let c = [r[i], g[i], b[i]].map(|v| if v.is_finite() { v } else { 0.0 });
+                [c[0] * tint[0], c[1] * tint[1], c[2] * tint[2]]
+            })
+            .collect();
+        return Ok((layers.width as u32, layers.height as u32, texels));
+    }
+    let rgb = decode_rgb8(path, bytes)?;
+    let (w, h) = rgb.dimensions();
+    let lut: Vec<f32> = (0..=255u8)
+        .map(|v| crate::colour::rgb::srgb_decode(v as f64 / 255.0) as f32)
+        .collect();
+    let texels = rgb
+        .pixels()
+        .map(|p| {
+            let c = p.0.map(|v| lut[v as usize]);
+            [c[0] * tint[0], c[1] * tint[1], c[2] * tint[2]]
+        })
+        .collect();
+    Ok((w, h, texels))
 }
 
 /// The 8-bit RGB texels of a PNG or JPEG image (alpha dropped), after the checks of

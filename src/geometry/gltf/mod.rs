@@ -82,6 +82,8 @@ pub struct GltfMaterial {
     pub ior: f64,
     /// Linear RGB emissive factor.
     pub emissive: [f64; 3],
+    /// sRGB colour multiplying `emissive` per texel.
+    pub emissive_texture: Option<GltfTextureRef>,
     /// `KHR_materials_emissive_strength`, 1 without it.
     pub emissive_strength: f64,
 }
@@ -651,6 +653,10 @@ fn material(path: &Path, m: &gltf::Material) -> Result<GltfMaterial, GeometryErr
         )?),
         None => None,
     };
+    let emissive_texture = match m.emissive_texture() {
+        Some(t) => Some(texture_ref(path, "emissive texture", i, info_parts(t))?),
+        None => None,
+    };
     let normal_texture = match m.normal_texture() {
         Some(n) => {
             let parts = (n.texture(), n.tex_coord(), normal_transform(path, i, &n)?);
@@ -677,6 +683,7 @@ fn material(path: &Path, m: &gltf::Material) -> Result<GltfMaterial, GeometryErr
         transmission: m.transmission().map_or(0.0, |t| f(t.transmission_factor())),
         ior: m.ior().map_or(1.5, f),
         emissive: m.emissive_factor().map(f),
+        emissive_texture,
         emissive_strength: m.emissive_strength().map_or(1.0, f),
     })
 }

@@ -58,6 +58,10 @@ pub(super) fn model_parts(
         }
     }
     let mut parts = Vec::with_capacity(model.groups.len());
+    let mut emissive_maps: std::collections::HashMap<
+        String,
+        std::sync::Arc<crate::texture::emission::EmissionTexture>,
+    > = std::collections::HashMap::new();
     for g in model.groups {
         let Some(name) = g.material else {
             let material = lookup(&format!("{field}.material"), fallback).map_err(|e| {
@@ -91,7 +95,9 @@ pub(super) fn model_parts(
                 materials.len() as u32 - 1
             }
         };
-        let emission = match (ke_luminance, mtl.ke) {
+        // `map_Ke` multiplies `Ke`, which is white when the material gives only the map.
+        let ke = mtl.ke.or(mtl.map_ke.as_ref().map(|_| [1.0; 3]));
+        let emission = match (ke_luminance, ke) {
             (Some(l), Some(ke)) if ke.iter().any(|&v| v > 0.0) => {
                 if let Some(v) = ke.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
                     return Err(ctx.err(
@@ -103,12 +109,33 @@ pub(super) fn model_parts(
                         format!("component {v} must be ≥ 0"),
                     ));
                 }
+                let texture = match &mtl.map_ke {
+                    None => None,
+                    Some(map) => Some(match emissive_maps.get(&name) {
+                        Some(t) => t.clone(),
+                        None => {
+                            let t =
+                                std::sync::Arc::new(emission_map(ctx, &shape_field, mtl, map, ke)?);
+                            emissive_maps.insert(name.clone(), t.clone());
+                            t
+                        }
+                    }),
+                };
                 let peak = ke.iter().copied().fold(0.0, f64::max);
                 let y = 0.2126 * ke[0] + 0.7152 * ke[1] + 0.0722 * ke[2];
-                Some(EmissionDesc {
-                    spectrum: SpectrumDesc::Rgb(ke[0] / peak, ke[1] / peak, ke[2] / peak),
-                    amount: Amount::Luminance(l * y),
-                    two_sided: false,
+                Some(match texture {
+                    None => EmissionDesc {
+                        spectrum: SpectrumDesc::Rgb(ke[0] / peak, ke[1] / peak, ke[2] / peak),
+                        amount: Amount::Luminance(l * y),
+                        two_sided: false,
+                        texture: None,
+                    },
+                    Some(t) => EmissionDesc {
+                        spectrum: SpectrumDesc::Rgb(1.0, 1.0, 1.0),
+                        amount: Amount::Luminance(l),
+                        two_sided: false,
+                        texture: Some(t),
+                    },
                 })
             }
             _ => None,
@@ -121,4 +148,39 @@ pub(super) fn model_parts(
         });
     }
     Ok(parts)
+}
+
+/// The emission texture of material `mtl`'s `map_Ke` (relative to its MTL file), each texel's
+/// linear colour multiplied by `ke`, with the map's `-s`, `-o` and `-clamp`.
+fn emission_map(
+    ctx: &Context,
+    shape_field: &str,
+    mtl: &geometry::mtl::MtlMaterial,
+    map: &geometry::mtl::MtlMap,
+    ke: [f64; 3],
+) -> Result<crate::texture::emission::EmissionTexture, SceneError> {
+    let at = format!(
+        "{shape_field} (`map_Ke` of material {:?}, '{}' line {})",
+        mtl.name,
+        mtl.file.display(),
+        mtl.line
+    );
+    let uv = crate::texture::scale_offset(map.scale, map.offset);
+    if !uv.is_finite() {
+        return Err(ctx.err(at, "its -s and -o must be finite"));
+    }
+    let path = mtl
+        .file
+        .parent()
+        .unwrap_or(std::path::Path::new(""))
+        .join(&map.file);
+    let mut t = crate::texture::emission::EmissionTexture::load(&path, ke.map(|v| v as f32))
+        .map_err(|e| ctx.err(&at, e.to_string()))?;
+    t.uv = uv;
+    t.wrap = if map.clamp {
+        crate::texture::Wrap::Clamp
+    } else {
+        crate::texture::Wrap::Repeat
+    };
+    Ok(t)
 }
