@@ -532,3 +532,130 @@ fn gltf_scene_camera_choice_and_errors() {
     assert_ne!(code, 0);
     assert!(stderr.contains("WIDTHxHEIGHT"), "{stderr}");
 }
+
+/// A RON scene takes its camera from a glTF model it places (`camera: (from_model: …)`): the
+/// same rays as the file rendered on its own, moved by the object's transform; `vfov_deg` or a
+/// projection replaces only the field of view; `--camera` chooses among the model's cameras;
+/// an unknown object, a non-glTF object, an unknown camera and `position` beside `from_model`
+/// are clear errors.
+#[test]
+fn ron_scene_takes_its_camera_from_a_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    plane_scene(
+        d,
+        "plane.gltf",
+        Vec3::new(0.3, 0.0, 0.2),
+        Some(perspective()),
+    );
+    let (w, h) = (60u32, 40u32);
+    let alone = load_world(
+        &d.join("plane.gltf"),
+        &Overrides {
+            resolution: Some((w, h)),
+            ..Default::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let ron = |camera: &str, transform: &str| {
+        let text = format!(
+            r#"(camera: ({camera}resolution: ({w}, {h})),
+                objects: [(name: "box", shape: Sphere(center: (0, -5, 0), radius: 0.5), material: "black"),
+                          (name: "plane", shape: Model(file: "plane.gltf", lights: true){transform})])"#
+        );
+        std::fs::write(d.join("s.ron"), text).unwrap();
+        d.join("s.ron")
+    };
+    let load = |p: &Path, o: &Overrides| load_world(p, o).unwrap_or_else(|e| panic!("{e}"));
+    let placed = load(
+        &ron("from_model: (object: \"plane\"), ", ""),
+        &Overrides::default(),
+    );
+    let moved = load(
+        &ron(
+            "from_model: (object: \"plane\", camera: \"main\"), ",
+            ", transform: (rotate_deg: (0, 30, 0), translate: (1, 0.5, -2))",
+        ),
+        &Overrides::default(),
+    );
+    let t = Mat4::from_translation(Vec3::new(1.0, 0.5, -2.0))
+        * Mat4::from_rotation_y(30f32.to_radians());
+    for (x, y) in [(0.5, 0.5), (41.5, 13.5), (59.5, 39.5), (30.0, 20.0)] {
+        let r0 = alone.camera.generate_ray(x, y, glam::Vec2::ZERO);
+        let r1 = placed.camera.generate_ray(x, y, glam::Vec2::ZERO);
+        assert!(
+            (r0.origin - r1.origin).length() < 1e-5 && (r0.dir - r1.dir).length() < 1e-6,
+            "pixel ({x}, {y}): {r0:?} vs {r1:?}"
+        );
+        let r2 = moved.camera.generate_ray(x, y, glam::Vec2::ZERO);
+        let (o, dir) = (
+            t.transform_point3(r0.origin),
+            t.transform_vector3(r0.dir).normalize(),
+        );
+        assert!(
+            (o - r2.origin).length() < 1e-5 && (dir - r2.dir).length() < 1e-5,
+            "moved pixel ({x}, {y}): {o} {dir} vs {r2:?}"
+        );
+    }
+    // A wider field of view from the same point, and a fisheye there.
+    let wide = load(
+        &ron("from_model: (object: \"plane\"), vfov_deg: 80, ", ""),
+        &Overrides::default(),
+    );
+    let (c0, c1) = (
+        alone.camera.generate_ray(30.0, 20.0, glam::Vec2::ZERO),
+        wide.camera.generate_ray(30.0, 20.0, glam::Vec2::ZERO),
+    );
+    assert!((c0.origin - c1.origin).length() < 1e-5 && (c0.dir - c1.dir).length() < 1e-6);
+    let (e0, e1) = (
+        alone.camera.generate_ray(30.0, 0.0, glam::Vec2::ZERO),
+        wide.camera.generate_ray(30.0, 0.0, glam::Vec2::ZERO),
+    );
+    let half = |r: &candela::camera::CameraRay| r.dir.angle_between(c0.dir).to_degrees();
+    assert!((half(&e0) - YFOV_DEG / 2.0).abs() < 0.01 && (half(&e1) - 40.0).abs() < 0.01);
+    let fish = load(
+        &ron(
+            "from_model: (object: \"plane\"), projection: Fisheye(mapping: Equidistant, fov_deg: 180), ",
+            "",
+        ),
+        &Overrides::default(),
+    );
+    let f = fish.camera.generate_ray(30.0, 20.0, glam::Vec2::ZERO);
+    assert!((f.origin - c0.origin).length() < 1e-5 && (f.dir - c0.dir).length() < 1e-3);
+    // --camera chooses among the model's cameras.
+    let by_flag = load(
+        &ron("from_model: (object: \"plane\"), ", ""),
+        &Overrides {
+            camera: Some("persp".into()),
+            ..Default::default()
+        },
+    );
+    let r = by_flag.camera.generate_ray(41.5, 13.5, glam::Vec2::ZERO);
+    assert!((r.dir - alone.camera.generate_ray(41.5, 13.5, glam::Vec2::ZERO).dir).length() < 1e-6);
+    let err = |camera: &str| match load_world(&ron(camera, ""), &Overrides::default()) {
+        Ok(_) => panic!("{camera} loaded"),
+        Err(e) => e.to_string(),
+    };
+    let e = err("from_model: (object: \"room\"), ");
+    assert!(
+        e.contains("camera.from_model.object") && e.contains("\"room\"") && e.contains("\"plane\""),
+        "{e}"
+    );
+    let e = err("from_model: (object: \"box\"), ");
+    assert!(e.contains("not a glTF `Model`"), "{e}");
+    let e = err("from_model: (object: \"plane\", camera: \"balcony\"), ");
+    assert!(
+        e.contains("camera.from_model.camera balcony") && e.contains("\"main\""),
+        "{e}"
+    );
+    let e = err("from_model: (object: \"plane\"), position: (0, 1, 0), ");
+    assert!(
+        e.contains("camera.position") && e.contains("from_model"),
+        "{e}"
+    );
+    let e = err("vfov_deg: 40, ");
+    assert!(
+        e.contains("camera.position") && e.contains("missing"),
+        "{e}"
+    );
+}

@@ -61,9 +61,17 @@ impl Camera {
         c: &CameraDesc,
         check_film: impl FnOnce(u32, u32) -> Result<(), SceneError>,
     ) -> Result<Self, SceneError> {
-        let position = ctx.vec3("camera.position", c.position)?;
-        let look_at = ctx.vec3("camera.look_at", c.look_at)?;
-        let up = ctx.vec3("camera.up", c.up)?;
+        let required = |field: &str, v: Option<[f32; 3]>| {
+            v.ok_or_else(|| {
+                ctx.err(
+                    format!("camera.{field}"),
+                    "missing: give `position` and `look_at`, or `from_model` (a camera of a glTF model)",
+                )
+            })
+        };
+        let position = ctx.vec3("camera.position", required("position", c.position)?)?;
+        let look_at = ctx.vec3("camera.look_at", required("look_at", c.look_at)?)?;
+        let up = ctx.vec3("camera.up", c.up.unwrap_or([0.0, 1.0, 0.0]))?;
         let forward = look_at - position;
         if forward.length_squared() == 0.0 {
             return Err(ctx.err("camera.look_at", "look_at equals position"));
@@ -604,9 +612,10 @@ mod tests {
             sources: Default::default(),
         };
         let mut desc = CameraDesc {
-            position: [0.0, 0.0, 0.0],
-            look_at: [0.0, 0.0, 1.0],
-            up: [0.0, 1.0, 0.0],
+            position: Some([0.0, 0.0, 0.0]),
+            look_at: Some([0.0, 0.0, 1.0]),
+            up: None,
+            from_model: None,
             vfov_deg: Some(40.0),
             resolution: (8, 6),
             projection: None,

@@ -190,9 +190,10 @@ pub fn subdivisions_for(triangles: usize) -> u32 {
 pub fn mesh_scene(mesh: candela::geometry::TriangleMesh, spp: u32, resolution: u32) -> SceneFile {
     SceneFile {
         camera: CameraDesc {
-            position: [0.0, 1.2, -3.2],
-            look_at: [0.0, 0.9, 0.0],
-            up: [0.0, 1.0, 0.0],
+            position: Some([0.0, 1.2, -3.2]),
+            look_at: Some([0.0, 0.9, 0.0]),
+            up: None,
+            from_model: None,
             vfov_deg: Some(45.0),
             resolution: (resolution, resolution),
             projection: None,

@@ -17,7 +17,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub struct RenderOpts {
     /// Scene file: RON, or a glTF file (.gltf, .glb) rendered as a whole scene with its camera, lights and materials (docs/scene-format.md → glTF files as scenes).
     scene: PathBuf,
-    /// glTF scene: the camera to render through, by the index of its camera node (0-based, in scene order) or by its node or camera name (default: the first camera node).
+    /// The camera to render through: for a glTF scene, or a RON scene whose camera is `from_model`, the index of the model's camera node (0-based, in scene order) or its node or camera name (default: the first camera node, or `from_model.camera`).
     #[arg(long)]
     camera: Option<String>,
     /// Image size WIDTHxHEIGHT in pixels, e.g. 1280x720 (overrides camera.resolution; a glTF scene's default is 1024 pixels wide at its camera's aspect ratio).

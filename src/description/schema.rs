@@ -189,12 +189,19 @@ fn default_meter_max_samples() -> u64 {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
-    /// Eye position, m.
-    pub position: V3,
-    /// Point looked at, m.
-    pub look_at: V3,
-    #[serde(default = "default_up")]
-    pub up: V3,
+    /// Eye position, m (required unless `from_model` gives it).
+    #[serde(default)]
+    pub position: Option<V3>,
+    /// Point looked at, m (required unless `from_model` gives the view).
+    #[serde(default)]
+    pub look_at: Option<V3>,
+    /// Up direction; (0, 1, 0) when omitted (a `from_model` camera's own up).
+    #[serde(default)]
+    pub up: Option<V3>,
+    /// The position, view, up and field of view of a camera of a glTF model placed by one of
+    /// the scene's objects, instead of `position`, `look_at` and `up`.
+    #[serde(default)]
+    pub from_model: Option<ModelCameraDesc>,
     /// Full vertical field of view of the perspective projection, degrees (shorthand for
     /// `projection: Perspective(vfov_deg: …)`; not with `projection`).
     #[serde(default)]
@@ -235,8 +242,15 @@ pub enum FisheyeMappingDesc {
     Stereographic,
 }
 
-fn default_up() -> V3 {
-    [0.0, 1.0, 0.0]
+/// A camera of a glTF model (`camera.from_model`): the object of `objects` (by `name`) whose
+/// `Model` shape is the file, and which of its cameras (as `--camera` for a glTF file: an
+/// index in scene order or a node's or camera's name; the first when omitted).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelCameraDesc {
+    pub object: String,
+    #[serde(default)]
+    pub camera: Option<String>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -792,4 +806,8 @@ pub struct SunDesc {
     /// `time` is local apparent solar time (no UTC offset) instead of clock time.
     #[serde(default)]
     pub solar_time: bool,
+}
+
+fn default_up() -> V3 {
+    [0.0, 1.0, 0.0]
 }

@@ -177,16 +177,17 @@ pub fn load_world_for(
     let scene = if is_gltf_path(path) {
         super::gltf_scene::scene(path, overrides.camera.as_deref(), overrides.resolution)?
     } else {
-        if let Some(c) = &overrides.camera {
+        let scene = super::load(path)?;
+        if let (Some(c), None) = (&overrides.camera, &scene.camera.from_model) {
             return Err(SceneError::Invalid {
                 path: path.to_path_buf(),
                 field: "camera".into(),
                 message: format!(
-                    "--camera {c} chooses among a glTF file's cameras; a RON scene has its one `camera`"
+                    "--camera {c} chooses among a glTF file's cameras; this RON scene has its one `camera` (a `camera: (from_model: …)` takes --camera)"
                 ),
             });
         }
-        super::load(path)?
+        scene
     };
     build_for(&scene, path, overrides, mode)
 }
@@ -225,7 +226,8 @@ pub fn build_for(
 
     // Camera, and the film its resolution asks for.
     let illuminance = scene.render.illuminance || overrides.illuminance;
-    let mut camera_desc = scene.camera.clone();
+    let mut camera_desc =
+        super::gltf_scene::model_camera(&ctx, scene, overrides.camera.as_deref())?;
     if let Some(r) = overrides.resolution {
         camera_desc.resolution = r;
     }

@@ -45,10 +45,11 @@ fn choose<'a>(
     file: &str,
     cameras: &'a [GltfCamera],
     choice: Option<&str>,
+    (field, choice_field): (&str, &str),
 ) -> Result<&'a GltfCamera, SceneError> {
     if cameras.is_empty() {
         return Err(ctx.err(
-            "camera",
+            field,
             format!("'{file}' has no camera node in its scene: add a camera in the modelling tool and export it, or render a RON scene that places the model (`Model(file: \"{file}\", lights: true)`) and gives a `camera`"),
         ));
     }
@@ -61,7 +62,7 @@ fn choose<'a>(
     let Some(choice) = choice else {
         return Ok(&cameras[0]);
     };
-    let field = format!("camera (--camera {choice})");
+    let field = format!("{choice_field} {choice}");
     if let Ok(k) = choice.trim().parse::<usize>() {
         return cameras.get(k).ok_or_else(|| {
             ctx.err(
@@ -90,6 +91,129 @@ fn choose<'a>(
         })
 }
 
+/// The camera nodes of glTF file `path`.
+fn read_cameras(ctx: &Context, path: &Path) -> Result<Vec<GltfCamera>, SceneError> {
+    crate::geometry::gltf::load_cameras(path).map_err(|e| match e {
+        crate::geometry::GeometryError::Io { path, source } => SceneError::Io { path, source },
+        e => ctx.err("file", e.to_string()),
+    })
+}
+
+/// The vertical field of view (radians) and aspect ratio of camera `c` of `cameras` (of file
+/// `name`); an orthographic camera is an error at `field`.
+fn perspective(
+    ctx: &Context,
+    name: &str,
+    cameras: &[GltfCamera],
+    c: &GltfCamera,
+    field: &str,
+) -> Result<(f64, Option<f64>), SceneError> {
+    match c.projection {
+        GltfProjection::Perspective {
+            yfov_rad,
+            aspect_ratio,
+        } => Ok((yfov_rad, aspect_ratio)),
+        GltfProjection::Orthographic => Err(ctx.err(
+            field,
+            format!(
+                "camera {} of '{name}' is orthographic; candela's cameras are perspective, fisheye and equirectangular: export a perspective camera",
+                describe(cameras.iter().position(|x| std::ptr::eq(x, c)).unwrap_or(0), c)
+            ),
+        )),
+    }
+}
+
+/// The scene's `camera` with its `from_model` resolved (`choice`, from `--camera`, replaces
+/// `from_model.camera`): the position, view direction and up of that camera node of the glTF
+/// file that object `from_model.object` places, moved by the object's `transform` (directions
+/// renormalised), and the camera's vertical field of view unless `vfov_deg` or `projection`
+/// gives one. `position`, `look_at` and `up` beside `from_model` are errors.
+pub fn model_camera(
+    ctx: &Context,
+    scene: &SceneFile,
+    choice: Option<&str>,
+) -> Result<CameraDesc, SceneError> {
+    let mut desc = scene.camera.clone();
+    let Some(from) = desc.from_model.take() else {
+        return Ok(desc);
+    };
+    for (given, f) in [
+        (desc.position.is_some(), "position"),
+        (desc.look_at.is_some(), "look_at"),
+        (desc.up.is_some(), "up"),
+    ] {
+        if given {
+            return Err(ctx.err(
+                format!("camera.{f}"),
+                "`from_model` gives the camera's position, view and up; remove `position`, `look_at` and `up`",
+            ));
+        }
+    }
+    let ofield = "camera.from_model.object";
+    let models = || {
+        let names: Vec<String> = (scene.objects.iter())
+            .filter(|o| matches!(&o.shape, ShapeDesc::Model { file, .. } if is_gltf(file)))
+            .filter_map(|o| o.name.as_ref().map(|n| format!("{n:?}")))
+            .collect();
+        if names.is_empty() {
+            "the scene has no named object whose shape is a glTF `Model`".to_string()
+        } else {
+            format!("the named glTF `Model` objects: {}", names.join(", "))
+        }
+    };
+    let (i, object) = (scene.objects.iter().enumerate())
+        .find(|(_, o)| o.name.as_deref() == Some(from.object.as_str()))
+        .ok_or_else(|| {
+            ctx.err(
+                ofield,
+                format!("no object is named {:?}; {}", from.object, models()),
+            )
+        })?;
+    let file = match &object.shape {
+        ShapeDesc::Model { file, .. } if is_gltf(file) => file,
+        _ => {
+            return Err(ctx.err(
+                ofield,
+                format!(
+                    "object {:?} is not a glTF `Model` (a `.gltf` or `.glb` file), so it has no cameras; {}",
+                    from.object,
+                    models()
+                ),
+            ))
+        }
+    };
+    let path = ctx.resolve(file);
+    let cameras = read_cameras(ctx, &path)?;
+    let choice = choice.or(from.camera.as_deref());
+    let c = choose(
+        ctx,
+        file,
+        &cameras,
+        choice,
+        ("camera.from_model", "camera.from_model.camera"),
+    )?;
+    let (yfov_rad, _) = perspective(ctx, file, &cameras, c, "camera.from_model.camera")?;
+    let (mut position, mut forward, mut up) = (c.position, c.forward, c.up);
+    if let Some(t) = &object.transform {
+        let field = format!("objects[{i}] {:?}.transform", from.object);
+        let t = crate::geometry::Transform::build(ctx, &field, t)?;
+        position = t.matrix.transform_point3(position);
+        forward = t.matrix.transform_vector3(forward).normalize_or_zero();
+        up = t.matrix.transform_vector3(up).normalize_or_zero();
+    }
+    desc.position = Some(position.to_array());
+    desc.look_at = Some((position + forward).to_array());
+    desc.up = Some(up.to_array());
+    if desc.vfov_deg.is_none() && desc.projection.is_none() {
+        desc.vfov_deg = Some(yfov_rad.to_degrees() as f32);
+    }
+    Ok(desc)
+}
+
+fn is_gltf(file: &str) -> bool {
+    super::build::is_gltf_path(Path::new(file))
+}
+
 /// The scene that renders glTF file `path` on its own, through its camera `camera` (see
 /// [`choose`]) at `resolution` (pixels; default [`DEFAULT_WIDTH`] wide at the camera's aspect
 /// ratio).
@@ -109,26 +233,15 @@ pub fn scene(
             "the glTF file's name is not valid UTF-8; rename it or place it in a RON scene",
         )
     })?;
-    let cameras = crate::geometry::gltf::load_cameras(path).map_err(|e| match e {
-        crate::geometry::GeometryError::Io { path, source } => SceneError::Io { path, source },
-        e => ctx.err("file", e.to_string()),
-    })?;
-    let c = choose(&ctx, name, &cameras, camera)?;
-    let (yfov_rad, aspect) = match c.projection {
-        GltfProjection::Perspective {
-            yfov_rad,
-            aspect_ratio,
-        } => (yfov_rad, aspect_ratio),
-        GltfProjection::Orthographic => {
-            return Err(ctx.err(
-                "camera",
-                format!(
-                    "camera {} of '{name}' is orthographic; candela's cameras are perspective, fisheye and equirectangular: export a perspective camera",
-                    describe(cameras.iter().position(|x| std::ptr::eq(x, c)).unwrap_or(0), c)
-                ),
-            ));
-        }
-    };
+    let cameras = read_cameras(&ctx, path)?;
+    let c = choose(
+        &ctx,
+        name,
+        &cameras,
+        camera,
+        ("camera", "camera (--camera)"),
+    )?;
+    let (yfov_rad, aspect) = perspective(&ctx, name, &cameras, c, "camera")?;
     let resolution = match resolution {
         Some(r) => r,
         None => {
@@ -149,9 +262,10 @@ pub fn scene(
         .map_or("model".into(), |s| s.to_string_lossy().into_owned());
     Ok(SceneFile {
         camera: CameraDesc {
-            position: c.position.to_array(),
-            look_at: look_at.to_array(),
-            up: c.up.to_array(),
+            position: Some(c.position.to_array()),
+            look_at: Some(look_at.to_array()),
+            up: Some(c.up.to_array()),
+            from_model: None,
             vfov_deg: Some(yfov_rad.to_degrees() as f32),
             resolution,
             projection: None,
