@@ -8,10 +8,10 @@
 //! reflectance textures do; since luminance is linear in radiance, the filtered luminance is the
 //! luminance of the filtered radiance.
 
-use super::{coefficients, footprint, sigmoid, UvMap, Wrap, T_MIN_NM, T_SPAN_NM};
+use super::{bilinear_shapes, coefficients, footprint, shape_at, UvMap, Wrap};
 use crate::colour::grid::LEN;
 use crate::photometry::K_M;
-use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths, N_LAMBDA};
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::Vec2;
 use std::collections::HashMap;
 
@@ -153,26 +153,8 @@ impl EmissionTexture {
     /// Radiance at texture coordinates `tex` (bilinear), W·m⁻²·sr⁻¹·nm⁻¹ per cd/m² of the
     /// amount, per wavelength of `wl`.
     pub fn radiance(&self, tex: Vec2, wl: &SampledWavelengths) -> SampledSpectrum {
-        let (cols, rows, wxs, wys) = footprint(&self.uv, self.wrap, self.width, self.height, tex);
-        let mut t = [0.0f32; N_LAMBDA];
-        for (t, l) in t.iter_mut().zip(wl.lambda.iter()) {
-            *t = (l - T_MIN_NM as f32) * (1.0 / T_SPAN_NM as f32);
-        }
-        let mut out = SampledSpectrum::ZERO;
-        for (r, wy) in rows.iter().zip(wys) {
-            for (c, wx) in cols.iter().zip(wxs) {
-                let i = r * self.width as usize + c;
-                let w = wx * wy * self.scale[i];
-                if w == 0.0 {
-                    continue;
-                }
-                let [a0, a1, a2] = self.coeffs[i];
-                for (o, t) in out.0.iter_mut().zip(t) {
-                    *o += w * sigmoid((a0 * t + a1) * t + a2);
-                }
-            }
-        }
-        out * self.d65.sample(wl)
+        let fp = footprint(&self.uv, self.wrap, self.width, self.height, tex);
+        bilinear_shapes(&self.coeffs, self.width, fp, wl, |i| self.scale[i]) * self.d65.sample(wl)
     }
 
     /// Luminance at texture coordinates `tex` (bilinear), cd/m² per cd/m² of the amount.
@@ -194,21 +176,11 @@ impl EmissionTexture {
     }
 }
 
-/// The shape S(λ) of coefficients `co` at `nm`, in f64.
-fn shape_at(co: [f32; 3], nm: f64) -> f64 {
-    let [a0, a1, a2] = co.map(|v| v as f64);
-    let t = (nm - T_MIN_NM) / T_SPAN_NM;
-    let x = (a0 * t + a1) * t + a2;
-    if x.is_infinite() {
-        return if x > 0.0 { 1.0 } else { 0.0 };
-    }
-    0.5 + 0.5 * x / (1.0 + x * x).sqrt()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::photometry::luminous_integral;
+    use crate::spectrum::N_LAMBDA;
 
     /// Each texel's radiance is that of an `Rgb` emission of its colour scaled to its luminance
     /// (the rule of the untextured emitters), and its luminance is Y(c).

@@ -216,37 +216,58 @@ impl Texture {
 
     /// Reflectance of texel (`x`, `y`) (y = 0 the top row) at `nm`.
     pub fn texel_reflectance(&self, x: u32, y: u32, nm: f64) -> f64 {
-        let [a0, a1, a2] = self.coeffs[(y * self.width + x) as usize].map(|v| v as f64);
-        let t = (nm - T_MIN_NM) / T_SPAN_NM;
-        let x = (a0 * t + a1) * t + a2;
-        if x.is_infinite() {
-            return if x > 0.0 { 1.0 } else { 0.0 };
-        }
-        0.5 + 0.5 * x / (1.0 + x * x).sqrt()
+        shape_at(self.coeffs[(y * self.width + x) as usize], nm)
     }
 
     /// Reflectance at texture coordinates `tex` (bilinear), per wavelength of `wl`.
     pub fn reflectance(&self, tex: Vec2, wl: &SampledWavelengths) -> SampledSpectrum {
-        let (cols, rows, wxs, wys) = footprint(&self.uv, self.wrap, self.width, self.height, tex);
-        let mut t = [0.0f32; N_LAMBDA];
-        for (t, l) in t.iter_mut().zip(wl.lambda.iter()) {
-            *t = (l - T_MIN_NM as f32) * (1.0 / T_SPAN_NM as f32);
-        }
-        let mut out = SampledSpectrum::ZERO;
-        for (r, wy) in rows.iter().zip(wys) {
-            for (c, wx) in cols.iter().zip(wxs) {
-                let w = wx * wy;
-                if w == 0.0 {
-                    continue;
-                }
-                let [a0, a1, a2] = self.coeffs[r * self.width as usize + c];
-                for (o, t) in out.0.iter_mut().zip(t) {
-                    *o += w * sigmoid((a0 * t + a1) * t + a2);
-                }
+        let fp = footprint(&self.uv, self.wrap, self.width, self.height, tex);
+        bilinear_shapes(&self.coeffs, self.width, fp, wl, |_| 1.0)
+    }
+}
+
+/// The spectrum of sigmoid coefficients `co` (as [`Texture`] keeps them) at `nm`, in f64.
+fn shape_at(co: [f32; 3], nm: f64) -> f64 {
+    let [a0, a1, a2] = co.map(|v| v as f64);
+    let t = (nm - T_MIN_NM) / T_SPAN_NM;
+    let x = (a0 * t + a1) * t + a2;
+    if x.is_infinite() {
+        return if x > 0.0 { 1.0 } else { 0.0 };
+    }
+    0.5 + 0.5 * x / (1.0 + x * x).sqrt()
+}
+
+/// Σ w·`weight`(texel)·S_texel(λ) over the bilinear footprint `fp` ([`footprint`]) of an image
+/// `width` texels wide whose texels' spectra have coefficients `coeffs`, at the wavelengths
+/// of `wl`.
+#[inline(always)]
+fn bilinear_shapes(
+    coeffs: &[[f32; 3]],
+    width: u32,
+    (cols, rows, wxs, wys): ([usize; 2], [usize; 2], [f32; 2], [f32; 2]),
+    wl: &SampledWavelengths,
+    weight: impl Fn(usize) -> f32,
+) -> SampledSpectrum {
+    let mut t = [0.0f32; N_LAMBDA];
+    for (t, l) in t.iter_mut().zip(wl.lambda.iter()) {
+        *t = (l - T_MIN_NM as f32) * (1.0 / T_SPAN_NM as f32);
+    }
+    let mut out = SampledSpectrum::ZERO;
+    for (r, wy) in rows.iter().zip(wys) {
+        for (c, wx) in cols.iter().zip(wxs) {
+            let i = r * width as usize + c;
+            let w = wx * wy;
+            if w == 0.0 {
+                continue;
+            }
+            let w = w * weight(i);
+            let [a0, a1, a2] = coeffs[i];
+            for (o, t) in out.0.iter_mut().zip(t) {
+                *o += w * sigmoid((a0 * t + a1) * t + a2);
             }
         }
-        out
     }
+    out
 }
 
 /// The linear-sRGB colours of an image's texels (top row first) times `tint`, with its width
