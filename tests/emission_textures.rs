@@ -386,3 +386,36 @@ fn bad_emission_textures_are_clear_errors() {
     let e = err(r#"(spectrum: Texture(file: "zero.png"), amount: Luminance(1.0))"#);
     assert!(e.contains("zero.png"), "{e}");
 }
+
+/// Light tracing evaluates the texture where its paths start: a two-colour emitter facing a
+/// mirror lights the floor beside it only through the mirror (light → mirror → floor → eye),
+/// and the light-traced image agrees block by block with the path tracer's, which sees the
+/// emitter's texels where its rays hit them.
+#[test]
+fn light_tracing_starts_paths_with_the_texels_radiance() {
+    let d = dir("emission_textures_light_tracing");
+    halves_png(&d, "halves.png");
+    let text = r#"(
+        camera: (position: (1.2, 0.9, 0.0), look_at: (1.2, 0, 0), up: (0, 0, 1), vfov_deg: 60, resolution: (16, 16)),
+        render: (spp: 256, max_depth: 2, light_paths_per_sample: 4, caustics: CAUSTICS),
+        materials: {
+            "floor": Diffuse(reflectance: Constant(0.5)),
+            "mirror": Conductor(n: Constant(0.2), k: Constant(3.0)),
+        },
+        objects: [
+            (shape: Quad(origin: (-50, 0, -50), edge_u: (0, 0, 100), edge_v: (100, 0, 0)), material: "floor"),
+            (shape: Quad(origin: (-50, 1, -50), edge_u: (100, 0, 0), edge_v: (0, 0, 100)), material: "mirror"),
+            (shape: Quad(origin: (-0.5, 0.4, -0.5), edge_u: (0, 0, 1), edge_v: (1, 0, 0)), material: "black",
+             emission: (spectrum: Texture(file: "halves.png", wrap: Clamp), amount: Luminance(5000.0))),
+        ],
+    )"#;
+    let lt = common::world_in(&text.replace("CAUSTICS", "LightTracing"), &d);
+    let pt = common::world_in(&text.replace("CAUSTICS", "PathTracing"), &d);
+    assert!(lt.caustics.is_some() && pt.caustics.is_none());
+    let (a, b) = (common::render(&lt, 2), common::render(&pt, 2));
+    common::assert_blocks_agree(&a, &b, 4, ("light tracing", "path tracing"));
+    // The floor is lit: the comparison is not of two black images. Its brightest block is
+    // under the bright half's mirror image (z < 0 is image right).
+    let blocks = common::block_means(&a, 8);
+    assert!(blocks.iter().all(|(m, se)| *m > 20.0 * se), "{blocks:?}");
+}
