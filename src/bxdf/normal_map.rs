@@ -3,8 +3,9 @@
 //! and (128, 128, 255) the unperturbed normal), x and y multiplied by the map's `scale`, then
 //! normalised, in the frame whose x is
 //! the direction of increasing u on the surface, y that of increasing v (up the image, glTF's
-//! and OpenGL's convention), z the shading normal. The tangent comes from the triangle's
-//! texture-coordinate derivatives dp/du, dp/dv at the hit (after the map's UV transform),
+//! and OpenGL's convention), z the shading normal. The tangent comes from the primitive's
+//! texture-coordinate derivatives dp/du, dp/dv at the hit
+//! ([`crate::geometry::SceneGeometry::texture_derivatives`], after the map's UV transform),
 //! orthonormalised against the shading normal; mirrored texture coordinates flip y.
 
 use super::Material;

@@ -6,8 +6,8 @@
 //! Hits come back in world space: points through the instance transform with an error bound
 //! that covers its rounding, normals through its inverse transpose.
 //!
-//! Memory: [`Instance`] is 144 bytes, plus one top-level node (80 bytes) per about 4–8
-//! instances; the mesh costs what it costs once.
+//! Memory: [`Instance`] is 144 bytes and its index 4, plus one top-level node (80 bytes) per
+//! about 4–8 instances; the mesh costs what it costs once.
 
 use super::bvh::{build_cwbvh, check_depth, padded_aabb};
 use super::prim::{PrimT, RayPre};
@@ -50,6 +50,8 @@ pub(super) struct InstanceSet {
     tlas: CwBvh,
     /// In top-level leaf order.
     insts: Vec<Instance>,
+    /// The leaf of each instance, in the caller's order ([`Hit::instance`] → `insts`).
+    leaf_of: Vec<u32>,
     meshes: Vec<SceneGeometry>,
     /// Instanced triangles (every instance counted).
     triangles: u64,
@@ -100,10 +102,7 @@ impl Instance {
         dir: Vec3,
     ) -> Hit {
         let h = mesh.make_hit(prim, pre, t, a, b);
-        let has_tex = mesh
-            .prim_uvs
-            .get(prim as usize)
-            .is_some_and(|i| i[0] != u32::MAX);
+        let has_tex = mesh.has_texture_coordinates(prim);
         let mut h = self.hit_to_world(h, dir, has_tex);
         // Vertex normals: each carried to world space, then interpolated, as in a copy (the
         // interpolation does not commute with normalising after a non-uniform scale).
@@ -258,6 +257,10 @@ impl InstanceSet {
         for (i, inst) in insts.iter_mut().enumerate() {
             inst.index = i as u32;
         }
+        let mut leaf_of = vec![0u32; insts.len()];
+        for (leaf, &i) in tlas.primitive_indices.iter().enumerate() {
+            leaf_of[i as usize] = leaf as u32;
+        }
         let mut by_leaf: Vec<Option<Instance>> = insts.into_iter().map(Some).collect();
         let insts: Vec<Instance> = tlas
             .primitive_indices
@@ -274,6 +277,7 @@ impl InstanceSet {
         Ok(Some(InstanceSet {
             tlas,
             insts,
+            leaf_of,
             meshes,
             triangles,
             bounds: (lo, hi),
@@ -300,6 +304,7 @@ impl InstanceSet {
     pub(super) fn memory_bytes(&self) -> usize {
         self.tlas.nodes.capacity() * std::mem::size_of::<obvhs::cwbvh::node::CwBvhNode>()
             + self.insts.capacity() * std::mem::size_of::<Instance>()
+            + self.leaf_of.capacity() * std::mem::size_of::<u32>()
             + self
                 .meshes
                 .iter()
@@ -364,6 +369,26 @@ impl InstanceSet {
     ) -> Hit {
         let inst = &self.insts[leaf as usize];
         inst.world_hit(&self.meshes[inst.mesh as usize], prim, &pre, (t, a, b), dir)
+    }
+
+    /// (dp/du, dp/dv) in world space at `hit` on an instance (see
+    /// [`SceneGeometry::texture_derivatives`]): the mesh's object-space derivatives through
+    /// the instance's linear part L. Tangent vectors are differences of points, so they map by
+    /// L (not by the inverse transpose, as normals do): the result is the derivatives of a
+    /// world-space copy of the mesh, orthogonal to the hit's world normal, and a mirroring L
+    /// carries the frame's handedness with it.
+    pub(super) fn texture_derivatives(&self, hit: &Hit) -> Option<(Vec3, Vec3)> {
+        let inst = &self.insts[*self.leaf_of.get(hit.instance as usize)? as usize];
+        let mesh = &self.meshes[inst.mesh as usize];
+        let (mut du, mut dv) = mesh.triangle_derivatives(hit.prim)?;
+        if inst.mirror && !mesh.has_texture_coordinates(hit.prim) {
+            // `tex` is the barycentrics of the mirrored winding ([`Instance::hit_to_world`]):
+            // (b2, b1) of the object-space triangle.
+            std::mem::swap(&mut du, &mut dv);
+        }
+        let l = glam::Mat3::from(inst.to_world.matrix3);
+        let (du, dv) = (l * du, l * dv);
+        (du.is_finite() && dv.is_finite()).then_some((du, dv))
     }
 
     /// True if the instance of a closest hit mirrors.

@@ -40,7 +40,7 @@ pub fn survival_probability(throughput: f32) -> f32 {
 
 /// `hit` with its shading normal perturbed by the normal map `m` (in the tangent frame of the
 /// hit primitive's texture coordinates); unchanged where the primitive gives no such frame
-/// (spheres, disks, instanced meshes).
+/// (a triangle whose texture coordinates have no area).
 #[inline]
 pub fn normal_mapped(
     world: &crate::world::World,
