@@ -16,7 +16,7 @@ use candela::world::World;
 use glam::{Affine3A, Mat3, Quat, Vec2, Vec3};
 use serde_json::{json, Value};
 use std::f64::consts::PI;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A bumpy 2 m × 2 m tile of `n`×`n` cells in the xy plane (front +Z) with texture coordinates
 /// on a rotated, sheared layout (dp/du along no edge).
@@ -543,5 +543,64 @@ fn tilted_map_on_a_sphere_follows_the_cosine_law() {
     assert!(
         rejects > n / 4,
         "the test cannot tell the frame's y from its reverse"
+    );
+}
+
+/// The scene's `NormalMapped(material: …, file: …)` puts a material under a map read from an
+/// image: the tilted disk renders to the bit as with the map given in code; a missing image and
+/// a map inside a map are errors naming the field.
+#[test]
+fn scene_normal_mapped_material_is_the_map_from_its_image() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("normal_maps_scene_material");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    png(&dir, "tilt.png", 1, 1, &[TILT]);
+    let text = |material: &str| {
+        format!(
+            r#"(
+    camera: (position: (0, 1, 0), look_at: (0, 0, 0), up: (0, 0, 1), vfov_deg: 90, resolution: (16, 16)),
+    render: (spp: 16, max_depth: 1),
+    materials: {{ "white": {material} }},
+    objects: [(shape: Disk(center: (0, 0, 0), normal: (0, 1, 0), radius: 3), material: "white")],
+    lights: [Distant(direction: (-0.5, -1, 0.2), spectrum: Named("D65"), amount: Illuminance(1000.0))],
+)"#
+        )
+    };
+    let plain = "Diffuse(reflectance: Constant(0.8))";
+    let by_code = with_map(common::world(&text(plain)), 1, 1, vec![TILT]);
+    let by_scene = common::world_in(
+        &text(&format!(
+            "NormalMapped(material: {plain}, file: \"tilt.png\", scale: 1.0)"
+        )),
+        &dir,
+    );
+    let (a, b) = (common::render(&by_code, 1), common::render(&by_scene, 1));
+    assert_bit_identical(&a, &b, "scene NormalMapped");
+    let unmapped = common::render(&common::world(&text(plain)), 1);
+    assert!(a
+        .pixels
+        .iter()
+        .zip(&unmapped.pixels)
+        .any(|(p, q)| p.mean_xyz() != q.mean_xyz()));
+    let err = |material: &str| {
+        std::fs::write(dir.join("bad.ron"), text(material)).unwrap();
+        match candela::scene::load_world(&dir.join("bad.ron"), &Default::default()) {
+            Ok(_) => panic!("{material} loaded"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let e = err(&format!(
+        "NormalMapped(material: {plain}, file: \"gone.png\")"
+    ));
+    assert!(
+        e.contains("materials") && e.contains(".file") && e.contains("gone.png"),
+        "{e}"
+    );
+    let e = err(&format!(
+        "NormalMapped(material: NormalMapped(material: {plain}, file: \"tilt.png\"), file: \"tilt.png\")"
+    ));
+    assert!(
+        e.contains("cannot wrap another normal-mapped material"),
+        "{e}"
     );
 }

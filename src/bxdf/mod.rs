@@ -217,6 +217,35 @@ impl Material {
                 *distribution,
             )?),
             MaterialDesc::Black => Material::Black,
+            MaterialDesc::NormalMapped {
+                material,
+                file,
+                scale,
+                uv_scale,
+                uv_offset,
+                wrap,
+            } => {
+                if let MaterialDesc::NormalMapped { .. } = **material {
+                    return Err(ctx.err(
+                        format!("{field}.material"),
+                        "a normal map cannot wrap another normal-mapped material",
+                    ));
+                }
+                let inner = Self::build(ctx, &format!("{field}.material"), material)?;
+                if !(scale.is_finite() && uv_scale.iter().chain(uv_offset).all(|v| v.is_finite())) {
+                    return Err(ctx.err(field, "scale, uv_scale and uv_offset must be finite"));
+                }
+                let mut map =
+                    crate::texture::bytes::ByteTexture::<3>::load(&ctx.resolve(file), [0, 1, 2])
+                        .map_err(|e| ctx.err(format!("{field}.file"), e.to_string()))?;
+                map.uv = crate::texture::scale_offset(*uv_scale, *uv_offset);
+                map.wrap = *wrap;
+                Material::NormalMapped(std::sync::Arc::new(normal_map::NormalMapped {
+                    inner,
+                    map,
+                    scale: *scale,
+                }))
+            }
         })
     }
 

@@ -471,6 +471,25 @@ pub enum MaterialDesc {
     },
     /// Absorbs all light.
     Black,
+    /// `material` under a tangent-space normal map (docs/scene-format.md → normal maps).
+    NormalMapped {
+        material: Box<MaterialDesc>,
+        /// PNG or JPEG image, linear 8-bit, relative to the scene file.
+        file: String,
+        /// Multiplies the map's x and y (default 1).
+        #[serde(default = "default_map_scale")]
+        scale: f32,
+        #[serde(default = "default_uv_scale")]
+        uv_scale: [f32; 2],
+        #[serde(default)]
+        uv_offset: [f32; 2],
+        #[serde(default)]
+        wrap: crate::texture::Wrap,
+    },
+}
+
+fn default_map_scale() -> f32 {
+    1.0
 }
 
 fn zero_spectrum() -> SpectrumDesc {
