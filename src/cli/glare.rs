@@ -153,6 +153,16 @@ fn interval_json(i: &Interval) -> serde_json::Value {
     })
 }
 
+/// An index's interval with the threshold selection's figures (`k` its place in
+/// [`candela::glare::Membership::shift`]) and its verdict.
+fn index_json(g: &UncertainGlare, name: &str, i: &Interval, k: usize) -> serde_json::Value {
+    let mut v = interval_json(i);
+    v["membership_shift"] = g.membership.shift[k].into();
+    v["membership_reach"] = g.membership.reach[k].into();
+    v["trusted"] = g.trusted(name).into();
+    v
+}
+
 fn json(g: &UncertainGlare) -> String {
     let r = &g.result;
     let sources: Vec<_> = r
@@ -171,17 +181,22 @@ fn json(g: &UncertainGlare) -> String {
         })
         .collect();
     let v = serde_json::json!({
-        "dgp": interval_json(&g.dgp),
-        "dgi": interval_json(&g.dgi),
-        "ugr": interval_json(&g.ugr),
-        "vcp": interval_json(&g.vcp),
-        "cgi": interval_json(&g.cgi),
+        "dgp": index_json(g, "DGP", &g.dgp, 0),
+        "dgi": index_json(g, "DGI", &g.dgi, 1),
+        "ugr": index_json(g, "UGR", &g.ugr, 2),
+        "vcp": index_json(g, "VCP", &g.vcp, 4),
+        "cgi": index_json(g, "CGI", &g.cgi, 3),
         "ev_lx": interval_json(&g.ev_lx),
         "ev_direct_lx": r.ev_direct_lx,
         "background_cd_m2": r.background_cd_m2,
         "mean_luminance_cd_m2": r.mean_luminance_cd_m2,
         "threshold_cd_m2": r.threshold_cd_m2,
         "sources": sources,
+        "membership": {
+            "pixels_within_2se": g.membership.pixels_within_2se,
+            "solid_angle_share_within_2se": g.membership.solid_angle_share_within_2se,
+        },
+        "untrusted": g.untrusted,
         "trustworthy": g.trustworthy,
         "warnings": g.warnings,
     });

@@ -8,8 +8,10 @@
 //! estimate (the value less its second-order bias from the noise, [`super::bias`]) ±
 //! t₀.₉₇₅(K − 1)·sd; the draws are corrected alike, so they centre on it. The sources'
 //! membership is a step function of the pixels, which no estimate corrects: pixels near the
-//! threshold must be converged for UGR and DGI to be calibrated (docs/glare.md). The draws also say whether the detection itself is stable: how often
-//! the number of sources changes, and how much luminous solid angle changes sides of the
+//! threshold must be converged for UGR and DGI to be calibrated (docs/glare.md), and an index
+//! that the pixels in doubt could move by more than its half-width ([`super::membership`]) is
+//! not trusted. The draws also say whether the detection itself is stable: how often the
+//! number of sources changes, and how much luminous solid angle changes sides of the
 //! threshold.
 //!
 //! Limits: pixels are taken as independent and normal (a path-traced pixel's mean over many
@@ -21,6 +23,7 @@
 use super::bias::{bias, CORRECTED};
 use super::image::{GlareImage, ImageError};
 use super::indices::{evaluate_detected, GlareOptions, GlareResult};
+use super::membership::{membership, Membership};
 use crate::meter::t95;
 use crate::sampling::mix64;
 
@@ -43,6 +46,10 @@ pub struct UncertainOptions {
     /// Largest mean share of the glare sources' L·ω that changes sides of the threshold in a
     /// draw (default 0.05).
     pub max_membership_flip: f64,
+    /// Largest reach of the threshold's selection of noisy pixels over an index
+    /// ([`Membership::reach`], how far the pixels in doubt could move it), as a multiple of
+    /// the index's 95 % half-width (default 1).
+    pub max_membership_reach: f64,
 }
 
 impl Default for UncertainOptions {
@@ -54,6 +61,7 @@ impl Default for UncertainOptions {
             max_ugr_half_width: 0.5,
             max_source_count_changes: 0.05,
             max_membership_flip: 0.05,
+            max_membership_reach: 1.0,
         }
     }
 }
@@ -72,6 +80,15 @@ pub struct Interval {
     /// 2.5 % and 97.5 % quantiles of the bias-corrected index over the draws (for skewed
     /// cases).
     pub quantiles: (f64, f64),
+}
+
+impl UncertainGlare {
+    /// Whether index `name` ("DGP", "DGI", "UGR", "CGI", "VCP") is trusted: the image passes
+    /// the image-wide checks and the index its own (each index in `untrusted` adds one
+    /// warning).
+    pub fn trusted(&self, name: &str) -> bool {
+        !self.untrusted.contains(&name) && self.warnings.len() == self.untrusted.len()
+    }
 }
 
 impl Interval {
@@ -102,6 +119,12 @@ pub struct UncertainGlare {
     /// Mean over the draws of the L·ω (of the image's own luminances) of the pixels whose
     /// glare membership differs from the image's, over the L·ω of the image's glare pixels.
     pub membership_flip: f64,
+    /// The threshold's selection of the image's noisy pixels (none without standard errors).
+    pub membership: Membership,
+    /// The indices ("DGP", "DGI", "UGR", "CGI") whose reach of the threshold's
+    /// selection passes [`UncertainOptions::max_membership_reach`] times their half-width: not
+    /// trusted at this noise.
+    pub untrusted: Vec<&'static str>,
     /// Whether the result is within every limit of [`UncertainOptions`].
     pub trustworthy: bool,
     /// The limits that were passed, in words.
@@ -176,6 +199,10 @@ pub fn evaluate_uncertain(
     let base_bias = match &img.stderr_cd_m2 {
         Some(se) => bias(img, &img.luminance_cd_m2, se, &base_det, &base, opt),
         None => [0.0; CORRECTED],
+    };
+    let member = match &img.stderr_cd_m2 {
+        Some(se) => membership(img, &img.luminance_cd_m2, se, &base_det, &base, opt),
+        None => Membership::default(),
     };
     let glare_flag = |r: &GlareResult, lum: &[f64]| -> Vec<bool> {
         // Pixels of the detected sources, recovered from the threshold (sources are exactly
@@ -265,16 +292,45 @@ pub fn evaluate_uncertain(
             100.0 * flip
         ));
     }
+    let out_dgi = interval(base.dgi, base.dgi - base_bias[1], &mut b);
+    let out_cgi = interval(base.cgi, base.cgi - base_bias[3], &mut f);
+    let out_vcp = interval(base.vcp, base.vcp, &mut e);
+    let mut untrusted = Vec::new();
+    for (k, (name, i)) in [
+        ("DGP", &out_dgp),
+        ("DGI", &out_dgi),
+        ("UGR", &out_ugr),
+        ("CGI", &out_cgi),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let reach = member.reach[k];
+        if k > 0 && reach > u.max_membership_reach * i.half_width {
+            untrusted.push(name);
+            warnings.push(format!(
+                "{name}: {} pixel(s) within 2 standard errors of the {:.0} cd/m² glare threshold \
+                 ({:.0} % of the sources' solid angle) could move it by {reach:.3}, more than its \
+                 95 % half-width {:.3}: not trusted at this noise (more samples needed)",
+                member.pixels_within_2se,
+                base.threshold_cd_m2,
+                100.0 * member.solid_angle_share_within_2se,
+                i.half_width
+            ));
+        }
+    }
     Ok(UncertainGlare {
-        dgi: interval(base.dgi, base.dgi - base_bias[1], &mut b),
-        vcp: interval(base.vcp, base.vcp, &mut e),
-        cgi: interval(base.cgi, base.cgi - base_bias[3], &mut f),
+        dgi: out_dgi,
+        vcp: out_vcp,
+        cgi: out_cgi,
         ev_lx: interval(base.ev_lx, base.ev_lx, &mut g),
         dgp: out_dgp,
         ugr: out_ugr,
         result: base,
         source_count_changes: changes,
         membership_flip: flip,
+        membership: member,
+        untrusted,
         trustworthy: warnings.is_empty(),
         warnings,
     })

@@ -6,7 +6,9 @@
 //!   solid angle, inside mask), and the geometry of Radiance's angular fisheye;
 //! - [`sources`]: glare-source detection (threshold, merging, peak extraction);
 //! - [`indices`]: position index, vertical illuminance and the indices DGP, DGI, UGR, VCP, CGI;
-//! - [`interval`]: the intervals, by simulation, and the verdict on a too-noisy image.
+//! - [`interval`]: the intervals, by simulation, and the verdict on a too-noisy image;
+//! - [`membership`]: how far the pixels near the threshold, whose side of it is in doubt,
+//!   could move each index.
 
 pub(crate) mod bias;
 pub mod file;
@@ -14,6 +16,7 @@ pub mod image;
 pub mod indices;
 pub mod interval;
 pub mod luminaires;
+pub mod membership;
 pub mod sources;
 
 pub use image::{angular_fisheye, GlareImage, ImageError};
@@ -24,4 +27,5 @@ pub use indices::{
 pub use interval::{
     evaluate_uncertain, significant_sources, Interval, UncertainGlare, UncertainOptions,
 };
+pub use membership::Membership;
 pub use sources::{DetectOptions, Task, Threshold};
