@@ -174,7 +174,7 @@ pub fn load_world_for(
     overrides: &Overrides,
     mode: &RunMode,
 ) -> Result<World, SceneError> {
-    let scene = if is_gltf_path(path) {
+    let scene = if super::gltf_scene::is_gltf_path(path) {
         super::gltf_scene::scene(path, overrides.camera.as_deref(), overrides.resolution)?
     } else {
         let scene = super::load(path)?;
@@ -190,13 +190,6 @@ pub fn load_world_for(
         scene
     };
     build_for(&scene, path, overrides, mode)
-}
-
-/// Whether a scene path is a glTF file (`.gltf`, `.glb`, any case), rendered as a whole scene.
-pub fn is_gltf_path(path: &Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
 fn object_field(i: usize, o: &ObjectDesc) -> String {

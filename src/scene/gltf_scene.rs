@@ -211,7 +211,14 @@ pub fn model_camera(
 }
 
 fn is_gltf(file: &str) -> bool {
-    super::build::is_gltf_path(Path::new(file))
+    is_gltf_path(Path::new(file))
+}
+
+/// Whether a scene path is a glTF file (`.gltf`, `.glb`, any case), rendered as a whole scene.
+pub fn is_gltf_path(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
 /// The scene that renders glTF file `path` on its own, through its camera `camera` (see
