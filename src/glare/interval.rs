@@ -50,6 +50,10 @@ pub struct UncertainOptions {
     /// ([`Membership::reach`], how far the pixels in doubt could move it), as a multiple of
     /// the index's 95 % half-width (default 1).
     pub max_membership_reach: f64,
+    /// Smallest share of the sources' solid angle in pixels within 2 standard errors of the
+    /// threshold for the reach to decide trust (default 0.10): below it the draws' intervals,
+    /// which re-select the sources, already hold the selection's noise.
+    pub min_membership_share: f64,
 }
 
 impl Default for UncertainOptions {
@@ -62,6 +66,7 @@ impl Default for UncertainOptions {
             max_source_count_changes: 0.05,
             max_membership_flip: 0.05,
             max_membership_reach: 1.0,
+            min_membership_share: 0.10,
         }
     }
 }
@@ -306,7 +311,10 @@ pub fn evaluate_uncertain(
     .enumerate()
     {
         let reach = member.reach[k];
-        if k > 0 && reach > u.max_membership_reach * i.half_width {
+        if k > 0
+            && reach > u.max_membership_reach * i.half_width
+            && member.solid_angle_share_within_2se >= u.min_membership_share
+        {
             untrusted.push(name);
             warnings.push(format!(
                 "{name}: {} pixel(s) within 2 standard errors of the {:.0} cd/m² glare threshold \
