@@ -26,8 +26,7 @@ pub struct RayHit {
 
 /// [`super::prim::intersect_triangle`] with the vertex transform and the edge functions in SIMD (the
 /// three vertices in three lanes); every operation and its rounding is the same as in the
-/// scalar test, so the results are bit-identical. `v` may also be the marker of a non-triangle
-/// primitive (NaN first vertex), which is then tested from `others`.
+/// scalar test, so the results are bit-identical.
 #[cfg(all(
     target_arch = "x86_64",
     target_feature = "avx2",
@@ -38,7 +37,6 @@ fn intersect_triangle_simd<const KZ: usize>(
     r: &RayPre,
     t_max: f32,
     v: &[Vec3; 3],
-    others: &[Prim],
 ) -> Option<PrimT> {
     use std::arch::x86_64::*;
     let kx = (KZ + 1) % 3;
@@ -86,11 +84,6 @@ fn intersect_triangle_simd<const KZ: usize>(
         let pos = _mm_movemask_ps(_mm_cmpgt_ps(e, zero)) & 7;
         if neg != 0 && pos != 0 {
             return None;
-        }
-        // A marker for a non-triangle primitive (see `SceneGeometry::tris`) gets here: its first
-        // vertex is NaN, so two of its edge functions are NaN and the sign test cannot reject it.
-        if v[0].x.is_nan() {
-            return others[v[1].x.to_bits() as usize].intersect::<KZ>(r, t_max);
         }
         let mut xa = [0.0f32; 4];
         let mut ya = [0.0f32; 4];
@@ -233,28 +226,30 @@ impl SceneGeometry {
         (c.best.0 != u32::MAX).then_some(c.best)
     }
 
-    /// Ray test of primitive `id` (a leaf primitive id from the traversal).
+    /// Ray test of primitive `id` (a leaf primitive id from the traversal). The marker of a
+    /// non-triangle primitive (NaN first vertex, see `SceneGeometry::tris`) is checked first, so
+    /// that analytic primitives skip the triangle test; in triangle scenes the branch is always
+    /// taken the same way.
     #[inline(always)]
     fn prim_intersect<const KZ: usize>(&self, id: u32, pre: &RayPre, t_max: f32) -> Option<PrimT> {
         debug_assert!((id as usize) < self.tris.len());
         // SAFETY: leaf primitive ids index `tris` (same length as the builder's input).
         let v = unsafe { self.tris.get_unchecked(id as usize) };
+        if v[0].x.is_nan() {
+            return self.others[v[1].x.to_bits() as usize].intersect::<KZ>(pre, t_max);
+        }
         #[cfg(all(
             target_arch = "x86_64",
             target_feature = "avx2",
             target_feature = "fma"
         ))]
-        return intersect_triangle_simd::<KZ>(pre, t_max, v, &self.others);
+        return intersect_triangle_simd::<KZ>(pre, t_max, v);
         #[cfg(not(all(
             target_arch = "x86_64",
             target_feature = "avx2",
             target_feature = "fma"
         )))]
-        if v[0].x.is_nan() {
-            self.others[v[1].x.to_bits() as usize].intersect::<KZ>(pre, t_max)
-        } else {
-            super::prim::intersect_triangle::<KZ>(pre, t_max, v)
-        }
+        super::prim::intersect_triangle::<KZ>(pre, t_max, v)
     }
 
     /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
