@@ -231,11 +231,7 @@ impl SceneGeometry {
                             format!("origin {origin}, edges {edge_u} and {edge_v} must be finite and not parallel (the quad has zero area)"),
                         ));
                     }
-                    prims.push(Prim::Quad {
-                        origin: *origin,
-                        edge_u: *edge_u,
-                        edge_v: *edge_v,
-                    });
+                    prims.push(Prim::quad(*origin, *edge_u, *edge_v));
                 }
                 Shape::Disk {
                     center,

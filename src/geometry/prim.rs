@@ -2,9 +2,10 @@
 //!
 //! Triangles use the watertight test of Woop, Benthin & Wald (2013) as in pbrt-v4, with the
 //! 2×2 edge determinants evaluated exactly-rounded in f64 and pbrt's conservative `t > δt`
-//! check. Spheres, quads and disks are intersected in f64 (their counts are small), which makes
-//! the side-of-surface decisions essentially exact; together with [`super::offset_ray_origin`]
-//! this prevents self-intersection at any scale.
+//! check. Spheres, quads and disks are intersected in f64, which makes the side-of-surface
+//! decisions essentially exact; together with [`super::offset_ray_origin`] this prevents
+//! self-intersection at any scale. Quads carry their plane normal and dual edge vectors,
+//! precomputed in f64, so that their test is a handful of dot products and one division.
 
 use super::robust::gamma;
 use glam::{DVec3, Vec2, Vec3};
@@ -16,10 +17,12 @@ pub(crate) enum Prim {
         center: Vec3,
         radius: f32,
     },
+    /// Built with [`Prim::quad`], which fills in `pre`.
     Quad {
         origin: Vec3,
         edge_u: Vec3,
         edge_v: Vec3,
+        pre: QuadPre,
     },
     /// `normal` is unit length.
     Disk {
@@ -27,6 +30,40 @@ pub(crate) enum Prim {
         normal: Vec3,
         radius: f32,
     },
+}
+
+/// A quad's ray-test data, in f64 from its f32 edges: the (unnormalized) plane normal
+/// n = edge_u × edge_v and the dual edge vectors, which give the parameters of a point p of
+/// the plane as s = du·(p − origin), t = dv·(p − origin).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct QuadPre {
+    pub n: DVec3,
+    /// n / |n| rounded to f32: the front-face normal.
+    pub unit_n: Vec3,
+    /// (edge_v × n) / |n|².
+    pub du: DVec3,
+    /// (n × edge_u) / |n|².
+    pub dv: DVec3,
+}
+
+impl Prim {
+    /// The parallelogram origin + s·edge_u + t·edge_v, s, t ∈ \[0, 1\] (edges not parallel).
+    pub fn quad(origin: Vec3, edge_u: Vec3, edge_v: Vec3) -> Prim {
+        let (eu, ev) = (edge_u.as_dvec3(), edge_v.as_dvec3());
+        let n = eu.cross(ev);
+        let nn = n.length_squared();
+        Prim::Quad {
+            origin,
+            edge_u,
+            edge_v,
+            pre: QuadPre {
+                n,
+                unit_n: n.normalize().as_vec3(),
+                du: ev.cross(n) / nn,
+                dv: n.cross(eu) / nn,
+            },
+        }
+    }
 }
 
 /// Per-ray precomputation shared by all primitive tests.
@@ -204,33 +241,40 @@ pub(crate) fn intersect_sphere(r: &RayPre, t_max: f32, center: Vec3, radius: f32
     (t > 0.0 && t32 > 0.0 && t32 < t_max).then_some((t32, 0.0, 0.0))
 }
 
-#[inline]
-pub(crate) fn intersect_quad(
-    r: &RayPre,
-    t_max: f32,
-    origin: Vec3,
-    eu: Vec3,
-    ev: Vec3,
-) -> Option<PrimT> {
-    let (o, eu, ev) = (origin.as_dvec3(), eu.as_dvec3(), ev.as_dvec3());
-    let n = eu.cross(ev);
-    let den = r.dd.dot(n);
-    if den == 0.0 {
+/// Ray–parallelogram test in f64. With w = origin − o, the plane's t is (w·n) / (d·n), and the
+/// parameters of the plane point p = o + t·d are s = du·(p − origin) = (t·du·d − du·w) and
+/// likewise for dv. Every rejection is decided before dividing, on t·(d·n) and s·(d·n): the
+/// division's latency would otherwise hold up each (often mispredicted) branch.
+#[inline(always)]
+pub(crate) fn intersect_quad(r: &RayPre, t_max: f32, origin: Vec3, q: &QuadPre) -> Option<PrimT> {
+    let w = origin.as_dvec3() - r.od;
+    let num = w.dot(q.n);
+    let den = r.dd.dot(q.n);
+    let den_abs = den.abs();
+    // t > 0 (which also excludes den = 0) and t < t_max, the latter with a relative margin of
+    // 1e-6 that covers the rounding of t to f32: the exact test follows the division.
+    if !(num * den > 0.0 && num.abs() < den_abs * (t_max as f64 * (1.0 + 1e-6))) {
         return None;
     }
-    let t = (o - r.od).dot(n) / den;
+    // s·|d·n| and t·|d·n| (the parameters' sign follows d·n's; ×±1 is exact).
+    let sign = if den < 0.0 { -1.0 } else { 1.0 };
+    let sd = sign * (num * r.dd.dot(q.du) - den * w.dot(q.du));
+    let vd = sign * (num * r.dd.dot(q.dv) - den * w.dot(q.dv));
+    if !(sd >= 0.0 && sd <= den_abs && vd >= 0.0 && vd <= den_abs) {
+        return None;
+    }
+    let t = num / den;
     let t32 = t as f32;
     if !(t > 0.0 && t32 > 0.0 && t32 < t_max) {
         return None;
     }
-    let rel = r.od + t * r.dd - o;
-    let nn = n.length_squared();
-    let s = rel.cross(ev).dot(n) / nn;
-    let v = eu.cross(rel).dot(n) / nn;
-    if !((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&v)) {
-        return None;
-    }
-    Some((t32, s as f32, v as f32))
+    // In [0, 1] up to the division's rounding, which `min` removes.
+    let inv = 1.0 / den_abs;
+    Some((
+        t32,
+        ((sd * inv) as f32).min(1.0),
+        ((vd * inv) as f32).min(1.0),
+    ))
 }
 
 #[inline]
@@ -320,11 +364,7 @@ impl Prim {
         match self {
             Prim::Triangle(p) => intersect_triangle::<KZ>(r, t_max, p),
             Prim::Sphere { center, radius } => intersect_sphere(r, t_max, *center, *radius),
-            Prim::Quad {
-                origin,
-                edge_u,
-                edge_v,
-            } => intersect_quad(r, t_max, *origin, *edge_u, *edge_v),
+            Prim::Quad { origin, pre, .. } => intersect_quad(r, t_max, *origin, pre),
             Prim::Disk {
                 center,
                 normal,
@@ -350,6 +390,7 @@ impl Prim {
                 origin,
                 edge_u,
                 edge_v,
+                ..
             } => {
                 let pts = [
                     origin,
@@ -400,11 +441,7 @@ impl Prim {
         match *self {
             Prim::Triangle(v) => triangle_normal(&v),
             Prim::Sphere { center, .. } => (p.as_dvec3() - center.as_dvec3()).normalize().as_vec3(),
-            Prim::Quad { edge_u, edge_v, .. } => edge_u
-                .as_dvec3()
-                .cross(edge_v.as_dvec3())
-                .normalize()
-                .as_vec3(),
+            Prim::Quad { pre, .. } => pre.unit_n,
             Prim::Disk { normal, .. } => normal.as_dvec3().normalize().as_vec3(),
         }
     }
@@ -441,6 +478,7 @@ impl Prim {
                 origin,
                 edge_u,
                 edge_v,
+                ..
             } => {
                 let (o, eu, ev) = (origin.as_dvec3(), edge_u.as_dvec3(), edge_v.as_dvec3());
                 let (s, v) = (a as f64, b as f64);
@@ -501,6 +539,7 @@ impl Prim {
                 origin,
                 edge_u,
                 edge_v,
+                ..
             } => {
                 let p = origin.as_dvec3() + u0 * edge_u.as_dvec3() + u1 * edge_v.as_dvec3();
                 let p = p.as_vec3();

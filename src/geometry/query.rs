@@ -26,8 +26,7 @@ pub struct RayHit {
 
 /// [`super::prim::intersect_triangle`] with the vertex transform and the edge functions in SIMD (the
 /// three vertices in three lanes); every operation and its rounding is the same as in the
-/// scalar test, so the results are bit-identical. `v` may also be the marker of a non-triangle
-/// primitive (NaN first vertex), which is then tested from `others`.
+/// scalar test, so the results are bit-identical.
 #[cfg(all(
     target_arch = "x86_64",
     target_feature = "avx2",
@@ -38,7 +37,6 @@ fn intersect_triangle_simd<const KZ: usize>(
     r: &RayPre,
     t_max: f32,
     v: &[Vec3; 3],
-    others: &[Prim],
 ) -> Option<PrimT> {
     use std::arch::x86_64::*;
     let kx = (KZ + 1) % 3;
@@ -86,11 +84,6 @@ fn intersect_triangle_simd<const KZ: usize>(
         let pos = _mm_movemask_ps(_mm_cmpgt_ps(e, zero)) & 7;
         if neg != 0 && pos != 0 {
             return None;
-        }
-        // A marker for a non-triangle primitive (see `SceneGeometry::tris`) gets here: its first
-        // vertex is NaN, so two of its edge functions are NaN and the sign test cannot reject it.
-        if v[0].x.is_nan() {
-            return others[v[1].x.to_bits() as usize].intersect::<KZ>(r, t_max);
         }
         let mut xa = [0.0f32; 4];
         let mut ya = [0.0f32; 4];
@@ -200,17 +193,34 @@ impl SceneGeometry {
 
     #[inline(always)]
     fn closest<const KZ: usize>(&self, pre: &RayPre, t_max: f32) -> Option<(u32, f32, f32, f32)> {
-        struct Closest<'a, const KZ: usize> {
+        if self.others.is_empty() {
+            self.closest_in::<KZ, false>(pre, t_max)
+        } else {
+            self.closest_in::<KZ, true>(pre, t_max)
+        }
+    }
+
+    /// [`SceneGeometry::closest`] for a scene with (`ANALYTIC`) or without non-triangle
+    /// primitives.
+    #[inline(always)]
+    fn closest_in<const KZ: usize, const ANALYTIC: bool>(
+        &self,
+        pre: &RayPre,
+        t_max: f32,
+    ) -> Option<(u32, f32, f32, f32)> {
+        struct Closest<'a, const KZ: usize, const ANALYTIC: bool> {
             geo: &'a SceneGeometry,
             pre: &'a RayPre,
             best: (u32, f32, f32, f32),
         }
-        impl<const KZ: usize> LeafTest for Closest<'_, KZ> {
+        impl<const KZ: usize, const ANALYTIC: bool> LeafTest for Closest<'_, KZ, ANALYTIC> {
             #[inline(always)]
             fn leaf(&mut self, first: u32, unary: u32, mut t_max: f32) -> Option<f32> {
                 let (mut id, mut u) = (first, unary);
                 while u != 0 {
-                    if let Some((t, a, b)) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max) {
+                    if let Some((t, a, b)) =
+                        self.geo.prim_intersect::<KZ, ANALYTIC>(id, self.pre, t_max)
+                    {
                         self.best = (id, t, a, b);
                         t_max = t;
                     }
@@ -224,7 +234,7 @@ impl SceneGeometry {
                 prefetch(self.geo.tris.as_ptr().wrapping_add(first as usize) as *const u8);
             }
         }
-        let mut c = Closest::<KZ> {
+        let mut c = Closest::<KZ, ANALYTIC> {
             geo: self,
             pre,
             best: (u32::MAX, t_max, 0.0, 0.0),
@@ -233,28 +243,36 @@ impl SceneGeometry {
         (c.best.0 != u32::MAX).then_some(c.best)
     }
 
-    /// Ray test of primitive `id` (a leaf primitive id from the traversal).
+    /// Ray test of primitive `id` (a leaf primitive id from the traversal). With `ANALYTIC` (the
+    /// scene has non-triangle primitives) the marker of one (NaN first vertex, see
+    /// `SceneGeometry::tris`) is checked first, so that analytic primitives skip the triangle
+    /// test; without, there are no markers and triangles pay nothing for the check.
     #[inline(always)]
-    fn prim_intersect<const KZ: usize>(&self, id: u32, pre: &RayPre, t_max: f32) -> Option<PrimT> {
+    fn prim_intersect<const KZ: usize, const ANALYTIC: bool>(
+        &self,
+        id: u32,
+        pre: &RayPre,
+        t_max: f32,
+    ) -> Option<PrimT> {
         debug_assert!((id as usize) < self.tris.len());
         // SAFETY: leaf primitive ids index `tris` (same length as the builder's input).
         let v = unsafe { self.tris.get_unchecked(id as usize) };
+        debug_assert!(ANALYTIC || !v[0].x.is_nan());
+        if ANALYTIC && v[0].x.is_nan() {
+            return self.others[v[1].x.to_bits() as usize].intersect::<KZ>(pre, t_max);
+        }
         #[cfg(all(
             target_arch = "x86_64",
             target_feature = "avx2",
             target_feature = "fma"
         ))]
-        return intersect_triangle_simd::<KZ>(pre, t_max, v, &self.others);
+        return intersect_triangle_simd::<KZ>(pre, t_max, v);
         #[cfg(not(all(
             target_arch = "x86_64",
             target_feature = "avx2",
             target_feature = "fma"
         )))]
-        if v[0].x.is_nan() {
-            self.others[v[1].x.to_bits() as usize].intersect::<KZ>(pre, t_max)
-        } else {
-            super::prim::intersect_triangle::<KZ>(pre, t_max, v)
-        }
+        super::prim::intersect_triangle::<KZ>(pre, t_max, v)
     }
 
     /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
@@ -392,18 +410,36 @@ impl SceneGeometry {
         t_max: f32,
         pass: impl FnMut(u32, &RayPre, PrimT) -> bool,
     ) -> bool {
-        struct AnyHit<'a, F, const KZ: usize> {
+        if self.others.is_empty() {
+            self.any_hit_in::<KZ, false>(pre, t_max, pass)
+        } else {
+            self.any_hit_in::<KZ, true>(pre, t_max, pass)
+        }
+    }
+
+    /// [`SceneGeometry::any_hit`] for a scene with (`ANALYTIC`) or without non-triangle
+    /// primitives.
+    #[inline(always)]
+    fn any_hit_in<const KZ: usize, const ANALYTIC: bool>(
+        &self,
+        pre: &RayPre,
+        t_max: f32,
+        pass: impl FnMut(u32, &RayPre, PrimT) -> bool,
+    ) -> bool {
+        struct AnyHit<'a, F, const KZ: usize, const ANALYTIC: bool> {
             geo: &'a SceneGeometry,
             pre: &'a RayPre,
             pass: F,
             hit: bool,
         }
-        impl<F: FnMut(u32, &RayPre, PrimT) -> bool, const KZ: usize> LeafTest for AnyHit<'_, F, KZ> {
+        impl<F: FnMut(u32, &RayPre, PrimT) -> bool, const KZ: usize, const ANALYTIC: bool> LeafTest
+            for AnyHit<'_, F, KZ, ANALYTIC>
+        {
             #[inline(always)]
             fn leaf(&mut self, first: u32, unary: u32, t_max: f32) -> Option<f32> {
                 let (mut id, mut u) = (first, unary);
                 while u != 0 {
-                    if let Some(h) = self.geo.prim_intersect::<KZ>(id, self.pre, t_max) {
+                    if let Some(h) = self.geo.prim_intersect::<KZ, ANALYTIC>(id, self.pre, t_max) {
                         if !(self.pass)(id, self.pre, h) {
                             self.hit = true;
                             return None;
@@ -419,7 +455,7 @@ impl SceneGeometry {
                 prefetch(self.geo.tris.as_ptr().wrapping_add(first as usize) as *const u8);
             }
         }
-        let mut a = AnyHit::<_, KZ> {
+        let mut a = AnyHit::<_, KZ, ANALYTIC> {
             geo: self,
             pre,
             pass,

@@ -59,24 +59,65 @@ pub fn point_error_bound(p: Vec3) -> Vec3 {
 /// the offset is proportional to the floating-point error of `p` (Ray Tracing Gems ch. 6 /
 /// pbrt-v4 `OffsetRayOrigin`). The offset is tiny (≈ 1e-6 relative to |p|), so contact
 /// shadows are preserved. A ray into the surface (`dot(w, ng) < 0`) starts just below it.
-#[inline]
+#[inline(always)]
 pub fn offset_ray_origin(p: Vec3, error: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
     let d = ng.abs().dot(error);
     let d = if w.dot(ng) < 0.0 { -d } else { d };
     let offset = ng * d;
-    let po = p + offset;
-    // Both neighbours computed and one selected: the sign of the offset is data-dependent, and
-    // branching on it mispredicted often enough to show in profiles.
+    step_toward3(p + offset, offset)
+}
+
+/// [`step_toward`] of each component. Both neighbours are computed and one selected: the sign
+/// of the offset is data-dependent, and branching on it mispredicted often enough to show in
+/// profiles. On x86-64 the three components are stepped side by side in SSE lanes, with the
+/// same integer operations as [`step_toward`].
+#[inline(always)]
+fn step_toward3(v: Vec3, dir: Vec3) -> Vec3 {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE2 is part of x86-64; only register operations.
+    unsafe {
+        use std::arch::x86_64::*;
+        let vf = _mm_setr_ps(v.x, v.y, v.z, 0.0);
+        let df = _mm_setr_ps(dir.x, dir.y, dir.z, 0.0);
+        let (vb, db) = (_mm_castps_si128(vf), _mm_castps_si128(df));
+        let sign = _mm_set1_epi32(i32::MIN);
+        let one = _mm_set1_epi32(1);
+        // All ones where v and dir differ in sign (a step toward zero), else 0.
+        let toward = _mm_srai_epi32::<31>(_mm_xor_si128(vb, db));
+        // v + 1 away from zero, v − 1 toward it.
+        let stepped = _mm_add_epi32(vb, _mm_or_si128(toward, one));
+        // ±0 steps to the smallest subnormal of dir's sign.
+        let from_zero = _mm_or_si128(_mm_and_si128(db, sign), one);
+        let is_zero = _mm_cmpeq_epi32(_mm_slli_epi32::<1>(vb), _mm_setzero_si128());
+        let select = |m: __m128i, a: __m128i, b: __m128i| {
+            _mm_or_si128(_mm_and_si128(m, a), _mm_andnot_si128(m, b))
+        };
+        let bits = select(is_zero, from_zero, stepped);
+        // v unchanged for dir = ±0, a NaN v, and an infinite v moving out.
+        let dir_zero = _mm_castps_si128(_mm_cmpeq_ps(df, _mm_setzero_ps()));
+        let v_nan = _mm_castps_si128(_mm_cmpunord_ps(vf, vf));
+        let v_inf = _mm_cmpeq_epi32(_mm_andnot_si128(sign, vb), _mm_set1_epi32(0x7f80_0000));
+        let keep = _mm_or_si128(
+            _mm_or_si128(dir_zero, v_nan),
+            _mm_andnot_si128(toward, v_inf),
+        );
+        let mut out = [0.0f32; 4];
+        _mm_storeu_ps(out.as_mut_ptr(), _mm_castsi128_ps(select(keep, vb, bits)));
+        Vec3::new(out[0], out[1], out[2])
+    }
+    #[cfg(not(target_arch = "x86_64"))]
     Vec3::new(
-        step_toward(po.x, offset.x),
-        step_toward(po.y, offset.y),
-        step_toward(po.z, offset.z),
+        step_toward(v.x, dir.x),
+        step_toward(v.y, dir.y),
+        step_toward(v.z, dir.z),
     )
 }
 
 /// `v` moved one ulp toward the sign of `dir` (unchanged for `dir` = 0, NaN, and ±∞ moving out):
 /// the same as [`next_float_up`] / [`next_float_down`], on the bit pattern without branches
 /// (the sign of the offset is data-dependent, and the branchy version showed in profiles).
+/// (On x86-64 only the reference of [`step_toward3`]'s tests.)
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 #[inline(always)]
 fn step_toward(v: f32, dir: f32) -> f32 {
     let (vb, db) = (v.to_bits(), dir.to_bits());
@@ -169,6 +210,44 @@ mod tests {
                     got.to_bits() == want.to_bits() || (got == 0.0 && want == 0.0),
                     "step_toward({v:e}, {d}) = {got:e}, want {want:e}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn step_toward3_is_step_toward_per_component() {
+        let values = [
+            0.0f32,
+            -0.0,
+            1.0,
+            -1.0,
+            3.5e-39,
+            -3.5e-39,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            123.456,
+            -7.0e20,
+            f32::MAX,
+            -f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for (i, &a) in values.iter().enumerate() {
+            for (j, &b) in values.iter().enumerate() {
+                let c = values[(i + j) % values.len()];
+                let (v, d) = (Vec3::new(a, b, c), Vec3::new(b, c, a));
+                let got = step_toward3(v, d);
+                for k in 0..3 {
+                    let want = step_toward(v[k], d[k]);
+                    assert!(
+                        got[k].to_bits() == want.to_bits(),
+                        "step_toward3 component {k}: ({:e}, {:e}) gave {:e}, want {want:e}",
+                        v[k],
+                        d[k],
+                        got[k]
+                    );
+                }
             }
         }
     }
