@@ -87,7 +87,8 @@ pub fn render_pixel(
         );
         if let Some(e) = e.as_deref_mut() {
             let mel = health.as_ref().is_some_and(|h| h.wants_irradiance());
-            let v = surface_illuminance(world, seed, ray.origin, ray.dir, batch, index, mel, stats);
+            let seen = (ray.origin, ray.dir, &l, &wl);
+            let v = surface_illuminance(world, seed, seen, batch, index, mel, stats);
             if let (Some(h), Some((_, m))) = (health.as_mut(), v) {
                 h.add_edi(sums.count, m);
             }
@@ -118,17 +119,31 @@ pub fn pixel_batch(pixel: u64, s: u64) -> (u64, u64) {
 /// Stream id of the illuminance estimates (independent of the radiance samples).
 const ILLUMINANCE_STREAM: u64 = 0x11_1c_e5_7a_u64 << 20;
 
+/// Smallest reflectance at each of the camera path's wavelengths for its radiance to give the
+/// illuminance (below it, or at a surface that is not Lambertian, a path of its own does).
+const MIN_REUSED_REFLECTANCE: f32 = 1e-4;
+
 /// Illuminance (lx) on the surface a camera ray sees, or None if it sees no receiving surface
-/// (nothing, the sky, or an emitter). `seed` is the buffer's stream (the decision buffer of
-/// adaptive mode has its own), so each buffer's illuminance samples are independent; `pixel`
-/// and `sample` are the camera sample's batch stream and index in it ([`pixel_batch`]). With
-/// `melanopic`, the second value is the melanopic EDI (lx) of the same estimate, else 0.
+/// (nothing, the sky, or an emitter). `seen` is the camera ray (origin, direction) with the
+/// radiance its path brought and that path's wavelengths. At a flat-shaded Lambertian surface
+/// of reflectance ρ(λ) the surface reflects ρ/π of its irradiance, so π L/ρ is an irradiance
+/// estimator of the same form as [`crate::integrator::irradiance`] (light sampling weighed
+/// against the cosine-sampled continuation, which Lambertian sampling is) at no further cost;
+/// elsewhere a path of its own estimates it: `seed` is the buffer's stream (the decision buffer
+/// of adaptive mode has its own), so each buffer's illuminance samples are independent of its
+/// other buffers'; `pixel` and `sample` are the camera sample's batch stream and index in it
+/// ([`pixel_batch`]). With `melanopic`, the second value is the melanopic EDI (lx) of the same
+/// estimate, else 0.
 #[allow(clippy::too_many_arguments)]
 fn surface_illuminance(
     world: &World,
     seed: u64,
-    origin: glam::Vec3,
-    dir: glam::Vec3,
+    (origin, dir, l, wl_cam): (
+        glam::Vec3,
+        glam::Vec3,
+        &crate::spectrum::SampledSpectrum,
+        &SampledWavelengths,
+    ),
     pixel: u64,
     sample: u64,
     melanopic: bool,
@@ -136,21 +151,40 @@ fn surface_illuminance(
 ) -> Option<(f64, f64)> {
     let hit = world.geometry.intersect(origin, dir, f32::INFINITY)?;
     stats.camera_rays += 1;
-    if world.objects[hit.object as usize].light.is_some() {
+    let object = world.objects[hit.object as usize];
+    if object.light.is_some() {
         return None;
     }
-    // The hemisphere on the side of the surface facing the camera.
-    let n = if hit.ng.dot(dir) > 0.0 {
-        -hit.ng
-    } else {
-        hit.ng
+    let material = &world.materials[object.material as usize];
+    let reused = (hit.ns.dot(hit.ng) >= 1.0 - 1e-6)
+        .then(|| material.lambertian_reflectance(hit.tex, wl_cam))
+        .flatten()
+        .filter(|rho| rho.0.iter().all(|&r| r >= MIN_REUSED_REFLECTANCE));
+    let (e, wl) = match reused {
+        Some(rho) => ((*l * std::f32::consts::PI).safe_div(rho), *wl_cam),
+        None => {
+            // The hemisphere on the side of the surface facing the camera.
+            let n = if hit.ng.dot(dir) > 0.0 {
+                -hit.ng
+            } else {
+                hit.ng
+            };
+            let mut sampler = Sampler::new(seed ^ ILLUMINANCE_STREAM, pixel, sample);
+            let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
+            let at = crate::integrator::RayStart::surface(&hit);
+            let light_traced = world.caustics.is_some();
+            let e = crate::integrator::irradiance(
+                world,
+                &at,
+                n,
+                light_traced,
+                &mut wl,
+                &mut sampler,
+                stats,
+            );
+            (e, wl)
+        }
     };
-    let mut sampler = Sampler::new(seed ^ ILLUMINANCE_STREAM, pixel, sample);
-    let mut wl = SampledWavelengths::sample_visible(sampler.get1d());
-    let at = crate::integrator::RayStart::surface(&hit);
-    let light_traced = world.caustics.is_some();
-    let e =
-        crate::integrator::irradiance(world, &at, n, light_traced, &mut wl, &mut sampler, stats);
     let lux = radiance_to_xyz(&e, &wl)[1];
     let m = if melanopic {
         crate::film::health_melanopic_edi(&e, &wl)

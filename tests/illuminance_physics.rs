@@ -58,10 +58,28 @@ fn point_light_illuminance_channel_whatever_the_reflectance() {
     }
 }
 
+/// A Lambertian surface's illuminance comes from the camera path's own radiance (π L/ρ), so
+/// the channel is checked against L here with the plane under a flat normal map, which makes
+/// the illuminance an estimate of its own (a path from the surface) that does not share L's
+/// samples.
 #[test]
 fn luminance_is_rho_e_over_pi_of_the_illuminance_channel() {
     let rho = 0.5;
-    let film = render(&point_over_plane(rho, ""), 2);
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("illuminance_rho_e");
+    std::fs::create_dir_all(&dir).unwrap();
+    image::RgbImage::from_pixel(1, 1, image::Rgb([128, 128, 255]))
+        .save(dir.join("flat.png"))
+        .unwrap();
+    let text = format!(
+        r#"(
+        camera: (position: (0.3, 3.0, -1.0), look_at: (0.5, 0.0, 0.5), vfov_deg: 40, resolution: (12, 12)),
+        render: (spp: 64, illuminance: true),
+        materials: {{ "plane": NormalMapped(material: Diffuse(reflectance: Constant({rho})), file: "flat.png") }},
+        objects: [(shape: Quad(origin: (-50, 0, -50), edge_u: (0, 0, 100), edge_v: (100, 0, 0)), material: "plane")],
+        lights: [Point(position: (0, {H}, 0), spectrum: Named("D65"), amount: Intensity({I_CD}))],
+    )"#
+    );
+    let film = render(&world_in(&text, &dir), 2);
     for (i, p) in film.pixels_e().enumerate() {
         let l = p.mean_xyz()[1];
         let e = p.mean_e().unwrap();
@@ -372,4 +390,73 @@ fn skylight_through_an_opening_with_and_without_a_portal() {
         near.stderr,
         near_without.stderr
     );
+}
+
+/// The two illuminance estimators agree: in a closed grey room lit by a point light, the
+/// channel of a Lambertian surface (π L/ρ from the camera path) and of the same surface under
+/// a flat normal map (a path of its own from the surface) match block by block within their
+/// standard errors, and both match the point light's direct illuminance plus the same
+/// inter-reflected light on average.
+#[test]
+fn lambertian_illuminance_from_the_camera_path_matches_a_path_of_its_own() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("illuminance_reuse");
+    std::fs::create_dir_all(&dir).unwrap();
+    image::RgbImage::from_pixel(1, 1, image::Rgb([128, 128, 255]))
+        .save(dir.join("flat.png"))
+        .unwrap();
+    let scene = |material: &str| {
+        format!(
+            r#"(
+        camera: (position: (0, 1.5, -1.9), look_at: (0, 0.8, 1), vfov_deg: 70, resolution: (16, 16)),
+        render: (spp: 256, illuminance: true),
+        materials: {{ "grey": {material} }},
+        objects: [
+            (shape: Quad(origin: (-2, 0, -2), edge_u: (0, 0, 4), edge_v: (4, 0, 0)), material: "grey"),
+            (shape: Quad(origin: (-2, 3, -2), edge_u: (4, 0, 0), edge_v: (0, 0, 4)), material: "grey"),
+            (shape: Quad(origin: (-2, 0, -2), edge_u: (4, 0, 0), edge_v: (0, 3, 0)), material: "grey"),
+            (shape: Quad(origin: (-2, 0, 2), edge_u: (0, 3, 0), edge_v: (4, 0, 0)), material: "grey"),
+            (shape: Quad(origin: (-2, 0, -2), edge_u: (0, 3, 0), edge_v: (0, 0, 4)), material: "grey"),
+            (shape: Quad(origin: (2, 0, -2), edge_u: (0, 0, 4), edge_v: (0, 3, 0)), material: "grey"),
+        ],
+        lights: [Point(position: (0.3, 2.5, 0.4), spectrum: Named("D65"), amount: Intensity(300.0))],
+    )"#
+        )
+    };
+    let diffuse = "Diffuse(reflectance: Rgb(0.7, 0.6, 0.5))";
+    let reused = render(&world_in(&scene(diffuse), &dir), 2);
+    let own = render(
+        &world_in(
+            &scene(&format!(
+                "NormalMapped(material: {diffuse}, file: \"flat.png\")"
+            )),
+            &dir,
+        ),
+        2,
+    );
+    // 4 × 4 blocks of the E channel.
+    let blocks = |f: &candela::film::Film| -> Vec<(f64, f64)> {
+        let mut out = vec![(0.0, 0.0); 16];
+        for (i, p) in f.pixels_e().enumerate() {
+            let (x, y) = (i % 16, i / 16);
+            let b = &mut out[(y / 4) * 4 + x / 4];
+            b.0 += p.mean_e().unwrap() / 16.0;
+            b.1 += (p.e_standard_error() / 16.0).powi(2);
+        }
+        out.into_iter().map(|(m, v)| (m, v.sqrt())).collect()
+    };
+    let (a, b) = (blocks(&reused), blocks(&own));
+    let mut worst = 0.0f64;
+    for (k, ((ma, sa), (mb, sb))) in a.iter().zip(&b).enumerate() {
+        let z = (ma - mb) / (sa * sa + sb * sb).sqrt();
+        worst = worst.max(z.abs());
+        assert!(
+            z.abs() < 4.5,
+            "block {k}: {ma} ± {sa} lx (π L/ρ) vs {mb} ± {sb} lx (own path)"
+        );
+        assert!(
+            *sa < 0.03 * ma && *sb < 0.03 * mb,
+            "block {k}: too noisy to compare"
+        );
+    }
+    eprintln!("largest block |z| {worst:.2}");
 }

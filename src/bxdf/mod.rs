@@ -428,6 +428,24 @@ impl Material {
         }
     }
 
+    /// The reflectance ρ(λ) at `wl` of a Lambertian material at texture coordinates `tex`
+    /// (`Diffuse`, a textured one, or a metallic-roughness material that is Lambertian
+    /// there); None for any other material, and for a normal-mapped one.
+    pub fn lambertian_reflectance(
+        &self,
+        tex: Vec2,
+        wl: &SampledWavelengths,
+    ) -> Option<SampledSpectrum> {
+        match self {
+            Material::Diffuse(d) => Some(d.reflectance.sample(wl)),
+            Material::DiffuseAt(r) => Some(*r),
+            Material::TexturedDiffuse(_) | Material::MetalRough(_) => {
+                self.at_texture(tex, wl)?.lambertian_reflectance(tex, wl)
+            }
+            _ => None,
+        }
+    }
+
     /// Called once per surface hit, before `eval`, `pdf` or `sample`: a material whose
     /// scattering directions depend on wavelength (a rough dispersive dielectric) keeps only
     /// the hero wavelength here, so that light sampling and BSDF sampling at this vertex
