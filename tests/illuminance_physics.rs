@@ -422,7 +422,7 @@ fn lambertian_illuminance_from_the_camera_path_matches_a_path_of_its_own() {
     )"#
         )
     };
-    let diffuse = "Diffuse(reflectance: Rgb(0.7, 0.6, 0.5))";
+    let diffuse = "Diffuse(reflectance: Rgb(0.9, 0.8, 0.7))";
     let reused = render(&world_in(&scene(diffuse), &dir), 2);
     let own = render(
         &world_in(
