@@ -2,6 +2,7 @@
 //! any hit for shadow rays (optionally letting some objects' primitives through), the
 //! per-primitive leaf tests they run, and a brute-force reference.
 
+use super::instance::InstanceSet;
 use super::prim::{Prim, PrimT, RayPre};
 use super::traverse::{prefetch, traverse, LeafTest};
 use super::{Hit, SceneGeometry};
@@ -98,6 +99,13 @@ fn intersect_triangle_simd<const KZ: usize>(
     }
 }
 
+/// A closest hit: on a primitive stored flat (the ray's test data and (primitive, t, a, b)),
+/// or in an instance.
+enum Found<'a> {
+    Flat(RayPre, (u32, f32, f32, f32)),
+    Instanced(&'a InstanceSet, (u32, RayPre, u32, PrimT)),
+}
+
 impl SceneGeometry {
     #[inline(always)]
     fn ray_ok(origin: Vec3, dir: Vec3, t_max: f32) -> bool {
@@ -114,29 +122,55 @@ impl SceneGeometry {
     /// This is [`SceneGeometry::intersect_basic`]'s traversal followed by the full hit record
     /// (point, unit normals, shading normal, error bounds).
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
-        if !Self::ray_ok(origin, dir, t_max) {
-            return None;
-        }
-        let pre = RayPre::new(origin, dir);
-        let flat = if self.tris.is_empty() {
-            None
-        } else {
-            self.closest_dyn(&pre, t_max)
-        };
-        if let Some(set) = &self.instances {
-            let t = flat.map_or(t_max, |f| f.1);
-            if let Some(h) = set.closest(origin, dir, t) {
-                return Some(set.make_hit(h, dir));
-            }
-        }
-        let (prim, t, a, b) = flat?;
-        Some(self.make_hit(prim, &pre, t, a, b))
+        Some(match self.closest_any(origin, dir, t_max)? {
+            Found::Flat(pre, (prim, t, a, b)) => self.make_hit(prim, &pre, t, a, b),
+            Found::Instanced(set, h) => set.make_hit(h, dir),
+        })
     }
 
     /// The closest hit as Embree's `rtcIntersect1` reports it: `t`, the surface parameters,
     /// the unnormalized geometric normal, and the primitive and object ids. Same hits and
     /// conventions as [`SceneGeometry::intersect`], without building the full [`Hit`].
     pub fn intersect_basic(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<RayHit> {
+        Some(match self.closest_any(origin, dir, t_max)? {
+            Found::Flat(_, (prim, t, u, v)) => {
+                let tri = &self.tris[prim as usize];
+                let ng = if tri[0].x.is_nan() {
+                    self.prim(prim).normal_at(origin + t * dir)
+                } else {
+                    (tri[1] - tri[0]).cross(tri[2] - tri[0])
+                };
+                RayHit {
+                    t,
+                    u,
+                    v,
+                    ng,
+                    prim,
+                    object: self.prim_object[prim as usize],
+                }
+            }
+            Found::Instanced(set, h) => {
+                let (ng, object) = set.basic(&h);
+                let (_, _, prim, (t, mut u, mut v)) = h;
+                if set.mirrored(&h) {
+                    std::mem::swap(&mut u, &mut v);
+                }
+                RayHit {
+                    t,
+                    u,
+                    v,
+                    ng,
+                    prim,
+                    object,
+                }
+            }
+        })
+    }
+
+    /// The closest hit among the primitives stored flat and the instances (an instance's only
+    /// when nearer than the flat one).
+    #[inline(always)]
+    fn closest_any(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Found<'_>> {
         if !Self::ray_ok(origin, dir, t_max) {
             return None;
         }
@@ -149,36 +183,10 @@ impl SceneGeometry {
         if let Some(set) = &self.instances {
             let t = flat.map_or(t_max, |f| f.1);
             if let Some(h) = set.closest(origin, dir, t) {
-                let (ng, object) = set.basic(&h);
-                let (_, _, prim, (t, mut u, mut v)) = h;
-                if set.mirrored(&h) {
-                    std::mem::swap(&mut u, &mut v);
-                }
-                return Some(RayHit {
-                    t,
-                    u,
-                    v,
-                    ng,
-                    prim,
-                    object,
-                });
+                return Some(Found::Instanced(set, h));
             }
         }
-        let (prim, t, u, v) = flat?;
-        let tri = &self.tris[prim as usize];
-        let ng = if tri[0].x.is_nan() {
-            self.prim(prim).normal_at(origin + t * dir)
-        } else {
-            (tri[1] - tri[0]).cross(tri[2] - tri[0])
-        };
-        Some(RayHit {
-            t,
-            u,
-            v,
-            ng,
-            prim,
-            object: self.prim_object[prim as usize],
-        })
+        flat.map(|f| Found::Flat(pre, f))
     }
 
     /// Closest-hit traversal: (primitive, t, a, b) of the closest hit.
