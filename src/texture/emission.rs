@@ -8,12 +8,11 @@
 //! reflectance textures do; since luminance is linear in radiance, the filtered luminance is the
 //! luminance of the filtered radiance.
 
-use super::{bilinear_shapes, coefficients, footprint, shape_at, UvMap, Wrap};
+use super::{bilinear_shapes, coefficients, fit_distinct, footprint, shape_at, UvMap, Wrap};
 use crate::colour::grid::LEN;
 use crate::photometry::K_M;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::Vec2;
-use std::collections::HashMap;
 
 /// Memory of one texel once loaded, bytes: three f32 sigmoid coefficients, the f32 radiance
 /// factor and the f32 luminance.
@@ -62,37 +61,19 @@ impl EmissionTexture {
             .map(|i| K_M * d65.values[i] as f64 * v[i])
             .collect();
         let clean = |c: &[f32; 3]| c.map(|x| if x.is_finite() && x > 0.0 { x } else { 0.0 });
-        let mut index: HashMap<[u32; 3], u32> = HashMap::new();
-        let mut distinct: Vec<[u32; 3]> = Vec::new();
-        let ids: Vec<u32> = texels
-            .iter()
-            .map(|c| {
-                let k = clean(c).map(f32::to_bits);
-                *index.entry(k).or_insert_with(|| {
-                    distinct.push(k);
-                    distinct.len() as u32 - 1
-                })
-            })
-            .collect();
-        drop(index);
-        use rayon::prelude::*;
-        let fitted: Vec<([f32; 3], f32, f32)> = distinct
-            .par_iter()
-            .map(|k| {
-                let c = k.map(|b| f32::from_bits(b) as f64);
-                let peak = c[0].max(c[1]).max(c[2]);
-                if peak <= 0.0 {
-                    return ([0.0, 0.0, f32::NEG_INFINITY], 0.0, 0.0);
-                }
-                let co = coefficients(c.map(|x| (x / peak).min(1.0)));
-                let shape_y: f64 = (0..LEN)
-                    .map(|i| shape_at(co, 360.0 + i as f64) * w[i])
-                    .sum();
-                let y = luma(c);
-                let scale = if shape_y > 0.0 { y / shape_y } else { 0.0 };
-                (co, scale as f32, y as f32)
-            })
-            .collect();
+        let (ids, fitted) = fit_distinct(texels, clean, |c| {
+            let peak = c[0].max(c[1]).max(c[2]);
+            if peak <= 0.0 {
+                return ([0.0, 0.0, f32::NEG_INFINITY], 0.0, 0.0);
+            }
+            let co = coefficients(c.map(|x| (x / peak).min(1.0)));
+            let shape_y: f64 = (0..LEN)
+                .map(|i| shape_at(co, 360.0 + i as f64) * w[i])
+                .sum();
+            let y = luma(c);
+            let scale = if shape_y > 0.0 { y / shape_y } else { 0.0 };
+            (co, scale as f32, y as f32)
+        });
         let scale = ids.iter().map(|&i| fitted[i as usize].1).collect();
         let luminance = ids.iter().map(|&i| fitted[i as usize].2).collect();
         EmissionTexture {

@@ -152,25 +152,7 @@ impl Texture {
     /// `width × height`, top row first. Each distinct colour is fitted once.
     pub fn from_linear_rgb(width: u32, height: u32, texels: &[[f32; 3]]) -> Texture {
         assert_eq!(texels.len(), width as usize * height as usize);
-        let key = |c: &[f32; 3]| c.map(|v| v.clamp(0.0, 1.0).to_bits());
-        let mut index: HashMap<[u32; 3], u32> = HashMap::new();
-        let mut distinct: Vec<[u32; 3]> = Vec::new();
-        let ids: Vec<u32> = texels
-            .iter()
-            .map(|c| {
-                let k = key(c);
-                *index.entry(k).or_insert_with(|| {
-                    distinct.push(k);
-                    distinct.len() as u32 - 1
-                })
-            })
-            .collect();
-        drop(index);
-        use rayon::prelude::*;
-        let fitted: Vec<[f32; 3]> = distinct
-            .par_iter()
-            .map(|k| coefficients(k.map(|b| f32::from_bits(b) as f64)))
-            .collect();
+        let (ids, fitted) = fit_distinct(texels, |c| c.map(|v| v.clamp(0.0, 1.0)), coefficients);
         Texture {
             width,
             height,
@@ -313,6 +295,34 @@ pub(crate) fn linear_texels(
         })
         .collect();
     Ok((w, h, texels))
+}
+
+/// Each distinct colour of `texels` (after `clean`) passed once to `fit`, in parallel: per
+/// texel the index of its colour's fit, and the fits.
+fn fit_distinct<T: Send>(
+    texels: &[[f32; 3]],
+    clean: impl Fn(&[f32; 3]) -> [f32; 3],
+    fit: impl Fn([f64; 3]) -> T + Sync,
+) -> (Vec<u32>, Vec<T>) {
+    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut distinct: Vec<[u32; 3]> = Vec::new();
+    let ids: Vec<u32> = texels
+        .iter()
+        .map(|c| {
+            let k = clean(c).map(f32::to_bits);
+            *index.entry(k).or_insert_with(|| {
+                distinct.push(k);
+                distinct.len() as u32 - 1
+            })
+        })
+        .collect();
+    drop(index);
+    use rayon::prelude::*;
+    let fitted = distinct
+        .par_iter()
+        .map(|k| fit(k.map(|b| f32::from_bits(b) as f64)))
+        .collect();
+    (ids, fitted)
 }
 
 /// The 8-bit RGB texels of a PNG or JPEG image (alpha dropped), after the checks of
