@@ -458,18 +458,10 @@ impl Prim {
                     n = DVec3::Z;
                 }
                 let p = (c + n * radius as f64).as_vec3();
-                let theta = n.z.clamp(-1.0, 1.0).acos();
-                let mut phi = n.y.atan2(n.x);
-                if phi < 0.0 {
-                    phi += std::f64::consts::TAU;
-                }
                 HitGeom {
                     p,
                     ng: n.as_vec3(),
-                    uv: Vec2::new(
-                        (phi / std::f64::consts::TAU) as f32,
-                        (theta / std::f64::consts::PI) as f32,
-                    ),
+                    uv: sphere_uv(n),
                     error: rounded_error(p, c.abs() + DVec3::splat(radius as f64)),
                     bary: Vec3::ZERO,
                 }
@@ -500,18 +492,10 @@ impl Prim {
                 let mut rel = r.od + t as f64 * r.dd - c;
                 rel -= rel.dot(n) * n;
                 let p = (c + rel).as_vec3();
-                let (tu, tv) = basis(n);
-                let mut phi = rel.dot(tv).atan2(rel.dot(tu));
-                if phi < 0.0 {
-                    phi += std::f64::consts::TAU;
-                }
                 HitGeom {
                     p,
                     ng: n.as_vec3(),
-                    uv: Vec2::new(
-                        (rel.length() / radius as f64) as f32,
-                        (phi / std::f64::consts::TAU) as f32,
-                    ),
+                    uv: disk_uv(rel, n, radius),
                     error: rounded_error(p, c.abs() + DVec3::splat(radius as f64)),
                     bary: Vec3::ZERO,
                 }
@@ -559,6 +543,34 @@ impl Prim {
             }
         }
     }
+}
+
+/// A sphere's surface parameters (φ/2π, θ/π) at unit normal `n`, θ from +Z, φ about +Z
+/// from +X in [0, 2π).
+pub(super) fn sphere_uv(n: DVec3) -> Vec2 {
+    let theta = n.z.clamp(-1.0, 1.0).acos();
+    let mut phi = n.y.atan2(n.x);
+    if phi < 0.0 {
+        phi += std::f64::consts::TAU;
+    }
+    Vec2::new(
+        (phi / std::f64::consts::TAU) as f32,
+        (theta / std::f64::consts::PI) as f32,
+    )
+}
+
+/// A disk's surface parameters (r/R, φ/2π) at the in-plane offset `rel` from its centre, for
+/// the disk of unit normal `n` and radius `radius`; φ from the first axis of [`basis`]`(n)`.
+pub(super) fn disk_uv(rel: DVec3, n: DVec3, radius: f32) -> Vec2 {
+    let (tu, tv) = basis(n);
+    let mut phi = rel.dot(tv).atan2(rel.dot(tu));
+    if phi < 0.0 {
+        phi += std::f64::consts::TAU;
+    }
+    Vec2::new(
+        (rel.length() / radius as f64) as f32,
+        (phi / std::f64::consts::TAU) as f32,
+    )
 }
 
 #[cfg(test)]

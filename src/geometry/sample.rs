@@ -37,8 +37,6 @@ impl SceneGeometry {
     /// from `u` on primitive `prim`: those a hit there reports ([`Hit::tex`]), i.e. a mesh's
     /// interpolated `vt` where it has them, else the surface's own parameters.
     fn tex_at(&self, prim: u32, pr: &Prim, p: Vec3, n: Vec3, u: Vec2) -> Vec2 {
-        use std::f64::consts::{PI, TAU};
-        let turn = |phi: f64| (if phi < 0.0 { phi + TAU } else { phi } / TAU) as f32;
         match *pr {
             Prim::Triangle(_) => {
                 // The barycentrics sample_area used.
@@ -54,13 +52,7 @@ impl SceneGeometry {
                 }
             }
             Prim::Quad { .. } => u,
-            Prim::Sphere { .. } => {
-                let n = n.as_dvec3();
-                Vec2::new(
-                    turn(n.y.atan2(n.x)),
-                    (n.z.clamp(-1.0, 1.0).acos() / PI) as f32,
-                )
-            }
+            Prim::Sphere { .. } => super::prim::sphere_uv(n.as_dvec3()),
             Prim::Disk {
                 center,
                 normal,
@@ -69,11 +61,7 @@ impl SceneGeometry {
                 let nd = normal.as_dvec3().normalize();
                 let mut rel = p.as_dvec3() - center.as_dvec3();
                 rel -= rel.dot(nd) * nd;
-                let (tu, tv) = super::prim::basis(nd);
-                Vec2::new(
-                    (rel.length() / radius as f64) as f32,
-                    turn(rel.dot(tv).atan2(rel.dot(tu))),
-                )
+                super::prim::disk_uv(rel, nd, radius)
             }
         }
     }
