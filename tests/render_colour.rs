@@ -6,7 +6,7 @@
 mod common;
 use candela::colour::colorimetry::sd_to_xyz_absolute;
 use candela::colour::tables::Observer;
-use candela::light::{AreaLight, Light};
+use candela::light::Light;
 use common::*;
 
 /// Mean over pixels of the pixel means, and its standard error from the spread of the pixel
@@ -32,9 +32,10 @@ fn check(spectrum: &str, luminance: f64) {
         )],
     )"#
     ));
-    let Light::Area(AreaLight { radiance, .. }) = &w.lights[0] else {
+    let Light::Area(light) = &w.lights[0] else {
         panic!("expected an area light")
     };
+    let radiance = light.uniform_radiance().expect("an untextured emitter");
     let expected = sd_to_xyz_absolute(&radiance.to_f64_array(), Observer::Cie1931_2);
     // The photometric scaling itself: Y of the radiance is the requested luminance.
     assert!(

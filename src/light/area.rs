@@ -36,17 +36,54 @@ pub struct AreaLight {
     pub cdf: Vec<f32>,
     /// Total area of `prims`, m².
     pub total_area: f32,
-    /// Radiance L_e(λ), W·m⁻²·sr⁻¹·nm⁻¹, the same at every point and direction; with a
-    /// texture, that of a texel of luminance Y = 1 and colour white.
-    pub radiance: DenseSpectrum,
-    /// The emission texture and the luminance (cd/m²) of a texel of Y = 1: the radiance at a
-    /// point is this times the texture's there.
-    texture: Option<(Arc<EmissionTexture>, f32)>,
-    /// Per primitive (as `prims`) of a textured light: its mean luminance, cd/m², estimated
-    /// from points on it (for light selection and the flux only, never for radiance).
-    prim_luminance: Vec<f32>,
+    radiance: Radiance,
     /// Emits from both faces (otherwise only from the front face).
     pub two_sided: bool,
+}
+
+/// What an area light's surface emits.
+#[derive(Clone, Debug)]
+enum Radiance {
+    /// L_e(λ), W·m⁻²·sr⁻¹·nm⁻¹, the same at every point and direction.
+    Uniform(DenseSpectrum),
+    /// `luminance` (cd/m²) times the emission texture's radiance per unit Y, and each
+    /// primitive's (as `prims`) mean luminance, cd/m², estimated from points on it (for light
+    /// selection and the flux only, never for radiance).
+    Textured {
+        texture: Arc<EmissionTexture>,
+        luminance: f32,
+        prim_luminance: Vec<f32>,
+    },
+}
+
+/// A textured light's mean luminance on each of `prims` (cd/m²), `luminance_at` giving it at
+/// texture coordinates: the mean over a grid of stratified points (up to [`MEAN_POINTS_MAX`]
+/// per primitive, [`MEAN_POINTS_TOTAL`] in all).
+fn mean_luminances(
+    prims: &[u32],
+    geom: &SceneGeometry,
+    luminance_at: impl Fn(Vec2) -> f64 + Sync,
+) -> Vec<f32> {
+    let side = ((MEAN_POINTS_TOTAL / prims.len().max(1)).min(MEAN_POINTS_MAX) as f64)
+        .sqrt()
+        .max(1.0) as usize;
+    use rayon::prelude::*;
+    prims
+        .par_iter()
+        .map(|&prim| {
+            let mut sum = 0.0f64;
+            for j in 0..side {
+                for k in 0..side {
+                    let u = Vec2::new(
+                        (j as f32 + 0.5) / side as f32,
+                        (k as f32 + 0.5) / side as f32,
+                    );
+                    sum += luminance_at(geom.sample_prim(prim, u).tex);
+                }
+            }
+            (sum / (side * side) as f64) as f32
+        })
+        .collect()
 }
 
 /// Luminous flux (lm) of a Lambertian emitter of `luminance` cd/m² and `area` m² emitting from
@@ -149,22 +186,25 @@ impl AreaLight {
                         format!("{l} cd/m² makes the brightest texel {peak:e} cd/m², beyond single precision"),
                     ));
                 }
+                // A white texel's radiance is D65 at this luminance: the same checks of the
+                // amount as an untextured emitter's (not so small that it rounds to 0).
                 let d65 = crate::colour::tables::named_spectrum("D65").expect("D65 ships");
                 let d65 = DenseSpectrum::from_fn(|nm| d65.value(nm));
-                let radiance =
-                    ctx.scaled_emission(&format!("{field}.emission.spectrum"), &afield, &d65, l)?;
-                let mut light = Self {
+                ctx.scaled_emission(&format!("{field}.emission.spectrum"), &afield, &d65, l)?;
+                let prim_luminance =
+                    mean_luminances(&prims, geometry, |tex| t.luminance(tex) * l as f32 as f64);
+                return Ok(Self {
                     object,
                     prims,
                     cdf,
                     total_area: total as f32,
-                    radiance,
-                    texture: Some((t.clone(), l as f32)),
-                    prim_luminance: Vec::new(),
+                    radiance: Radiance::Textured {
+                        texture: t.clone(),
+                        luminance: l as f32,
+                        prim_luminance,
+                    },
                     two_sided,
-                };
-                light.prim_luminance = light.mean_luminances(geometry);
-                return Ok(light);
+                });
             }
         };
         let luminance = match e.amount {
@@ -184,65 +224,51 @@ impl AreaLight {
             prims,
             cdf,
             total_area: total as f32,
-            radiance,
-            texture: None,
-            prim_luminance: Vec::new(),
+            radiance: Radiance::Uniform(radiance),
             two_sided,
         })
     }
 
-    /// A textured light's mean luminance on each primitive (cd/m²): the mean over a grid of
-    /// stratified points (up to [`MEAN_POINTS_MAX`] per primitive, [`MEAN_POINTS_TOTAL`] in all).
-    fn mean_luminances(&self, geom: &SceneGeometry) -> Vec<f32> {
-        let side = ((MEAN_POINTS_TOTAL / self.prims.len().max(1)).min(MEAN_POINTS_MAX) as f64)
-            .sqrt()
-            .max(1.0) as usize;
-        use rayon::prelude::*;
-        self.prims
-            .par_iter()
-            .map(|&prim| {
-                let mut sum = 0.0f64;
-                for j in 0..side {
-                    for k in 0..side {
-                        let u = Vec2::new(
-                            (j as f32 + 0.5) / side as f32,
-                            (k as f32 + 0.5) / side as f32,
-                        );
-                        sum += self.luminance_at(geom.sample_prim(prim, u).tex);
-                    }
-                }
-                (sum / (side * side) as f64) as f32
-            })
-            .collect()
+    /// The radiance L_e(λ) (W·m⁻²·sr⁻¹·nm⁻¹) of an untextured light, the same everywhere on
+    /// it; None for a textured one.
+    pub fn uniform_radiance(&self) -> Option<&DenseSpectrum> {
+        match &self.radiance {
+            Radiance::Uniform(r) => Some(r),
+            Radiance::Textured { .. } => None,
+        }
     }
 
     /// Whether the emission varies over the surface by a texture.
     pub fn is_textured(&self) -> bool {
-        self.texture.is_some()
+        matches!(self.radiance, Radiance::Textured { .. })
     }
 
     /// Radiance (W·m⁻²·sr⁻¹·nm⁻¹) leaving the surface where its texture coordinates are `tex`.
     #[inline]
     pub fn radiance_at(&self, tex: Vec2, wl: &SampledWavelengths) -> SampledSpectrum {
-        match &self.texture {
-            None => self.radiance.sample(wl),
-            Some((t, l)) => t.radiance(tex, wl) * *l,
+        match &self.radiance {
+            Radiance::Uniform(r) => r.sample(wl),
+            Radiance::Textured {
+                texture, luminance, ..
+            } => texture.radiance(tex, wl) * *luminance,
         }
     }
 
     /// Luminance (cd/m²) of the surface where its texture coordinates are `tex`.
     pub fn luminance_at(&self, tex: Vec2) -> f64 {
-        match &self.texture {
-            None => luminous_integral(&self.radiance),
-            Some((t, l)) => t.luminance(tex) * *l as f64,
+        match &self.radiance {
+            Radiance::Uniform(r) => luminous_integral(r),
+            Radiance::Textured {
+                texture, luminance, ..
+            } => texture.luminance(tex) * *luminance as f64,
         }
     }
 
     /// Mean luminance (cd/m²) of the `k`-th of `prims` (estimated for a textured light).
     pub fn prim_mean_luminance(&self, k: usize) -> f64 {
-        match &self.texture {
-            None => luminous_integral(&self.radiance),
-            Some(_) => self.prim_luminance[k] as f64,
+        match &self.radiance {
+            Radiance::Uniform(r) => luminous_integral(r),
+            Radiance::Textured { prim_luminance, .. } => prim_luminance[k] as f64,
         }
     }
 
@@ -336,11 +362,26 @@ impl AreaLight {
         }
     }
 
+    /// Σ A·L over the primitives (cd/m² × m²; estimated for a textured light) and their
+    /// area Σ A (m²).
+    fn luminance_area(&self, geom: &SceneGeometry) -> (f64, f64) {
+        let (mut la, mut area) = (0.0, 0.0);
+        for (k, &prim) in self.prims.iter().enumerate() {
+            let a = geom.prim_area(prim) as f64;
+            la += a * self.prim_mean_luminance(k);
+            area += a;
+        }
+        (la, area)
+    }
+
+    /// Mean luminance over the light's surface, cd/m² (estimated for a textured light).
+    pub fn mean_luminance(&self, geom: &SceneGeometry) -> f64 {
+        let (la, area) = self.luminance_area(geom);
+        la / area.max(f64::MIN_POSITIVE)
+    }
+
     /// Luminous flux, lm (estimated from points for a textured light).
     pub fn power_lm(&self, geom: &SceneGeometry) -> f64 {
-        let la: f64 = (0..self.prims.len())
-            .map(|k| geom.prim_area(self.prims[k]) as f64 * self.prim_mean_luminance(k))
-            .sum();
-        flux_lm(la, 1.0, sides(self.two_sided))
+        flux_lm(self.luminance_area(geom).0, 1.0, sides(self.two_sided))
     }
 }

@@ -270,13 +270,7 @@ pub fn emitters(lights: &[Light], geom: &SceneGeometry) -> Vec<Emitter> {
                 // A textured light's primitives by their estimated mean luminance, floored at a
                 // thousandth of the light's mean so that none that might emit is never chosen.
                 let floor = if a.is_textured() {
-                    let (mut la, mut area) = (0.0, 0.0);
-                    for (k, &prim) in a.prims.iter().enumerate() {
-                        let ak = geom.prim_area(prim) as f64;
-                        la += ak * a.prim_mean_luminance(k);
-                        area += ak;
-                    }
-                    1e-3 * la / area.max(f64::MIN_POSITIVE)
+                    1e-3 * a.mean_luminance(geom)
                 } else {
                     0.0
                 };
