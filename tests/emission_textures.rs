@@ -114,38 +114,16 @@ fn gltf_emissive_texture_multiplies_factor_and_strength() {
     let d = dir("emission_textures_gltf");
     halves_png(&d, "halves.png");
     // The emitter facing −Y at y = 2; u = (x + 1)/2 (v is uniform in the image).
-    let pos: [[f32; 3]; 4] = [
+    let pos = [
         [-1.0, 2.0, -1.0],
         [1.0, 2.0, -1.0],
         [1.0, 2.0, 1.0],
         [-1.0, 2.0, 1.0],
     ];
-    let uv: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-    let idx: [u32; 6] = [0, 1, 2, 0, 2, 3];
-    let mut bin: Vec<u8> = pos.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-    bin.extend(uv.iter().flatten().flat_map(|v| v.to_le_bytes()));
-    bin.extend(idx.iter().flat_map(|v| v.to_le_bytes()));
-    std::fs::write(d.join("panel.bin"), &bin).unwrap();
     let factor = [1.0, 0.8, 0.5];
     let strength = 2000.0;
-    let doc = json!({
-        "asset": {"version": "2.0"},
+    let extra = json!({
         "extensionsUsed": ["KHR_materials_emissive_strength"],
-        "buffers": [{"byteLength": bin.len(), "uri": "panel.bin"}],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
-            {"buffer": 0, "byteOffset": 48, "byteLength": 32},
-            {"buffer": 0, "byteOffset": 80, "byteLength": 24}
-        ],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-             "min": [-1.0, 2.0, -1.0], "max": [1.0, 2.0, 1.0]},
-            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
-            {"bufferView": 2, "componentType": 5125, "count": 6, "type": "SCALAR"}
-        ],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
-                                     "indices": 2, "material": 0}]}],
-        "nodes": [{"mesh": 0}],
         "materials": [{
             "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
             "emissiveFactor": factor,
@@ -156,11 +134,7 @@ fn gltf_emissive_texture_multiplies_factor_and_strength() {
         "textures": [{"source": 0, "sampler": 0}],
         "samplers": [{"wrapS": 33071, "wrapT": 33071}],
     });
-    std::fs::write(
-        d.join("panel.gltf"),
-        serde_json::to_vec_pretty(&doc).unwrap(),
-    )
-    .unwrap();
+    common::gltf_quad(&d, "panel.gltf", pos, [0, 1, 2, 0, 2, 3], extra);
     let w = common::world_in(
         &meters_scene(r#"(shape: Model(file: "panel.gltf"), material: "black")"#),
         &d,

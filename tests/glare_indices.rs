@@ -1,6 +1,7 @@
 //! The glare formulas against hand computations, the Guth position index against its
 //! published table, and the calibration of the 95 % intervals propagated from pixel noise.
 
+mod common;
 use candela::glare::{
     angular_fisheye, evaluate, evaluate_uncertain, position_index, GlareImage, GlareOptions,
     GlareResult, UncertainOptions,
@@ -113,22 +114,7 @@ fn disc_image(background: f64, source: f64, rel_se: f64) -> GlareImage {
     // four pixels, so that the disc's L·ω-weighted centre lies mid-pixel and noise does not
     // move it across a pixel edge (the position index is taken at the truncated centre, as
     // evalglare does; a centre on an edge makes it jump, see docs/glare.md).
-    let centre = {
-        let (c, r) = (30, 14);
-        let mut s = [0.0; 3];
-        for i in [
-            r * w + c,
-            r * w + c + 1,
-            (r + 1) * w + c,
-            (r + 1) * w + c + 1,
-        ] {
-            for k in 0..3 {
-                s[k] += direction[i][k];
-            }
-        }
-        let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
-        s.map(|v| v / n)
-    };
+    let centre = common::pixel_corner_direction(&direction, w, 30, 14);
     let cos_r = 12f64.to_radians().cos();
     let luminance_cd_m2: Vec<f64> = direction
         .iter()

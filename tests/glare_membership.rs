@@ -3,6 +3,7 @@
 //! under-cover, and the check flags them; with tiny standard errors the same image is trusted
 //! and the check does nothing.
 
+mod common;
 use candela::glare::{
     angular_fisheye, evaluate, evaluate_uncertain, GlareImage, GlareOptions, UncertainOptions,
 };
@@ -15,22 +16,7 @@ fn rimmed_disc(rim_se: f64) -> GlareImage {
     let (w, h) = (48, 48);
     let (direction, solid_angle_sr, inside) = angular_fisheye(w, h, 180.0, 180.0);
     // The corner of four pixels, so that the disc's weighted centre lies mid-pixel.
-    let centre = {
-        let (c, r) = (30, 14);
-        let mut s = [0.0; 3];
-        for i in [
-            r * w + c,
-            r * w + c + 1,
-            (r + 1) * w + c,
-            (r + 1) * w + c + 1,
-        ] {
-            for k in 0..3 {
-                s[k] += direction[i][k];
-            }
-        }
-        let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
-        s.map(|v| v / n)
-    };
+    let centre = common::pixel_corner_direction(&direction, w, 30, 14);
     let (mut luminance_cd_m2, mut stderr) = (Vec::new(), Vec::new());
     for d in &direction {
         let c = (d[0] * centre[0] + d[1] * centre[1] + d[2] * centre[2]).clamp(-1.0, 1.0);

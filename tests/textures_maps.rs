@@ -24,42 +24,19 @@ fn png(dir: &Path, name: &str, w: u32, h: u32, texels: &[[u8; 3]]) {
 /// `dir`/`name`, a `.gltf` with its buffer in a file, with material `material` (images by
 /// file name, textures 0.. on images 0..).
 fn gltf_floor(dir: &Path, name: &str, material: Value, images: &[&str]) {
-    let pos: [[f32; 3]; 4] = [
+    let pos = [
         [-2.0, 0.0, -2.0],
         [2.0, 0.0, -2.0],
         [2.0, 0.0, 2.0],
         [-2.0, 0.0, 2.0],
     ];
-    let uv: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-    let idx: [u32; 6] = [0, 2, 1, 0, 3, 2];
-    let mut bin: Vec<u8> = pos.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-    bin.extend(uv.iter().flatten().flat_map(|v| v.to_le_bytes()));
-    bin.extend(idx.iter().flat_map(|v| v.to_le_bytes()));
-    let bin_name = format!("{name}.bin");
-    std::fs::write(dir.join(&bin_name), &bin).unwrap();
-    let doc = json!({
-        "asset": {"version": "2.0"},
-        "buffers": [{"byteLength": bin.len(), "uri": bin_name}],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
-            {"buffer": 0, "byteOffset": 48, "byteLength": 32},
-            {"buffer": 0, "byteOffset": 80, "byteLength": 24}
-        ],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-             "min": [-2.0, 0.0, -2.0], "max": [2.0, 0.0, 2.0]},
-            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
-            {"bufferView": 2, "componentType": 5125, "count": 6, "type": "SCALAR"}
-        ],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
-                                     "indices": 2, "material": 0}]}],
-        "nodes": [{"mesh": 0}],
+    let extra = json!({
         "materials": [material],
         "images": images.iter().map(|f| json!({"uri": f})).collect::<Vec<_>>(),
         "textures": (0..images.len()).map(|i| json!({"source": i})).collect::<Vec<_>>(),
         "samplers": [],
     });
-    std::fs::write(dir.join(name), serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
+    common::gltf_quad(dir, name, pos, [0, 2, 1, 0, 3, 2], extra);
 }
 
 /// The floor seen from 1 m above (32 × 32 pixels over its middle 2 m; image right is −x) under

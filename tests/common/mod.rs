@@ -414,3 +414,78 @@ pub fn glb(j: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     out.extend(bin);
     out
 }
+
+/// One textured quad as `dir`/`name`, a `.gltf` with its buffer in `name.bin`: corners
+/// `positions` with texture coordinates (0, 0), (1, 0), (1, 1), (0, 1), triangles `indices`
+/// (glTF's front faces wind counter-clockwise), the primitive on material 0; `extra` (its
+/// materials, images, textures, samplers, extensions) is merged into the document.
+#[allow(dead_code)]
+pub fn gltf_quad(
+    dir: &Path,
+    name: &str,
+    positions: [[f32; 3]; 4],
+    indices: [u32; 6],
+    extra: serde_json::Value,
+) {
+    let uv: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let mut bin: Vec<u8> = (positions.iter().flatten())
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    bin.extend(uv.iter().flatten().flat_map(|v| v.to_le_bytes()));
+    bin.extend(indices.iter().flat_map(|v| v.to_le_bytes()));
+    let bin_name = format!("{name}.bin");
+    std::fs::write(dir.join(&bin_name), &bin).unwrap();
+    let bound = |f: fn(f32, f32) -> f32| {
+        (0..3)
+            .map(|k| positions.iter().map(|p| p[k]).reduce(f).unwrap())
+            .collect::<Vec<_>>()
+    };
+    let mut doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": bin.len(), "uri": bin_name}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+            {"buffer": 0, "byteOffset": 80, "byteLength": 24}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": bound(f32::min), "max": bound(f32::max)},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 2, "componentType": 5125, "count": 6, "type": "SCALAR"}
+        ],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
+                                     "indices": 2, "material": 0}]}],
+        "nodes": [{"mesh": 0}],
+    });
+    for (k, v) in extra.as_object().expect("extra is a JSON object") {
+        doc[k] = v.clone();
+    }
+    std::fs::write(dir.join(name), serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
+}
+
+/// The unit direction at the corner shared by pixels (`column`, `row`), (`column` + 1, `row`)
+/// and the two below them, of an image `width` pixels wide whose pixels look along
+/// `direction`: the mean of the four, normalised (a synthetic source centred there has its
+/// weighted centre mid-pixel, away from pixel edges).
+pub fn pixel_corner_direction(
+    direction: &[[f64; 3]],
+    width: usize,
+    column: usize,
+    row: usize,
+) -> [f64; 3] {
+    let (w, c, r) = (width, column, row);
+    let mut s = [0.0; 3];
+    for i in [
+        r * w + c,
+        r * w + c + 1,
+        (r + 1) * w + c,
+        (r + 1) * w + c + 1,
+    ] {
+        for k in 0..3 {
+            s[k] += direction[i][k];
+        }
+    }
+    let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+    s.map(|v| v / n)
+}
