@@ -148,23 +148,9 @@ fn perturbed(img: &GlareImage, t: u64) -> GlareImage {
     let mut out = img.clone();
     let se = img.stderr_cd_m2.as_ref().unwrap();
     for (i, l) in out.luminance_cd_m2.iter_mut().enumerate() {
-        *l += se[i] * gauss(t, i as u64);
+        *l += se[i] * common::gauss(t, i as u64);
     }
     out
-}
-
-fn gauss(seed: u64, i: u64) -> f64 {
-    let h = |x: u64| {
-        let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    };
-    let a = h(seed.wrapping_mul(0x1000_0000_01b3) ^ (2 * i));
-    let b = h(a ^ (2 * i + 1));
-    let u1 = ((a >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
-    let u2 = (b >> 11) as f64 / (1u64 << 53) as f64;
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
 #[test]
@@ -380,7 +366,7 @@ fn isolated_pixels_crossing_the_threshold_do_not_flag_the_image() {
         let mut lum = img.luminance_cd_m2.clone();
         let se = img.stderr_cd_m2.as_ref().unwrap();
         for (i, l) in lum.iter_mut().enumerate() {
-            *l += se[i] * gauss(90_000 + d, i as u64);
+            *l += se[i] * common::gauss(90_000 + d, i as u64);
         }
         let r = candela::glare::evaluate_luminance(&img, &lum, &opt);
         plain_changes += (r.sources.len() != 1) as u32;

@@ -489,3 +489,19 @@ pub fn pixel_corner_direction(
     let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
     s.map(|v| v / n)
 }
+
+/// A standard normal deviate number `i` of stream `seed` (Box–Muller on a 64-bit hash),
+/// independent of the library's random numbers.
+pub fn gauss(seed: u64, i: u64) -> f64 {
+    let h = |x: u64| {
+        let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    let a = h(seed.wrapping_mul(0x1000_0000_01b3) ^ (2 * i));
+    let b = h(a ^ (2 * i + 1));
+    let u1 = ((a >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+    let u2 = (b >> 11) as f64 / (1u64 << 53) as f64;
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
