@@ -16,25 +16,31 @@
 //! assumes a dew point of 11 °C and made Radiance's sunny hours 1.2 % darker, 4.2 standard
 //! errors of the mean z). candela: reduced sky, sun and direct samples (below).
 //!
-//! Measured: overcast 7012 point-hours, mean difference +0.00 %, |z| > 4 in none, mean z
-//! −0.002 ± 0.167; sunny 23 361 point-hours, +0.37 %, |z| > 4 in 0.19 %, mean z +0.058 ± 0.060;
-//! sDA 100 % and ASE 51.4 % in both, the points' direct-sun hours within 2 h. With Radiance's
-//! illuminances 3 % higher the mean z is −1.7 ± 0.2 overcast and −0.59 ± 0.07 sunny (both beyond
-//! 4 standard errors; |z| > 4 in 4.2 % of the overcast point-hours); 3 % lower, +1.3 ± 0.2 and
-//! +0.82 ± 0.08: the test fails either way.
+//! Measured (two runs): overcast 7014 point-hours, mean difference −0.33 % and −0.08 %, the
+//! points' mean z −0.37 ± 0.14 and −0.11 ± 0.17, Σ z̄² 29.7 and 33.2, |z − z̄| > 4 in 0.014 %
+//! and none of the hours; sunny 23 356 point-hours, +0.01 % and +0.30 %, mean z −0.02 ± 0.04
+//! and +0.05 ± 0.04, |z − z̄| > 4 in 0.15 % and 0.13 %; sDA 100 % and ASE 51.4 % in both, the
+//! points' direct-sun hours within 2 h. With Radiance's illuminances 3 % higher the overcast
+//! points' mean z is −3.4 ± 0.18 with Σ z̄² 452, the sunny −0.62 ± 0.05; 3 % lower, +2.96 ±
+//! 0.16 with Σ z̄² 338, and +0.68 ± 0.03: the test fails either way.
 //!
-//! CPU time: candela 32 s, Radiance 86 s (78 s of it the hourly suns' inter-reflected light),
-//! about a minute on 2 cores.
+//! CPU time: candela about 15 s, Radiance about 37 s (28 s of it the hourly suns'
+//! inter-reflected light), about 30 s on 2 cores.
 //!
 //! Asserts:
 //! - sDA and ASE within 2 percentage points (one point of 35 is 2.9 points, so ASE must count
 //!   the same points);
 //! - per point-hour (occupied, E > 50 lx), z = (E_candela − E_Radiance) / σ with σ² = candela's
 //!   standard error² + (s_R E_Radiance)², s_R Radiance's relative error at these settings
-//!   (measured against a second run at other ambient divisions, see RADIANCE_REL_SE): for
-//!   overcast and sunny hours separately, |z| > 4 in under 0.5 % of the point-hours, and the
-//!   mean z within 4 standard errors of 0, the standard error from the spread of the 35 points'
-//!   mean z (the shared coefficients correlate one point's hours, the points are independent).
+//!   (measured from two runs, see RADIANCE_REL_SE). Both tools' errors are mostly shared by a
+//!   point's hours (each point's coefficients serve all of them), so the hours of one point are
+//!   not independent draws and the test is made over points for what they share and over hours
+//!   for what they do not. For overcast and sunny hours separately: the points' mean z, z̄ₚ,
+//!   have Σ z̄ₚ² below χ²'s 0.999 quantile with 35 degrees of freedom (66.6: each point's offset
+//!   within its error); their mean within 4 standard errors of 0, the standard error from their
+//!   spread (no shared offset); and the hours' departures from their point's mean, |z − z̄ₚ|,
+//!   beyond 4 in under 0.5 % of the point-hours (no hour-dependent disagreement: the sky's
+//!   distribution, the sun's position or the weather conversion of some hours).
 //!
 //! Skipped never: without the Python venv (scripts/setup_python.sh, or CANDELA_PYTHON) the
 //! test fails, as the other reference tests do.
@@ -55,21 +61,23 @@ const CANDELA_SKY: &str = "4096";
 const CANDELA_SUN: &str = "1024";
 const CANDELA_DIRECT: &str = "64";
 
-/// Radiance: ambient divisions of the sky coefficients and of the hourly suns' inter-reflected
-/// light (12 bounces both), limit weight.
-const RADIANCE_AD: &str = "4096";
+/// Radiance: ambient divisions of the sky and sun coefficients and of the hourly suns'
+/// inter-reflected light (12 bounces all), limit weight.
+const RADIANCE_AD: &str = "65536";
 const RADIANCE_SUN_AD: &str = "256";
 const RADIANCE_LW: &str = "1e-5";
 
 /// Radiance's relative standard error per point-hour at these settings, overcast and sunny
-/// hours (occupied, E > 50 lx), measured once from two runs at −ad 4096 / 4000 and −sun-ad
-/// 256 / 250: their difference is 2.69 % RMS overcast and 4.94 % RMS sunny, so one run's error
-/// is 1.9 % and 3.5 % (3.8 % in sunny hours without direct sun at the point, taken here). The
-/// sky coefficients at −ad 4096 differ from −ad 65536 by 2.4 % RMS (0.2 to 5.9 % by point: a
-/// per-point offset shared by its hours); the hourly suns' inter-reflected light at −ad 256 is
-/// the noisier part of sunny hours. candela's per-hour standard errors at these settings: median
-/// 0.5 % of E overcast, 1.3 % sunny.
-const RADIANCE_REL_SE: [f64; 2] = [0.019, 0.038];
+/// hours (occupied, E > 50 lx), measured from two runs of these settings (rcontrib's parallel
+/// processes make each run's sampling differ): their difference is 1.00 % RMS overcast and
+/// 4.86 % RMS sunny, so one run's error is 0.71 % and 3.4 % (3.8 % in sunny hours without
+/// direct sun at the point, taken here). Overcast, the error is a per-point offset shared by
+/// all of the point's hours (the sky coefficients; 0.10 % RMS within a point), which a
+/// per-point-hour test only tolerates when it is small: at −ad 4096 the two runs differed by
+/// 3.3 % RMS and up to 10.8 % at one point, so that point's hours all sat near |z| = 4. Sunny,
+/// the hourly suns' inter-reflected light at −ad 256 dominates (4.7 % RMS within a point).
+/// candela's per-hour standard errors at these settings: median 0.5 % of E overcast, 1.3 % sunny.
+const RADIANCE_REL_SE: [f64; 2] = [0.0071, 0.038];
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -130,22 +138,32 @@ fn value(v: &Value) -> f64 {
     v.get("value").unwrap_or(v).as_f64().unwrap()
 }
 
-/// z statistics of one class of hours: (n, share of |z| > 4, mean z, its standard error from
-/// the points' means, mean relative difference).
-fn z_stats(z: &[Vec<f64>], rel: &[Vec<f64>]) -> (usize, f64, f64, f64, f64) {
+/// z statistics of one class of hours, per point: (point-hours, share of the hours whose z
+/// departs from its point's mean z by more than 4, mean of the points' mean z, its standard
+/// error from their spread, Σ of the points' squared mean z, mean relative difference).
+fn z_stats(z: &[Vec<f64>], rel: &[Vec<f64>]) -> (usize, f64, f64, f64, f64, f64) {
     let n: usize = z.iter().map(Vec::len).sum();
-    let tail = z.iter().flatten().filter(|v| v.abs() > 4.0).count() as f64 / n as f64;
-    let means: Vec<f64> = z
+    let points: Vec<&Vec<f64>> = z.iter().filter(|p| !p.is_empty()).collect();
+    let means: Vec<f64> = points
         .iter()
-        .filter(|p| !p.is_empty())
         .map(|p| p.iter().sum::<f64>() / p.len() as f64)
         .collect();
+    let tail = points
+        .iter()
+        .zip(&means)
+        .map(|(p, m)| p.iter().filter(|v| (*v - m).abs() > 4.0).count())
+        .sum::<usize>() as f64
+        / n as f64;
     let k = means.len() as f64;
     let mean = means.iter().sum::<f64>() / k;
     let var = means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (k - 1.0);
+    let chi2 = means.iter().map(|m| m * m).sum::<f64>();
     let rel_mean = rel.iter().flatten().sum::<f64>() / n as f64;
-    (n, tail, mean, (var / k).sqrt(), rel_mean)
+    (n, tail, mean, (var / k).sqrt(), chi2, rel_mean)
 }
+
+/// χ²'s 0.999 quantile with 35 degrees of freedom (one per grid point).
+const CHI2_35_0999: f64 = 66.62;
 
 #[test]
 fn annual_metrics_and_hours_match_radiance_matrix_method() {
@@ -299,15 +317,20 @@ fn annual_metrics_and_hours_match_radiance_matrix_method() {
                 }
             }
         }
-        let (n, tail, mean, se, rel_mean) = z_stats(&z, &rel);
+        let (n, tail, mean, se, chi2, rel_mean) = z_stats(&z, &rel);
         eprintln!(
-            "{class}: {n} point-hours, |z| > 4 in {:.3} %, mean z {mean:+.3} ± {se:.3}, \
+            "{class}: {n} point-hours, points' mean z: mean {mean:+.3} ± {se:.3}, \
+             Σ z̄² {chi2:.1} (35 points); |z − z̄| > 4 in {:.3} % of hours; \
              mean difference {:+.2} %",
             100.0 * tail,
             100.0 * rel_mean
         );
+        assert_eq!(z.iter().filter(|p| !p.is_empty()).count(), npts);
+        if chi2 > CHI2_35_0999 {
+            failures.push(format!("{class}: Σ z̄² {chi2:.1} > {CHI2_35_0999}"));
+        }
         if tail >= 0.005 {
-            failures.push(format!("{class}: |z| > 4 in {:.2} %", 100.0 * tail));
+            failures.push(format!("{class}: |z − z̄| > 4 in {:.2} %", 100.0 * tail));
         }
         if mean.abs() > 4.0 * se {
             failures.push(format!("{class}: mean z {mean:+.3} ± {se:.3}"));
