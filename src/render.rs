@@ -120,10 +120,11 @@ pub fn pixel_batch(pixel: u64, s: u64) -> (u64, u64) {
 const ILLUMINANCE_STREAM: u64 = 0x11_1c_e5_7a_u64 << 20;
 
 /// Smallest reflectance at each of the camera path's wavelengths for its radiance to give the
-/// illuminance (below it, or at a surface that is not Lambertian, a path of its own does):
-/// Russian roulette weighs the camera path by its throughput, which carries ρ, so on a dark
-/// surface π L/ρ would be noisier than a path of its own.
-const MIN_REUSED_REFLECTANCE: f32 = 0.5;
+/// illuminance (below it, or at a surface that is not Lambertian, a path of its own does). The
+/// camera path's Russian roulette weighs its throughput relative to this first surface's albedo
+/// (see [`crate::integrator::trace`]), so π L/ρ is as precise for its value on a dark surface
+/// as on a bright one; the floor only keeps 1/ρ finite.
+const MIN_REUSED_REFLECTANCE: f32 = 1e-4;
 
 /// Illuminance (lx) on the surface a camera ray sees, or None if it sees no receiving surface
 /// (nothing, the sky, or an emitter). `seen` is the camera ray (origin, direction) with the

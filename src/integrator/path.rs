@@ -131,6 +131,12 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
     // Product of η′² over the refractions so far (see `Material::eta_scale`), for Russian
     // roulette only.
     let mut eta_scale = 1.0f32;
+    // Russian roulette weighs the throughput relative to its value after the first scattering
+    // of a path from a camera or a luminance meter (set there): such a path's value is about
+    // that surface's albedo times the light it receives, so what the rest of the path brings
+    // matters relative to that albedo, not to 1. A dark surface's pixel is then as precise, for
+    // its value, as a bright one's. A receiver's path (depth ≥ 1 at the start) keeps 1.
+    let mut roulette_scale = 1.0f32;
     // Whether the path's first scattering (at the surface the camera sees) was non-specular:
     // with `start.caustics_by_light_tracing`, such paths that reach a light through a
     // specular scattering are light tracing's part (see `super::light_path`).
@@ -314,6 +320,7 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
         eta_scale *= material.eta_scale(wo, bs.wi, wl);
         if depth == 0 {
             first_non_specular = !bs.specular;
+            roulette_scale = first_scatter_roulette_scale(beta.max_component());
         }
         prev_specular = bs.specular;
         straight_through = 0;
@@ -327,7 +334,7 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
 
         // Russian roulette.
         if depth > settings.rr_depth {
-            let p = super::survival_probability(beta.max_component() * eta_scale);
+            let p = super::survival_probability(beta.max_component() * eta_scale * roulette_scale);
             if u_rr < 1.0 - p {
                 break;
             }
@@ -336,6 +343,21 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
         stats.bounce_rays += 1;
     }
     l
+}
+
+/// Factor on the throughput for Russian roulette after a camera path's first scattering left it
+/// at `beta` (its largest component): 1/beta for a surface that absorbs (a survival
+/// probability of min(throughput/beta, 0.99)), at most 10⁶; 1 where the scattering did not
+/// lower the throughput (the roulette is never made more eager to end a path than its
+/// throughput says). Unbiased whatever the factor: a surviving path's weight is divided by its
+/// survival probability.
+#[inline]
+fn first_scatter_roulette_scale(beta: f32) -> f32 {
+    if beta > 0.0 && beta < 1.0 {
+        1.0 / beta.max(1e-6)
+    } else {
+        1.0
+    }
 }
 
 /// Where a shadow ray starts: a surface point with its error bound and geometric normal, or a
