@@ -144,7 +144,12 @@ fn furnace_with_default_depth() {
     let film = render(&w, 2);
     let (m, se) = image_mean(&film);
     println!("furnace ρ = 0.9: L = {} ± {se} cd/m², exact 10", m[1]);
-    assert_every_pixel(&film, 10.0, 5.0);
+    // The furnace's per-sample values are skewed (every path's first bounces are alike; the
+    // spread is in Russian roulette's geometric tail), so a single pixel's t statistic from its
+    // 16 batches of 8 samples has heavy tails: over 576 such pixels, |z| reached 4.1–6.0 at
+    // seeds 0–3 while 93–96 % of the 95 % intervals held the exact value. The image mean tests
+    // the depth; the coverage, the intervals.
+    assert_pixel_coverage(&film, 10.0, 0.90);
 }
 
 /// A closed box of reflectance exactly 1 (nothing absorbs; the light it holds makes the exact

@@ -57,6 +57,36 @@ pub fn assert_every_pixel(film: &Film, expected: f64, k: f64) {
             "pixel {i}: Y = {y} cd/m², expected {expected} ± {k}·{se}"
         );
     }
+    assert_image_mean(film, expected);
+}
+
+/// Assert that at least `min_coverage` of the pixels' 95 % intervals (Student t with their
+/// batches − 1 degrees of freedom) hold `expected`, and the image mean is within 4 standard
+/// errors of it, below 1 % of `expected`: for images whose per-sample values are skewed (a
+/// furnace: deterministic first bounces and a geometric tail of Russian roulette), where single
+/// pixels' t statistics from 16 batches have heavier tails than a per-pixel bound assumes
+/// (docs/uncertainty.md, "Few samples per batch").
+pub fn assert_pixel_coverage(film: &Film, expected: f64, min_coverage: f64) {
+    let held = film
+        .pixels
+        .iter()
+        .filter(|p| (p.mean_xyz()[1] - expected).abs() <= p.y_ci95_half_width())
+        .count();
+    let coverage = held as f64 / film.pixels.len() as f64;
+    assert!(
+        coverage >= min_coverage,
+        "{held} of {} pixels' 95 % intervals hold {expected} ({:.1} %, at least {:.1} % expected)",
+        film.pixels.len(),
+        100.0 * coverage,
+        100.0 * min_coverage
+    );
+    assert_image_mean(film, expected);
+}
+
+/// Assert that the image mean is within 4 standard errors of `expected`, which must be below
+/// 1 % of `expected` (so that a change making the render much noisier cannot widen its own
+/// tolerance).
+fn assert_image_mean(film: &Film, expected: f64) {
     let (m, se) = image_mean(film);
     assert!(
         (m[1] - expected).abs() <= 4.0 * se,
