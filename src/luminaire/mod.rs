@@ -309,7 +309,7 @@ fn bracket(xs: &[f64], x: f64) -> Option<(usize, f64)> {
     if n == 1 {
         return Some((0, 0.0));
     }
-    let i = xs.partition_point(|&v| v <= x).clamp(1, n - 1) - 1;
+    let i = bracket_index(xs, x);
     let h = xs[i + 1] - xs[i];
     let t = if h > 0.0 {
         ((x - xs[i]) / h).clamp(0.0, 1.0)
@@ -317,6 +317,23 @@ fn bracket(xs: &[f64], x: f64) -> Option<(usize, f64)> {
         0.0
     };
     Some((i, t))
+}
+
+/// `xs.partition_point(|&v| v <= x).clamp(1, n - 1) - 1` for sorted `xs` of n ≥ 2 values: the
+/// last i ≤ n − 2 with xs[i] ≤ x (0 below xs[0]). Tables are mostly evenly spaced, so the
+/// index the spacing predicts is tried first and the binary search, whose mispredicted
+/// branches cost a goniometric light's every evaluation, only runs where it fails.
+#[inline]
+fn bracket_index(xs: &[f64], x: f64) -> usize {
+    let n = xs.len();
+    let span = xs[n - 1] - xs[0];
+    if span > 0.0 {
+        let g = ((x - xs[0]) / span * (n - 1) as f64) as usize;
+        if g < n - 1 && xs[g] <= x && x < xs[g + 1] {
+            return g;
+        }
+    }
+    xs.partition_point(|&v| v <= x).clamp(1, n - 1) - 1
 }
 
 impl Distribution {
@@ -584,6 +601,27 @@ pub fn polar_value(dist: &Distribution, c: f64, t: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn bracket_index_agrees_with_the_binary_search() {
+        let tables: [&[f64]; 5] = [
+            &[0.0, 2.5, 5.0, 7.5, 10.0, 90.0],
+            &[0.0, 5.0, 5.0, 10.0, 15.0],
+            &[0.0, 1.0, 10.0, 11.0, 12.0, 80.0, 90.0],
+            &[0.0, 22.5, 45.0, 67.5, 90.0],
+            &[3.0, 3.0],
+        ];
+        for xs in tables {
+            let (a, b) = (xs[0] - 1.0, xs[xs.len() - 1] + 1.0);
+            for k in 0..=4000 {
+                let x = a + (b - a) * k as f64 / 4000.0;
+                for x in [x, xs[k % xs.len()]] {
+                    let want = xs.partition_point(|&v| v <= x).clamp(1, xs.len() - 1) - 1;
+                    assert_eq!(super::bracket_index(xs, x), want, "{xs:?} at {x}");
+                }
+            }
+        }
+    }
+
     use super::*;
 
     fn rot(values: impl Fn(f64) -> f64, angles: &[f64]) -> Photometry {
