@@ -1,8 +1,8 @@
 //! A bounding volume hierarchy over the lights at a finite position, for choosing one light per
 //! shading point in proportion to an estimate of what it sends there (many-light sampling of
 //! Conty Estevez & Kulla 2018, "Importance Sampling of Many Lights with Adaptive Tree
-//! Splitting", without the splitting; the scheme of pbrt-v4's BVH light sampler, four children
-//! per node).
+//! Splitting", without the splitting; the scheme of pbrt-v4's BVH light sampler, with up to
+//! eight children per node).
 //!
 //! Leaves are single emitters: a point, spot or goniometric light, or ONE primitive of an area
 //! light (so a luminous ceiling made of one object with many primitives is sampled by where
