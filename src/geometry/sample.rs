@@ -96,7 +96,27 @@ impl SceneGeometry {
         reference: Vec3,
         u: Vec2,
     ) -> Option<(SurfacePoint, f32)> {
+        self.sample_prim_solid_angle_with(prim, reference, u, true)
+    }
+
+    /// [`SceneGeometry::sample_prim_solid_angle`] for a caller that may not need texture
+    /// coordinates (`tex` false: they are left zero, which saves a sphere's or a mesh's
+    /// parametrisation, e.g. for an untextured light). The point and pdf are the same.
+    pub fn sample_prim_solid_angle_with(
+        &self,
+        prim: u32,
+        reference: Vec3,
+        u: Vec2,
+        tex: bool,
+    ) -> Option<(SurfacePoint, f32)> {
         let pr = self.prim(prim);
+        let tex_at = |p: Vec3, n: Vec3| {
+            if tex {
+                self.tex_at(prim, &pr, p, n, u)
+            } else {
+                Vec2::ZERO
+            }
+        };
         if let Prim::Sphere { center, radius } = pr {
             if let Some((sin2_max, one_minus_cos_max)) =
                 Self::sphere_cone(center, radius, reference)
@@ -128,14 +148,14 @@ impl SceneGeometry {
                     return None;
                 }
                 let (p, n) = (p.as_vec3(), n.as_vec3());
-                let tex = self.tex_at(prim, &pr, p, n, u);
+                let tex = tex_at(p, n);
                 return Some((SurfacePoint { p, n, tex }, pdf));
             }
         }
         let (p, n) = pr.sample_area(u);
         let pdf = Self::area_to_solid_angle(pr.area(), reference, p, n);
         (pdf > 0.0 && pdf.is_finite()).then(|| {
-            let tex = self.tex_at(prim, &pr, p, n, u);
+            let tex = tex_at(p, n);
             (SurfacePoint { p, n, tex }, pdf)
         })
     }

@@ -325,7 +325,8 @@ impl AreaLight {
         u: Vec2,
         wl: &SampledWavelengths,
     ) -> Option<LightSample> {
-        let (sp, pdf_sa) = geom.sample_prim_solid_angle(prim, p, u)?;
+        // The texture coordinates only matter to a textured emission.
+        let (sp, pdf_sa) = geom.sample_prim_solid_angle_with(prim, p, u, self.is_textured())?;
         let d = sp.p - p;
         let dist = d.length();
         if dist == 0.0 || pdf_sa.is_nan() || pdf_sa <= 0.0 || !pdf_sa.is_finite() {

@@ -85,26 +85,6 @@ fn angle_between(a: Vec3, b: Vec3) -> f32 {
     }
 }
 
-/// cos(max(0, a − b)) from the sines and cosines of angles a, b ∈ [0, π].
-#[inline]
-fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
-    if cos_a > cos_b {
-        1.0
-    } else {
-        cos_a * cos_b + sin_a * sin_b
-    }
-}
-
-/// sin(max(0, a − b)) from the sines and cosines of angles a, b ∈ [0, π].
-#[inline]
-fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
-    if cos_a > cos_b {
-        0.0
-    } else {
-        sin_a * cos_b - cos_a * sin_b
-    }
-}
-
 #[inline]
 fn sin_of(cos: f32) -> f32 {
     (1.0 - cos * cos).max(0.0).sqrt()
@@ -181,8 +161,9 @@ impl LightBounds {
 /// every shading point needs, with the bounding sphere and sin θ_o computed once.
 #[derive(Clone, Copy, Debug)]
 pub struct NodeBounds {
-    /// Centre of the box and squared radius of its bounding sphere, m and m².
+    /// Centre of the box, and radius and squared radius of its bounding sphere, m and m².
     centre: Vec3,
+    r: f32,
     r2: f32,
     /// Power, lm.
     pub phi: f32,
@@ -195,9 +176,11 @@ pub struct NodeBounds {
 
 impl From<&LightBounds> for NodeBounds {
     fn from(b: &LightBounds) -> Self {
+        let r2 = 0.25 * (b.hi - b.lo).length_squared();
         NodeBounds {
             centre: b.centroid(),
-            r2: 0.25 * (b.hi - b.lo).length_squared(),
+            r: r2.sqrt(),
+            r2,
             phi: b.phi,
             w: b.axes.w,
             cos_o: b.axes.cos_theta,
@@ -215,76 +198,134 @@ impl NodeBounds {
     /// bounds can send anything to `p` (or every light lies exactly in the tangent plane).
     #[inline]
     pub fn importance(&self, p: Vec3, n: Option<Vec3>) -> f32 {
-        if self.phi <= 0.0 {
-            return 0.0;
+        let (n, has_n) = match n {
+            Some(n) => (n, true),
+            None => (Vec3::ZERO, false),
+        };
+        Lane {
+            c: self.centre,
+            r: self.r,
+            r2: self.r2,
+            phi: self.phi,
+            w: self.w,
+            cos_o: self.cos_o,
+            sin_o: self.sin_o,
+            cos_e: self.cos_e,
+            two_sided: self.two_sided,
         }
-        let r2 = self.r2;
-        let v = p - self.centre;
-        let dist2 = v.length_squared();
-        if dist2 <= r2 || dist2 == 0.0 || !dist2.is_finite() {
-            // Inside the bounding sphere: every direction is possible.
-            if dist2.is_nan() {
-                return 0.0;
-            }
-            return self.phi / r2.max(MIN_DIST2);
-        }
-        let wi = v / dist2.sqrt();
-        // Half-angle θ_b of the cone from p that contains the bounding sphere.
-        let sin2_b = r2 / dist2;
-        let (sin_b, cos_b) = (sin2_b.sqrt(), (1.0 - sin2_b).max(0.0).sqrt());
-
-        let mut cos_w = self.w.dot(wi);
-        if self.two_sided {
-            cos_w = cos_w.abs();
-        }
-        let sin_w = sin_of(cos_w);
-        let (cos_o, sin_o) = (self.cos_o, self.sin_o);
-        // θ' = max(0, θ_w − θ_o − θ_b): the smallest angle between an emitter's axis and the
-        // direction from one of its points to p.
-        let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-        let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
-        if cos_p <= self.cos_e {
-            return 0.0;
-        }
-        let mut importance = self.phi * cos_p / dist2.max(r2).max(MIN_DIST2);
-        if let Some(n) = n {
-            let cos_i = n.dot(wi).abs().min(1.0);
-            let sin_i = sin_of(cos_i);
-            importance *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b).max(MIN_COS_I);
-        }
-        importance.max(0.0)
+        .importance(p, n, has_n)
     }
 }
 
-/// Up to four [`NodeBounds`] side by side (one per lane), the children of a node of the 4-wide
-/// light BVH: their importances for one shading point are computed together, lane by lane with
-/// the same arithmetic as [`NodeBounds::importance`] (so each lane equals it bit for bit), in
-/// a form the compiler turns into SIMD. An empty lane has φ = 0 and importance 0.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Bounds4 {
-    cx: [f32; 4],
-    cy: [f32; 4],
-    cz: [f32; 4],
-    r2: [f32; 4],
-    /// Power of each lane, lm.
-    pub phi: [f32; 4],
-    wx: [f32; 4],
-    wy: [f32; 4],
-    wz: [f32; 4],
-    cos_o: [f32; 4],
-    sin_o: [f32; 4],
-    cos_e: [f32; 4],
-    /// 1 where the lane's emitters are two-sided, else 0.
-    two_sided: [f32; 4],
+/// One lane of [`Bounds8`] (the fields of [`NodeBounds`]).
+struct Lane {
+    c: Vec3,
+    r: f32,
+    r2: f32,
+    phi: f32,
+    w: Vec3,
+    cos_o: f32,
+    sin_o: f32,
+    cos_e: f32,
+    two_sided: bool,
 }
 
-impl Bounds4 {
-    /// Put `b` into lane `i` (< 4).
+impl Lane {
+    /// [`NodeBounds::importance`] (`has_n` false: no normal), with every branch a select so
+    /// that [`Bounds8`] computes eight lanes side by side in SIMD. The direction to p is never
+    /// normalised: with d = |p − c|, the cosines and sines of the angles at p are kept as d
+    /// times their value (d² for the final one), which leaves one division (1/d²) and no
+    /// chain of square root then division.
+    #[inline(always)]
+    fn importance(&self, p: Vec3, n: Vec3, has_n: bool) -> f32 {
+        let (r, r2, phi) = (self.r, self.r2, self.phi);
+        let (vx, vy, vz) = (p.x - self.c.x, p.y - self.c.y, p.z - self.c.z);
+        let dist2 = vx * vx + vy * vy + vz * vz;
+        let inside = dist2 <= r2 || dist2 == 0.0 || !dist2.is_finite();
+        // Inside the bounding sphere: every direction is possible.
+        let inside_value = if dist2.is_nan() {
+            0.0
+        } else {
+            phi / r2.max(MIN_DIST2)
+        };
+        let d = dist2.sqrt();
+        let inv_dist2 = 1.0 / dist2;
+        // d cos θ_b, d sin θ_b: the half-angle θ_b of the cone from p holding the sphere.
+        let cb = (dist2 - r2).max(0.0).sqrt();
+        let sb = r;
+        // d cos θ_w, d sin θ_w: the angle between the axis w and the direction c → p.
+        let a0 = self.w.x * vx + self.w.y * vy + self.w.z * vz;
+        let a = if self.two_sided { a0.abs() } else { a0 };
+        let s = (dist2 - a * a).max(0.0).sqrt();
+        let (cos_o, sin_o) = (self.cos_o, self.sin_o);
+        // d cos θ_x, d sin θ_x, θ_x = max(0, θ_w − θ_o).
+        let within_o = a > cos_o * d;
+        let x = if within_o { d } else { a * cos_o + s * sin_o };
+        let y = if within_o { 0.0 } else { s * cos_o - a * sin_o };
+        // θ' = max(0, θ_x − θ_b): the smallest angle between an emitter's axis and the
+        // direction from one of its points to p; cos θ' from d² cos θ'.
+        let cos_p = if x > cb { dist2 } else { x * cb + y * sb } * inv_dist2;
+        // 1 / max(d², MIN_DIST2) (outside the sphere d² > r²).
+        let mut imp = phi * cos_p * inv_dist2.min(1.0 / MIN_DIST2);
+        // d |cos θ_i|, d sin θ_i at the receiver; its bound is cos max(0, θ_i − θ_b).
+        let ci = (n.x * vx + n.y * vy + n.z * vz).abs().min(d);
+        let si = (dist2 - ci * ci).max(0.0).sqrt();
+        let f_i = if ci > cb {
+            1.0
+        } else {
+            (ci * cb + si * sb) * inv_dist2
+        }
+        .max(MIN_COS_I);
+        if has_n {
+            imp *= f_i;
+        }
+        let outside_value = if cos_p <= self.cos_e {
+            0.0
+        } else {
+            imp.max(0.0)
+        };
+        let v = if inside { inside_value } else { outside_value };
+        if phi <= 0.0 {
+            0.0
+        } else {
+            v
+        }
+    }
+}
+
+/// Up to [`WIDTH`] [`NodeBounds`] side by side (one per lane), the children of a node of the
+/// light BVH: their importances for one shading point are computed together, each lane with
+/// the arithmetic of [`NodeBounds::importance`] (so it equals it bit for bit), in a form the
+/// compiler turns into SIMD. An empty lane has φ = 0 and importance 0.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Bounds8 {
+    cx: [f32; WIDTH],
+    cy: [f32; WIDTH],
+    cz: [f32; WIDTH],
+    r: [f32; WIDTH],
+    r2: [f32; WIDTH],
+    /// Power of each lane, lm.
+    pub phi: [f32; WIDTH],
+    wx: [f32; WIDTH],
+    wy: [f32; WIDTH],
+    wz: [f32; WIDTH],
+    cos_o: [f32; WIDTH],
+    sin_o: [f32; WIDTH],
+    cos_e: [f32; WIDTH],
+    /// 1 where the lane's emitters are two-sided, else 0.
+    two_sided: [f32; WIDTH],
+}
+
+/// Lanes of [`Bounds8`]: eight f32 fill one AVX register.
+pub const WIDTH: usize = 8;
+
+impl Bounds8 {
+    /// Put `b` into lane `i` (< [`WIDTH`]).
     pub fn set(&mut self, i: usize, b: &NodeBounds) {
         self.cx[i] = b.centre.x;
         self.cy[i] = b.centre.y;
         self.cz[i] = b.centre.z;
+        self.r[i] = b.r;
         self.r2[i] = b.r2;
         self.phi[i] = b.phi;
         self.wx[i] = b.w.x;
@@ -296,57 +337,28 @@ impl Bounds4 {
         self.two_sided[i] = if b.two_sided { 1.0 } else { 0.0 };
     }
 
-    /// The four lanes' importances for a receiver at `p` with unit normal `n` (see
+    /// The lanes' importances for a receiver at `p` with unit normal `n` (see
     /// [`NodeBounds::importance`]), lm·m⁻².
     #[inline]
-    pub fn importance(&self, p: Vec3, n: Option<Vec3>) -> [f32; 4] {
-        let (nx, ny, nz, has_n) = match n {
-            Some(n) => (n.x, n.y, n.z, true),
-            None => (0.0, 0.0, 0.0, false),
+    pub fn importance(&self, p: Vec3, n: Option<Vec3>) -> [f32; WIDTH] {
+        let (n, has_n) = match n {
+            Some(n) => (n, true),
+            None => (Vec3::ZERO, false),
         };
-        let mut out = [0.0f32; 4];
+        let mut out = [0.0f32; WIDTH];
         for (i, out) in out.iter_mut().enumerate() {
-            // Every branch of the scalar version becomes a select, so the loop vectorises;
-            // each lane's value is the scalar one.
-            let phi = self.phi[i];
-            let r2 = self.r2[i];
-            let (vx, vy, vz) = (p.x - self.cx[i], p.y - self.cy[i], p.z - self.cz[i]);
-            let dist2 = vx * vx + vy * vy + vz * vz;
-            let inside = dist2 <= r2 || dist2 == 0.0 || !dist2.is_finite();
-            let inside_value = if dist2.is_nan() {
-                0.0
-            } else {
-                phi / r2.max(MIN_DIST2)
-            };
-            let d = dist2.sqrt();
-            let (wix, wiy, wiz) = (vx / d, vy / d, vz / d);
-            let sin2_b = r2 / dist2;
-            let (sin_b, cos_b) = (sin2_b.sqrt(), (1.0 - sin2_b).max(0.0).sqrt());
-            let cos_w0 = self.wx[i] * wix + self.wy[i] * wiy + self.wz[i] * wiz;
-            let cos_w = if self.two_sided[i] != 0.0 {
-                cos_w0.abs()
-            } else {
-                cos_w0
-            };
-            let sin_w = sin_of(cos_w);
-            let (cos_o, sin_o) = (self.cos_o[i], self.sin_o[i]);
-            let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-            let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-            let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
-            let mut imp = phi * cos_p / dist2.max(r2).max(MIN_DIST2);
-            let cos_i = (nx * wix + ny * wiy + nz * wiz).abs().min(1.0);
-            let sin_i = sin_of(cos_i);
-            let f_i = cos_sub_clamped(sin_i, cos_i, sin_b, cos_b).max(MIN_COS_I);
-            if has_n {
-                imp *= f_i;
+            *out = Lane {
+                c: Vec3::new(self.cx[i], self.cy[i], self.cz[i]),
+                r: self.r[i],
+                r2: self.r2[i],
+                phi: self.phi[i],
+                w: Vec3::new(self.wx[i], self.wy[i], self.wz[i]),
+                cos_o: self.cos_o[i],
+                sin_o: self.sin_o[i],
+                cos_e: self.cos_e[i],
+                two_sided: self.two_sided[i] != 0.0,
             }
-            let outside_value = if cos_p <= self.cos_e[i] {
-                0.0
-            } else {
-                imp.max(0.0)
-            };
-            let v = if inside { inside_value } else { outside_value };
-            *out = if phi <= 0.0 { 0.0 } else { v };
+            .importance(p, n, has_n);
         }
         out
     }
@@ -370,13 +382,13 @@ mod tests {
     }
 
     #[test]
-    fn four_lanes_equal_the_scalar_importance_bit_for_bit() {
+    fn lanes_equal_the_scalar_importance_bit_for_bit() {
         let mut s = 11u64;
         let next = |s: &mut u64| rand_dir(s).x;
         for trial in 0..4000 {
-            let mut b4 = Bounds4::default();
+            let mut b8 = Bounds8::default();
             let mut scalar = Vec::new();
-            let lanes = 1 + trial % 4;
+            let lanes = 1 + trial % WIDTH;
             for i in 0..lanes {
                 let c = 3.0 * rand_dir(&mut s);
                 let half = 0.5 * rand_dir(&mut s).abs() * if trial % 7 == 0 { 0.0 } else { 1.0 };
@@ -396,7 +408,7 @@ mod tests {
                     two_sided: trial % 3 == 0,
                 };
                 let nb = NodeBounds::from(&b);
-                b4.set(i, &nb);
+                b8.set(i, &nb);
                 scalar.push(nb);
             }
             // Receivers far, near, inside a bounding sphere, on a centre; with and without n.
@@ -407,7 +419,7 @@ mod tests {
                 _ => 3.0 * rand_dir(&mut s),
             };
             let n = (trial % 5 != 0).then(|| rand_dir(&mut s));
-            let got = b4.importance(p, n);
+            let got = b8.importance(p, n);
             for (i, got) in got.iter().enumerate() {
                 let want = scalar.get(i).map_or(0.0, |b| b.importance(p, n));
                 assert_eq!(

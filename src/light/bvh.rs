@@ -1,8 +1,8 @@
 //! A bounding volume hierarchy over the lights at a finite position, for choosing one light per
 //! shading point in proportion to an estimate of what it sends there (many-light sampling of
 //! Conty Estevez & Kulla 2018, "Importance Sampling of Many Lights with Adaptive Tree
-//! Splitting", without the splitting; the scheme of pbrt-v4's BVH light sampler, four children
-//! per node).
+//! Splitting", without the splitting; the scheme of pbrt-v4's BVH light sampler, with up to
+//! eight children per node).
 //!
 //! Leaves are single emitters: a point, spot or goniometric light, or ONE primitive of an area
 //! light (so a luminous ceiling made of one object with many primitives is sampled by where
@@ -11,29 +11,31 @@
 //! A (m²), 4π × peak intensity (cd) for point-like sources) and the cones of their emitters'
 //! axes and spread.
 //!
-//! Sampling walks from the root: at each node its (up to four) children's importances for the
+//! Sampling walks from the root: at each node its (up to eight) children's importances for the
 //! receiver at p with normal n ([`LightBounds::importance`], φ × bounded emitter cosine ×
 //! bounded receiver |cos| / clamped squared distance) are computed together
-//! ([`Bounds4::importance`]), a child is chosen in proportion, and the sample number is
+//! ([`Bounds8::importance`]), a child is chosen in proportion, and the sample number is
 //! rescaled for the next level. The probability of a leaf is the product of the choices;
-//! [`LightBvh::pmf`] recomputes it by following the leaf's trail from the root (two bits per
+//! [`LightBvh::pmf`] recomputes it by following the leaf's trail from the root (three bits per
 //! level: the child taken), with the same arithmetic as [`LightBvh::sample`], so it is exactly
 //! the probability the sample reported. The bounds are conservative, so a light that can send
 //! light to p never has probability zero.
 //!
 //! The tree is built top-down as a binary tree, splitting each node in two by the surface
 //! area–orientation heuristic over 12 buckets of the centroids along each axis (below depth
-//! [`MEDIAN_DEPTH`] at the median instead), then collapsed to four children per node: a node's
-//! children are its binary grandchildren (a child that is a leaf is kept as it is). Four
-//! importances cost about as much as one when computed side by side, and the walk is half as
-//! deep.
+//! [`MEDIAN_DEPTH`] at the median instead), then collapsed to up to eight children per node: a
+//! node's children are its binary descendants some levels down, as many levels as keep them
+//! at most eight (three for a full subtree; a leaf is kept as it is). Eight importances cost
+//! about as much as one when computed side by side, and the walk is a third as deep (a scene
+//! with at most eight emitters has one node: each emitter is chosen by its own importance).
 
-use super::bounds::{Bounds4, LightBounds, NodeBounds};
+use super::bounds::{Bounds8, LightBounds, NodeBounds, WIDTH};
 use glam::Vec3;
 
 /// Depth below which nodes are split at the median (count), so the binary tree is at most
-/// `MEDIAN_DEPTH` + 32 levels deep for up to 2³² leaves, and the 4-wide one half that: its
-/// trails (2 bits per level) fit in 64 bits.
+/// `MEDIAN_DEPTH` + 32 levels deep for up to 2³² leaves, and the 8-wide one at most a third of
+/// that (each of its levels spans at least three binary ones): its trails (3 bits per level)
+/// fit in 64 bits.
 const MEDIAN_DEPTH: u32 = 30;
 const BUCKETS: usize = 12;
 /// The largest f32 below 1, for rescaled sample numbers.
@@ -56,12 +58,12 @@ struct Node {
     leaf: bool,
 }
 
-/// A node of the 4-wide tree: its children's bounds side by side and what each child is.
+/// A node of the 8-wide tree: its children's bounds side by side and what each child is.
 #[derive(Clone, Debug)]
-struct Node4 {
-    bounds: Bounds4,
+struct Node8 {
+    bounds: Bounds8,
     /// Per child: the index of a node (interior child) or of an emitter (leaf child).
-    child: [u32; 4],
+    child: [u32; WIDTH],
     /// Bit i: child i is a leaf.
     leaves: u8,
     /// Children in use (lanes 0..count).
@@ -71,15 +73,15 @@ struct Node4 {
 /// Where an emitter sits in the tree.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Trail {
-    /// Bits 2k, 2k + 1: the child (0–3) taken at depth k.
+    /// Bits 3k to 3k + 2: the child (0–7) taken at depth k.
     pub bits: u64,
     pub depth: u32,
 }
 
 #[derive(Clone, Debug, Default)]
 pub struct LightBvh {
-    /// The 4-wide tree, root first; empty when there are fewer than two emitters.
-    nodes: Vec<Node4>,
+    /// The 8-wide tree, root first; empty when there are fewer than two emitters.
+    nodes: Vec<Node8>,
     /// With exactly one emitter: its bounds (the tree is empty).
     single: Option<NodeBounds>,
     emitters: Vec<Emitter>,
@@ -125,7 +127,7 @@ impl LightBvh {
         &self.emitters
     }
 
-    /// Number of (4-wide) nodes and the deepest leaf's depth in them.
+    /// Number of (8-wide) nodes and the deepest leaf's depth in them.
     pub fn stats(&self) -> (usize, u32) {
         let depth = self.trails.iter().map(|t| t.depth).max().unwrap_or(0);
         (self.nodes.len(), depth)
@@ -161,31 +163,41 @@ impl LightBvh {
         at
     }
 
-    /// The 4-wide node for the binary interior node `b` (its grandchildren, or a child that is
-    /// a leaf), appended with all its descendants; returns its index.
+    /// The 8-wide node for the binary interior node `b`, appended with all its descendants;
+    /// returns its index. Its children: `b`'s, each interior one replaced by its own two as
+    /// long as that makes at most [`WIDTH`] (all of a level at once, so at least three levels).
     fn collapse(&mut self, binary: &[Node], b: usize, trail: Trail) -> u32 {
         let at = self.nodes.len();
-        self.nodes.push(Node4 {
-            bounds: Bounds4::default(),
-            child: [0; 4],
+        self.nodes.push(Node8 {
+            bounds: Bounds8::default(),
+            child: [0; WIDTH],
             leaves: 0,
             count: 0,
         });
-        let mut kids: Vec<usize> = Vec::with_capacity(4);
-        for c in [b + 1, binary[b].index as usize] {
-            if binary[c].leaf {
-                kids.push(c);
-            } else {
-                kids.push(c + 1);
-                kids.push(binary[c].index as usize);
+        let mut kids: Vec<usize> = vec![b];
+        loop {
+            let interior = kids.iter().filter(|&&k| !binary[k].leaf).count();
+            if interior == 0 || kids.len() + interior > WIDTH {
+                break;
             }
+            kids = kids
+                .iter()
+                .flat_map(|&k| {
+                    if binary[k].leaf {
+                        [Some(k), None]
+                    } else {
+                        [Some(k + 1), Some(binary[k].index as usize)]
+                    }
+                })
+                .flatten()
+                .collect();
         }
-        let mut bounds = Bounds4::default();
-        let (mut child, mut leaves) = ([0u32; 4], 0u8);
+        let mut bounds = Bounds8::default();
+        let (mut child, mut leaves) = ([0u32; WIDTH], 0u8);
         for (i, &k) in kids.iter().enumerate() {
             bounds.set(i, &binary[k].bounds);
             let t = Trail {
-                bits: trail.bits | (i as u64) << (2 * trail.depth),
+                bits: trail.bits | (i as u64) << (3 * trail.depth),
                 depth: trail.depth + 1,
             };
             if binary[k].leaf {
@@ -196,7 +208,7 @@ impl LightBvh {
                 child[i] = self.collapse(binary, k, t);
             }
         }
-        self.nodes[at] = Node4 {
+        self.nodes[at] = Node8 {
             bounds,
             child,
             leaves,
@@ -295,17 +307,19 @@ impl LightBvh {
     /// children's, so it may light p while none of them can) the choice goes by power, so
     /// the probabilities still sum to 1 (the leaves so chosen send nothing to p). None at the
     /// root when no child can light p, or for a non-finite sum.
-    #[inline]
-    fn weights(&self, at: usize, p: Vec3, n: Option<Vec3>) -> Option<([f32; 4], f32)> {
+    #[inline(always)]
+    fn weights(&self, at: usize, p: Vec3, n: Option<Vec3>) -> Option<([f32; WIDTH], f32)> {
         let node = &self.nodes[at];
+        let total =
+            |w: &[f32; WIDTH]| ((w[0] + w[1]) + (w[2] + w[3])) + ((w[4] + w[5]) + (w[6] + w[7]));
         let mut w = node.bounds.importance(p, n);
-        let mut sum = (w[0] + w[1]) + (w[2] + w[3]);
+        let mut sum = total(&w);
         if sum == 0.0 {
             if at == 0 {
                 return None;
             }
             w = node.bounds.phi;
-            sum = (w[0] + w[1]) + (w[2] + w[3]);
+            sum = total(&w);
         }
         (sum > 0.0 && sum.is_finite()).then_some((w, sum))
     }
@@ -368,7 +382,7 @@ impl LightBvh {
             let Some((w, sum)) = self.weights(at, p, n) else {
                 return 0.0;
             };
-            let k = (trail.bits >> (2 * level) & 3) as usize;
+            let k = (trail.bits >> (3 * level) & 7) as usize;
             pmf *= w[k] / sum;
             at = self.nodes[at].child[k] as usize;
         }

@@ -30,6 +30,8 @@ pub struct GoniometricLight {
     pub position: Vec3,
     /// Luminaire frame → world.
     pub rotation: Mat3,
+    /// World → luminaire frame: `rotation` transposed once, not at every lookup.
+    to_local: Mat3,
     /// The file's luminous intensity distribution, cd.
     pub distribution: Arc<Distribution>,
     /// Radiant intensity per candela of the table, W·sr⁻¹·nm⁻¹ per cd (times the multiplier).
@@ -118,9 +120,11 @@ impl GoniometricLight {
                 format!("the light is too dim: {amount}, less than {MIN_SPECTRAL_VALUE:e}, which single precision rounds to 0; use a multiplier of 0 for a light that is off"),
             ));
         }
+        let rotation = Mat3::from_quat(crate::geometry::euler_rotation_deg(rotate_deg));
         Ok(Self {
             position,
-            rotation: Mat3::from_quat(crate::geometry::euler_rotation_deg(rotate_deg)),
+            rotation,
+            to_local: rotation.transpose(),
             distribution: Arc::new(distribution),
             spectrum: spectrum.scaled(scale),
             luminous_size_m: phot.size_m,
@@ -139,7 +143,7 @@ impl GoniometricLight {
 
     /// Table candela (before the spectrum's multiplier) toward a unit world direction.
     pub fn table_candela(&self, dir_world: Vec3) -> f64 {
-        let l = self.rotation.transpose() * dir_world;
+        let l = self.to_local * dir_world;
         self.distribution.eval([l.x as f64, l.y as f64, l.z as f64])
     }
 
