@@ -10,6 +10,9 @@
 
 mod ploc;
 mod sah;
+mod small;
+
+pub(super) use small::SmallQuads;
 
 use super::prim::Prim;
 use super::robust::gamma;
@@ -372,6 +375,11 @@ impl SceneGeometry {
 
         // Lay primitives out in leaf order so the traversal indexes them directly.
         let order = &bvh.primitive_indices;
+        let small = if prims.len() <= small::MAX_QUADS {
+            SmallQuads::new(&order.iter().map(|&i| prims[i as usize]).collect::<Vec<_>>())
+        } else {
+            SmallQuads::default()
+        };
         let mut others = Vec::new();
         let tris: Vec<[Vec3; 3]> = order
             .iter()
@@ -424,6 +432,7 @@ impl SceneGeometry {
             object_prims,
             bounds,
             instances: None,
+            small,
         })
     }
 }

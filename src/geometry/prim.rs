@@ -247,9 +247,21 @@ pub(crate) fn intersect_sphere(r: &RayPre, t_max: f32, center: Vec3, radius: f32
 /// division's latency would otherwise hold up each (often mispredicted) branch.
 #[inline(always)]
 pub(crate) fn intersect_quad(r: &RayPre, t_max: f32, origin: Vec3, q: &QuadPre) -> Option<PrimT> {
-    let w = origin.as_dvec3() - r.od;
+    intersect_quad_f64(r.od, r.dd, t_max, origin, q)
+}
+
+/// [`intersect_quad`] of the ray with origin `od` and direction `dd` (in f64).
+#[inline(always)]
+pub(crate) fn intersect_quad_f64(
+    od: DVec3,
+    dd: DVec3,
+    t_max: f32,
+    origin: Vec3,
+    q: &QuadPre,
+) -> Option<PrimT> {
+    let w = origin.as_dvec3() - od;
     let num = w.dot(q.n);
-    let den = r.dd.dot(q.n);
+    let den = dd.dot(q.n);
     let den_abs = den.abs();
     // t > 0 (which also excludes den = 0) and t < t_max, the latter with a relative margin of
     // 1e-6 that covers the rounding of t to f32: the exact test follows the division.
@@ -258,8 +270,8 @@ pub(crate) fn intersect_quad(r: &RayPre, t_max: f32, origin: Vec3, q: &QuadPre) 
     }
     // s·|d·n| and t·|d·n| (the parameters' sign follows d·n's; ×±1 is exact).
     let sign = if den < 0.0 { -1.0 } else { 1.0 };
-    let sd = sign * (num * r.dd.dot(q.du) - den * w.dot(q.du));
-    let vd = sign * (num * r.dd.dot(q.dv) - den * w.dot(q.dv));
+    let sd = sign * (num * dd.dot(q.du) - den * w.dot(q.du));
+    let vd = sign * (num * dd.dot(q.dv) - den * w.dot(q.dv));
     if !(sd >= 0.0 && sd <= den_abs && vd >= 0.0 && vd <= den_abs) {
         return None;
     }
@@ -335,6 +347,28 @@ pub(crate) fn triangle_hit_geom(v: &[Vec3; 3], a: f32, b: f32) -> HitGeom {
         uv: Vec2::new(a, b),
         error,
         bary: Vec3::new(b0, a, b),
+    }
+}
+
+/// [`Prim::hit_geom`] of a quad at parameters (s, t) = (a, b).
+#[inline(always)]
+pub(crate) fn quad_hit_geom(
+    origin: Vec3,
+    edge_u: Vec3,
+    edge_v: Vec3,
+    q: &QuadPre,
+    a: f32,
+    b: f32,
+) -> HitGeom {
+    let (o, eu, ev) = (origin.as_dvec3(), edge_u.as_dvec3(), edge_v.as_dvec3());
+    let (s, v) = (a as f64, b as f64);
+    let p = (o + s * eu + v * ev).as_vec3();
+    HitGeom {
+        p,
+        ng: q.unit_n,
+        uv: Vec2::new(a, b),
+        error: rounded_error(p, o.abs() + eu.abs() + ev.abs()),
+        bary: Vec3::ZERO,
     }
 }
 
@@ -470,19 +504,8 @@ impl Prim {
                 origin,
                 edge_u,
                 edge_v,
-                ..
-            } => {
-                let (o, eu, ev) = (origin.as_dvec3(), edge_u.as_dvec3(), edge_v.as_dvec3());
-                let (s, v) = (a as f64, b as f64);
-                let p = (o + s * eu + v * ev).as_vec3();
-                HitGeom {
-                    p,
-                    ng: self.normal_at(p),
-                    uv: Vec2::new(a, b),
-                    error: rounded_error(p, o.abs() + eu.abs() + ev.abs()),
-                    bary: Vec3::ZERO,
-                }
-            }
+                pre,
+            } => quad_hit_geom(origin, edge_u, edge_v, &pre, a, b),
             Prim::Disk {
                 center,
                 normal,

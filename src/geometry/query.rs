@@ -1,6 +1,7 @@
 //! Ray queries on the scene BVH: closest hit (full [`Hit`] or Embree-style [`RayHit`]),
 //! any hit for shadow rays (optionally letting some objects' primitives through), the
-//! per-primitive leaf tests they run, and a brute-force reference.
+//! per-primitive leaf tests they run, and a brute-force reference. A scene of a few quads is
+//! queried without its BVH (`bvh::small`).
 
 use super::instance::InstanceSet;
 use super::prim::{Prim, PrimT, RayPre};
@@ -99,10 +100,9 @@ fn intersect_triangle_simd<const KZ: usize>(
     }
 }
 
-/// A closest hit: on a primitive stored flat (the ray's test data and (primitive, t, a, b)),
-/// or in an instance.
+/// A closest hit: on a primitive stored flat ((primitive, t, a, b)), or in an instance.
 enum Found<'a> {
-    Flat(RayPre, (u32, f32, f32, f32)),
+    Flat((u32, f32, f32, f32)),
     Instanced(&'a InstanceSet, (u32, RayPre, u32, PrimT)),
 }
 
@@ -123,7 +123,7 @@ impl SceneGeometry {
     /// (point, unit normals, shading normal, error bounds).
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
         Some(match self.closest_any(origin, dir, t_max)? {
-            Found::Flat(pre, (prim, t, a, b)) => self.make_hit(prim, &pre, t, a, b),
+            Found::Flat((prim, t, a, b)) => self.hit_record(prim, origin, dir, t, a, b),
             Found::Instanced(set, h) => set.make_hit(h, dir),
         })
     }
@@ -133,7 +133,7 @@ impl SceneGeometry {
     /// conventions as [`SceneGeometry::intersect`], without building the full [`Hit`].
     pub fn intersect_basic(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<RayHit> {
         Some(match self.closest_any(origin, dir, t_max)? {
-            Found::Flat(_, (prim, t, u, v)) => {
+            Found::Flat((prim, t, u, v)) => {
                 let tri = &self.tris[prim as usize];
                 let ng = if tri[0].x.is_nan() {
                     self.prim(prim).normal_at(origin + t * dir)
@@ -174,11 +174,13 @@ impl SceneGeometry {
         if !Self::ray_ok(origin, dir, t_max) {
             return None;
         }
-        let pre = RayPre::new(origin, dir);
-        let flat = if self.tris.is_empty() {
+        // A scene of a few quads needs none of the triangle test's ray data.
+        let flat = if self.small.active() {
+            self.small.closest(origin, dir, t_max)
+        } else if self.tris.is_empty() {
             None
         } else {
-            self.closest_dyn(&pre, t_max)
+            self.closest_dyn(&RayPre::new(origin, dir), t_max)
         };
         if let Some(set) = &self.instances {
             let t = flat.map_or(t_max, |f| f.1);
@@ -186,12 +188,15 @@ impl SceneGeometry {
                 return Some(Found::Instanced(set, h));
             }
         }
-        flat.map(|f| Found::Flat(pre, f))
+        flat.map(Found::Flat)
     }
 
     /// Closest-hit traversal: (primitive, t, a, b) of the closest hit.
     #[inline(always)]
     pub(super) fn closest_dyn(&self, pre: &RayPre, t_max: f32) -> Option<(u32, f32, f32, f32)> {
+        if self.small.active() {
+            return self.small.closest(pre.o, pre.d, t_max);
+        }
         match pre.kz {
             0 => self.closest::<0>(pre, t_max),
             1 => self.closest::<1>(pre, t_max),
@@ -286,9 +291,27 @@ impl SceneGeometry {
     /// The hit record for primitive `prim` at ray parameter `t` (used after traversal and by
     /// brute-force tests).
     pub(super) fn make_hit(&self, prim: u32, pre: &RayPre, t: f32, a: f32, b: f32) -> Hit {
+        self.hit_record(prim, pre.o, pre.d, t, a, b)
+    }
+
+    /// [`SceneGeometry::make_hit`] for the ray from `origin` along `dir`, inlined into
+    /// [`SceneGeometry::intersect`] (the call and its ray data showed in profiles of small
+    /// scenes).
+    #[inline(always)]
+    fn hit_record(&self, prim: u32, origin: Vec3, dir: Vec3, t: f32, a: f32, b: f32) -> Hit {
         let v = &self.tris[prim as usize];
         let g = if v[0].x.is_nan() {
-            self.others[v[1].x.to_bits() as usize].hit_geom(pre, t, a, b)
+            // Quads (the common analytic primitive) skip the ray data that only spheres and
+            // disks need.
+            match self.others[v[1].x.to_bits() as usize] {
+                Prim::Quad {
+                    origin: corner,
+                    edge_u,
+                    edge_v,
+                    ref pre,
+                } => super::prim::quad_hit_geom(corner, edge_u, edge_v, pre, a, b),
+                ref p => p.hit_geom(&RayPre::new(origin, dir), t, a, b),
+            }
         } else {
             super::prim::triangle_hit_geom(v, a, b)
         };
@@ -322,7 +345,7 @@ impl SceneGeometry {
             prim,
             object: self.prim_object[prim as usize],
             instance: super::NO_INSTANCE,
-            front_face: pre.d.dot(g.ng) < 0.0,
+            front_face: dir.dot(g.ng) < 0.0,
             error: g.error,
         }
     }
@@ -333,7 +356,11 @@ impl SceneGeometry {
         if !Self::ray_ok(origin, dir, t_max) {
             return false;
         }
-        if !self.tris.is_empty() {
+        if self.small.active() {
+            if self.small.any_hit(origin, dir, t_max, |_, _, _| false) {
+                return true;
+            }
+        } else if !self.tris.is_empty() {
             let pre = RayPre::new(origin, dir);
             let block = |_: u32, _: &RayPre, _: PrimT| false;
             let hit = match pre.kz {
@@ -418,6 +445,9 @@ impl SceneGeometry {
         t_max: f32,
         pass: impl FnMut(u32, &RayPre, PrimT) -> bool,
     ) -> bool {
+        if self.small.active() {
+            return self.small.any_hit(pre.o, pre.d, t_max, pass);
+        }
         if self.others.is_empty() {
             self.any_hit_in::<KZ, false>(pre, t_max, pass)
         } else {

@@ -158,6 +158,7 @@ pub fn shadow_ray(from: &Hit, to_point: Vec3, to_normal: Vec3) -> (Vec3, Vec3, f
 
 /// General form of [`shadow_ray`] with explicit error bounds at both ends. A zero normal at
 /// either end means "a point not on a surface" (no offset at that end).
+#[inline]
 pub fn shadow_ray_between(
     from_p: Vec3,
     from_error: Vec3,

@@ -2,7 +2,7 @@
 //! objects and their primitives, bounds and size statistics. Building it is in `bvh`, ray
 //! queries in `query` (over the node walk in `traverse`), primitive sampling in `sample`.
 
-use super::bvh::cwbvh_depth;
+use super::bvh::{cwbvh_depth, SmallQuads};
 use super::instance::InstanceSet;
 use super::prim::Prim;
 use glam::Vec3;
@@ -33,6 +33,9 @@ pub struct SceneGeometry {
     /// Instanced meshes and their top-level BVH; `None` when the scene has none, so that
     /// scenes without instances pay one branch per query for them.
     pub(super) instances: Option<Box<InstanceSet>>,
+    /// For a scene of a few quads, their data for testing them all without the BVH (which
+    /// the queries then skip); empty otherwise.
+    pub(super) small: SmallQuads,
 }
 
 impl SceneGeometry {
@@ -105,5 +108,6 @@ impl SceneGeometry {
                 .map(|(_, v)| v.capacity() * 4 + 32)
                 .sum::<usize>()
             + self.instances.as_ref().map_or(0, |s| s.memory_bytes())
+            + self.small.memory_bytes()
     }
 }
