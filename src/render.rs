@@ -404,6 +404,9 @@ pub fn render_progressive(
         max_samples: world.camera.inside_pixels() as u64 * prog.max_spp as u64,
         ..Default::default()
     };
+    // Each tile's results, kept from pass to pass: the memory is reused instead of allocated
+    // (and its pages faulted in afresh) for every pass.
+    let mut tiles: Vec<TileResult> = (0..n_tiles).map(|_| TileResult::default()).collect();
     let reason = 'passes: loop {
         let (plan, frac) = plan_pass(world, film, prog);
         status.converged_fraction = frac;
@@ -424,15 +427,16 @@ pub fn render_progressive(
         }
         let adaptive = film.decision.is_some();
         let film_ref: &Film = film;
-        let results: Vec<Option<TileResult>> = pool.install(|| {
-            (0..n_tiles)
-                .into_par_iter()
-                .map(|t| {
+        let completed: Vec<bool> = pool.install(|| {
+            tiles
+                .par_iter_mut()
+                .enumerate()
+                .map(|(t, r)| {
                     if stop.load(Ordering::Relaxed) {
-                        return None;
+                        return false;
                     }
                     let (tx, ty) = (t % tiles_x, t / tiles_x);
-                    let mut r = TileResult::default();
+                    r.clear();
                     for y in ty * TILE..((ty + 1) * TILE).min(h) {
                         for x in tx * TILE..((tx + 1) * TILE).min(w) {
                             let i = y * w + x;
@@ -505,11 +509,11 @@ pub fn render_progressive(
                             r.health.extend(hp.into_iter().flatten());
                         }
                     }
-                    Some(r)
+                    true
                 })
                 .collect()
         });
-        if results.iter().any(Option::is_none) {
+        if completed.contains(&false) {
             break 'passes StopReason::Interrupted;
         }
         // Caustic light paths: `light_paths_per_sample` per camera sample each buffer received
@@ -544,9 +548,9 @@ pub fn render_progressive(
                 light.push((b, sums, per_buffer));
             }
         }
-        for r in results.into_iter().flatten() {
+        for r in &tiles {
             stats.merge(&r.stats);
-            for (k, (i, est)) in r.pixels.into_iter().enumerate() {
+            for (k, &(i, est)) in r.pixels.iter().enumerate() {
                 film.pixels[i] = est;
                 if let Some(d) = film.decision.as_mut() {
                     d[i] = r.decision[k];
@@ -616,6 +620,18 @@ struct TileResult {
     /// The pixels' light-and-health sums, when the film keeps them, one pixel after another.
     health: Vec<f64>,
     stats: RayStats,
+}
+
+impl TileResult {
+    /// Empty, keeping the vectors' memory for the next pass.
+    fn clear(&mut self) {
+        self.pixels.clear();
+        self.decision.clear();
+        self.e.clear();
+        self.decision_e.clear();
+        self.health.clear();
+        self.stats = RayStats::default();
+    }
 }
 
 /// Render the whole image at the scene's samples per pixel with `threads` worker threads
