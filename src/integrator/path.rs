@@ -132,7 +132,7 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
     // roulette only.
     let mut eta_scale = 1.0f32;
     // Russian roulette weighs the throughput relative to its value after the first scattering
-    // of a path from a camera or a luminance meter (set there): such a path's value is about
+    // of a path from a camera or a luminance meter (set at that scattering): its value is about
     // that surface's albedo times the light it receives, so what the rest of the path brings
     // matters relative to that albedo, not to 1. A dark surface's pixel is then as precise, for
     // its value, as a bright one's. A receiver's path (depth ≥ 1 at the start) keeps 1.

@@ -202,44 +202,22 @@ impl NodeBounds {
             Some(n) => (n, true),
             None => (Vec3::ZERO, false),
         };
-        Lane {
-            c: self.centre,
-            r: self.r,
-            r2: self.r2,
-            phi: self.phi,
-            w: self.w,
-            cos_o: self.cos_o,
-            sin_o: self.sin_o,
-            cos_e: self.cos_e,
-            two_sided: self.two_sided,
-        }
-        .importance(p, n, has_n)
+        self.importance_of_lane(p, n, has_n)
     }
-}
 
-/// One lane of [`Bounds8`] (the fields of [`NodeBounds`]).
-struct Lane {
-    c: Vec3,
-    r: f32,
-    r2: f32,
-    phi: f32,
-    w: Vec3,
-    cos_o: f32,
-    sin_o: f32,
-    cos_e: f32,
-    two_sided: bool,
-}
-
-impl Lane {
     /// [`NodeBounds::importance`] (`has_n` false: no normal), with every branch a select so
     /// that [`Bounds8`] computes eight lanes side by side in SIMD. The direction to p is never
     /// normalised: with d = |p − c|, the cosines and sines of the angles at p are kept as d
     /// times their value (d² for the final one), which leaves one division (1/d²) and no
     /// chain of square root then division.
     #[inline(always)]
-    fn importance(&self, p: Vec3, n: Vec3, has_n: bool) -> f32 {
+    fn importance_of_lane(&self, p: Vec3, n: Vec3, has_n: bool) -> f32 {
         let (r, r2, phi) = (self.r, self.r2, self.phi);
-        let (vx, vy, vz) = (p.x - self.c.x, p.y - self.c.y, p.z - self.c.z);
+        let (vx, vy, vz) = (
+            p.x - self.centre.x,
+            p.y - self.centre.y,
+            p.z - self.centre.z,
+        );
         let dist2 = vx * vx + vy * vy + vz * vz;
         let inside = dist2 <= r2 || dist2 == 0.0 || !dist2.is_finite();
         // Inside the bounding sphere: every direction is possible.
@@ -347,8 +325,8 @@ impl Bounds8 {
         };
         let mut out = [0.0f32; WIDTH];
         for (i, out) in out.iter_mut().enumerate() {
-            *out = Lane {
-                c: Vec3::new(self.cx[i], self.cy[i], self.cz[i]),
+            *out = NodeBounds {
+                centre: Vec3::new(self.cx[i], self.cy[i], self.cz[i]),
                 r: self.r[i],
                 r2: self.r2[i],
                 phi: self.phi[i],
@@ -358,7 +336,7 @@ impl Bounds8 {
                 cos_e: self.cos_e[i],
                 two_sided: self.two_sided[i] != 0.0,
             }
-            .importance(p, n, has_n);
+            .importance_of_lane(p, n, has_n);
         }
         out
     }

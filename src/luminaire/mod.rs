@@ -601,6 +601,8 @@ pub fn polar_value(dist: &Distribution, c: f64, t: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     #[test]
     fn bracket_index_agrees_with_the_binary_search() {
         let tables: [&[f64]; 5] = [
@@ -616,13 +618,11 @@ mod tests {
                 let x = a + (b - a) * k as f64 / 4000.0;
                 for x in [x, xs[k % xs.len()]] {
                     let want = xs.partition_point(|&v| v <= x).clamp(1, xs.len() - 1) - 1;
-                    assert_eq!(super::bracket_index(xs, x), want, "{xs:?} at {x}");
+                    assert_eq!(bracket_index(xs, x), want, "{xs:?} at {x}");
                 }
             }
         }
     }
-
-    use super::*;
 
     fn rot(values: impl Fn(f64) -> f64, angles: &[f64]) -> Photometry {
         Photometry {

@@ -247,13 +247,15 @@ impl SmallQuads {
         mut pass: impl FnMut(u32, &RayPre, PrimT) -> bool,
     ) -> bool {
         let (od, dd) = (o.as_dvec3(), d.as_dvec3());
+        // The ray's test data, made once and only for a ray that hits something.
+        let mut pre = None;
         for (gi, g) in self.groups.iter().enumerate() {
             let (_, mut mask) = Self::group_t(g, od, dd, t_max);
             while mask != 0 {
                 let id = gi * LANES + mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if let Some(h) = self.test(id, od, dd, t_max) {
-                    if !pass(id as u32, &RayPre::new(o, d), h) {
+                    if !pass(id as u32, pre.get_or_insert_with(|| RayPre::new(o, d)), h) {
                         return true;
                     }
                 }
