@@ -76,18 +76,31 @@ pub fn render_pixel(
             sun_deposited: sun.is_some(),
             ..PathStart::image(world, ray.origin)
         };
-        let l = trace(
-            world,
-            ray.origin,
-            ray.dir,
-            start,
-            &mut wl,
-            &mut sampler,
-            stats,
-        );
+        let (l, first_hit) = if e.is_some() {
+            crate::integrator::path::trace_with_first_hit(
+                world,
+                ray.origin,
+                ray.dir,
+                start,
+                &mut wl,
+                &mut sampler,
+                stats,
+            )
+        } else {
+            let l = trace(
+                world,
+                ray.origin,
+                ray.dir,
+                start,
+                &mut wl,
+                &mut sampler,
+                stats,
+            );
+            (l, None)
+        };
         if let Some(e) = e.as_deref_mut() {
             let mel = health.as_ref().is_some_and(|h| h.wants_irradiance());
-            let seen = (ray.origin, ray.dir, &l, &wl);
+            let seen = (ray.dir, first_hit, &l, &wl);
             let v = surface_illuminance(world, seed, seen, batch, index, mel, stats);
             if let (Some(h), Some((_, m))) = (health.as_mut(), v) {
                 h.add_edi(sums.count, m);
@@ -127,8 +140,9 @@ const ILLUMINANCE_STREAM: u64 = 0x11_1c_e5_7a_u64 << 20;
 const MIN_REUSED_REFLECTANCE: f32 = 1e-4;
 
 /// Illuminance (lx) on the surface a camera ray sees, or None if it sees no receiving surface
-/// (nothing, the sky, or an emitter). `seen` is the camera ray (origin, direction) with the
-/// radiance its path brought and that path's wavelengths. At a flat-shaded Lambertian surface
+/// (nothing, the sky, or an emitter). `seen` is the camera ray's direction, its first
+/// intersection (the camera path's own, not traced again), the radiance its path brought and
+/// that path's wavelengths. At a flat-shaded Lambertian surface
 /// of reflectance ρ(λ) the surface reflects ρ/π of its irradiance, so π L/ρ is an irradiance
 /// estimator of the same form as [`crate::integrator::irradiance`] (light sampling weighed
 /// against the cosine-sampled continuation, which Lambertian sampling is) at no further cost;
@@ -141,9 +155,9 @@ const MIN_REUSED_REFLECTANCE: f32 = 1e-4;
 fn surface_illuminance(
     world: &World,
     seed: u64,
-    (origin, dir, l, wl_cam): (
+    (dir, hit, l, wl_cam): (
         glam::Vec3,
-        glam::Vec3,
+        Option<crate::geometry::Hit>,
         &crate::spectrum::SampledSpectrum,
         &SampledWavelengths,
     ),
@@ -152,8 +166,7 @@ fn surface_illuminance(
     melanopic: bool,
     stats: &mut RayStats,
 ) -> Option<(f64, f64)> {
-    let hit = world.geometry.intersect(origin, dir, f32::INFINITY)?;
-    stats.camera_rays += 1;
+    let hit = hit?;
     let object = world.objects[hit.object as usize];
     if object.light.is_some() {
         return None;

@@ -117,7 +117,49 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
     stats: &mut RayStats,
     tally: &mut T,
 ) -> SampledSpectrum {
+    trace_impl(world, origin, dir, start, wl, sampler, stats, tally, false).0
+}
+
+/// [`trace`], and the first intersection of the ray (`intersect`'s hit, before any normal map):
+/// the surface the camera sees, for estimates at it that would otherwise trace the ray again.
+pub fn trace_with_first_hit(
+    world: &World,
+    origin: Vec3,
+    dir: Vec3,
+    start: PathStart,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+) -> (SampledSpectrum, Option<Hit>) {
+    trace_impl(
+        world,
+        origin,
+        dir,
+        start,
+        wl,
+        sampler,
+        stats,
+        &mut |_, _| {},
+        true,
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn trace_impl<T: FnMut(Vec3, SampledSpectrum)>(
+    world: &World,
+    origin: Vec3,
+    dir: Vec3,
+    start: PathStart,
+    wl: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    stats: &mut RayStats,
+    tally: &mut T,
+    keep_first_hit: bool,
+) -> (SampledSpectrum, Option<Hit>) {
     let settings = &world.settings;
+    let mut first_hit = None;
+    let mut seen_first = false;
     let mut l = SampledSpectrum::ZERO;
     let mut beta = SampledSpectrum::ONE;
     let mut ray_o = origin;
@@ -147,6 +189,10 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
 
     loop {
         let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
+        if keep_first_hit && !seen_first {
+            first_hit = hit;
+        }
+        seen_first = true;
         let Some(hit) = hit else {
             if depth == start.depth && !start.unscattered_escapes {
                 break;
@@ -342,7 +388,7 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
         }
         stats.bounce_rays += 1;
     }
-    l
+    (l, first_hit)
 }
 
 /// Factor on the throughput for Russian roulette after a camera path's first scattering left it
