@@ -144,7 +144,7 @@ impl GoniometricLight {
     /// Table candela (before the spectrum's multiplier) toward a unit world direction.
     pub fn table_candela(&self, dir_world: Vec3) -> f64 {
         let l = self.to_local * dir_world;
-        self.distribution.eval([l.x as f64, l.y as f64, l.z as f64])
+        self.distribution.eval_f32(l.to_array())
     }
 
     /// Luminous intensity (cd) toward a unit world direction, multiplier included.

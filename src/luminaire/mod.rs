@@ -423,6 +423,20 @@ impl Distribution {
         }
     }
 
+    /// [`Distribution::eval`] of a single-precision direction, as rendering asks for it: Type C
+    /// angles come from the single-precision `acos` and `atan2`, about twice as fast as the
+    /// double ones and as accurate as the direction itself (10⁻⁷ rad, 6·10⁻⁶°).
+    #[inline]
+    pub fn eval_f32(&self, d: [f32; 3]) -> f64 {
+        if self.kind != Kind::C {
+            return self.eval(d.map(f64::from));
+        }
+        let [x, y, z] = d;
+        let gamma = ((-y).clamp(-1.0, 1.0).acos() as f64).to_degrees();
+        let c = (((-z).atan2(x)) as f64).to_degrees().rem_euclid(360.0);
+        self.eval_angles(c, gamma)
+    }
+
     /// Candela toward a unit direction of the luminaire frame.
     pub fn eval(&self, d: [f64; 3]) -> f64 {
         let (p, a) = self.angles_of(d);
