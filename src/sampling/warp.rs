@@ -10,15 +10,30 @@ pub fn concentric_disk(u: Vec2) -> Vec2 {
     if o.x == 0.0 && o.y == 0.0 {
         return Vec2::ZERO;
     }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, std::f32::consts::FRAC_PI_4 * (o.y / o.x))
+    // The angle is π/4·q (|q| ≤ 1) from the x axis, or that from the y axis: a cosine and a
+    // sine on [−π/4, π/4], where short Taylor polynomials are exact to f32 rounding (no range
+    // reduction, unlike the library's sincos, which was 2 % of a diffuse render).
+    if o.x.abs() > o.y.abs() {
+        let (c, s) = cos_sin_quarter(std::f32::consts::FRAC_PI_4 * (o.y / o.x));
+        o.x * Vec2::new(c, s)
     } else {
-        (
-            o.y,
-            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (o.x / o.y),
-        )
-    };
-    r * Vec2::new(theta.cos(), theta.sin())
+        let (c, s) = cos_sin_quarter(std::f32::consts::FRAC_PI_4 * (o.x / o.y));
+        o.y * Vec2::new(s, c)
+    }
+}
+
+/// (cos x, sin x) for |x| ≤ π/4: Taylor polynomials to x⁸ and x⁹, whose truncation errors
+/// (below 3·10⁻⁸ and 2·10⁻⁹) are under half an f32 ulp of the results.
+#[inline(always)]
+fn cos_sin_quarter(x: f32) -> (f32, f32) {
+    let x2 = x * x;
+    let c =
+        1.0 + x2 * (-1.0 / 2.0 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0))));
+    let s = x
+        * (1.0
+            + x2 * (-1.0 / 6.0
+                + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0)))));
+    (c, s)
 }
 
 /// The concentric map in f64, as polar coordinates (r, φ) of the unit disk; r may be negative
@@ -156,6 +171,24 @@ mod tests {
         assert!(
             (r * phi.cos() - d.x as f64).abs() < 1e-6 && (r * phi.sin() - d.y as f64).abs() < 1e-6
         );
+        // The polynomial cosine and sine are the library's to f32 rounding, and the map is the
+        // f64 polar map's.
+        for k in 0..=20_000 {
+            let x = std::f32::consts::FRAC_PI_4 * (k as f32 / 10_000.0 - 1.0);
+            let (c, s) = cos_sin_quarter(x);
+            let xd = x as f64;
+            assert!((c as f64 - xd.cos()).abs() < 1.2e-7, "cos {x}");
+            assert!((s as f64 - xd.sin()).abs() < 6e-8, "sin {x}");
+        }
+        for i in 0..=200 {
+            for j in 0..=200 {
+                let (u0, u1) = (i as f32 / 200.0, j as f32 / 200.0);
+                let (r, phi) = concentric_disk_polar(u0 as f64, u1 as f64);
+                let d = concentric_disk(Vec2::new(u0, u1));
+                assert!((r * phi.cos() - d.x as f64).abs() < 2e-7, "{u0} {u1}");
+                assert!((r * phi.sin() - d.y as f64).abs() < 2e-7, "{u0} {u1}");
+            }
+        }
         let v = uniform_sphere_f64(0.2, 0.7);
         let w = uniform_sphere(Vec2::new(0.2, 0.7));
         assert!((v.as_vec3() - w).length() < 1e-6);

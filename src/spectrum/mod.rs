@@ -153,8 +153,11 @@ impl SampledWavelengths {
             if up >= 1.0 {
                 up -= 1.0;
             }
-            lambda[i] = sample_visible_wavelength(up);
-            pdf[i] = visible_wavelength_pdf(lambda[i]);
+            // a(λ − 538) = atanh(t), so sech² of it is 1 − t²: the density without an
+            // exponential.
+            let t = visible_tanh(up);
+            lambda[i] = wavelength_of_tanh(t);
+            pdf[i] = VIS_NORM as f32 * (1.0 - t * t);
         }
         Self { lambda, pdf }
     }
@@ -224,8 +227,19 @@ const VIS_NORM: f64 = VIS_A / (VIS_TANH_MAX - VIS_TANH_MIN);
 /// Inverse-CDF warp for [`visible_wavelength_pdf`]: λ = 538 + atanh(t)/a with
 /// t = lerp(u, tanh(a(360−538)), tanh(a(830−538))).
 pub fn sample_visible_wavelength(u: f32) -> f32 {
+    wavelength_of_tanh(visible_tanh(u))
+}
+
+/// tanh(a(λ − 538)) of the wavelength that [`sample_visible_wavelength`] gives for `u`.
+#[inline]
+fn visible_tanh(u: f32) -> f32 {
     let (t0, t1) = (VIS_TANH_MIN as f32, VIS_TANH_MAX as f32);
-    let t = t0 + u * (t1 - t0);
+    t0 + u * (t1 - t0)
+}
+
+/// λ = 538 + atanh(t)/a, nm.
+#[inline]
+fn wavelength_of_tanh(t: f32) -> f32 {
     // atanh(t) = ½ ln((1 + t)/(1 − t)), in f32 (t stays ≥ 0.03 away from ±1).
     let l = VIS_CENTER as f32 + ((1.0 + t) / (1.0 - t)).ln() * (0.5 / VIS_A as f32);
     l.clamp(LAMBDA_MIN, LAMBDA_MAX)
@@ -320,6 +334,14 @@ mod tests {
         for i in 1..N_LAMBDA {
             assert!(wl.lambda[i] != wl.lambda[0]);
             assert!(wl.pdf[i] > 0.0);
+        }
+        // The sampler's densities are the density function's at its wavelengths.
+        for u in (0..1000).map(|k| k as f32 / 1000.0) {
+            let wl = SampledWavelengths::sample_visible(u);
+            for i in 0..N_LAMBDA {
+                let want = visible_wavelength_pdf(wl.lambda[i]);
+                assert!((wl.pdf[i] - want).abs() <= 2e-6 * want, "{u} {i}");
+            }
         }
         let mut t = wl;
         t.terminate_secondary();
