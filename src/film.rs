@@ -75,37 +75,69 @@ pub fn radiance_to_xyz(l: &SampledSpectrum, wl: &SampledWavelengths) -> [f64; 3]
     [xyz[0] * k, xyz[1] * k, xyz[2] * k]
 }
 
-/// Independent batches of a pixel's camera samples: sample i belongs to batch i mod
-/// `PIXEL_BATCHES`, where it is sample i / `PIXEL_BATCHES` of the batch's own scrambled Sobol
-/// sequence (see [`crate::render::render_pixel`]); as for meters ([`crate::meter::BATCHES`]).
+/// Slots of a pixel's batch sums: sample i is added to slot i mod `PIXEL_BATCHES`. A render
+/// draws its camera samples from K independently scrambled Sobol sequences per pixel, K =
+/// [`Film::pixel_batches`] (2, 4, 8 or 16, a divisor of 16): sample i is sample i / K of
+/// sequence i mod K (see [`crate::render::render_pixel`]), so slot b holds samples of sequence
+/// b mod K, and the K batches are the slots taken together by that remainder
+/// ([`batch_standard_error`]).
 pub const PIXEL_BATCHES: usize = 16;
+
+/// Independent sample sequences (batches) per pixel unless the scene says otherwise
+/// (`render.pixel_batches`): the most, for the narrowest 95 % intervals (Student's t with 15
+/// degrees of freedom).
+pub const DEFAULT_PIXEL_BATCHES: u32 = 16;
+
+fn default_pixel_batches() -> u32 {
+    DEFAULT_PIXEL_BATCHES
+}
+
+/// The numbers of batches per pixel a render may use: the divisors of [`PIXEL_BATCHES`] that
+/// leave at least two batches for a standard error.
+pub const PIXEL_BATCH_CHOICES: [u32; 4] = [2, 4, 8, 16];
+
+/// The batch sums of `k` batches from the slot sums (slot b in batch b mod k), in the first
+/// `k` entries.
+#[inline]
+pub fn fold_batches(slots: &[f64; PIXEL_BATCHES], k: u32) -> [f64; PIXEL_BATCHES] {
+    let k = (k as usize).clamp(1, PIXEL_BATCHES);
+    let mut out = [0.0; PIXEL_BATCHES];
+    for (b, v) in slots.iter().enumerate() {
+        out[b % k] += v;
+    }
+    out
+}
 
 /// EXR attribute giving the number of independent sample batches per pixel behind `stderr.Y`
 /// and `stderr.E`: a pixel with n samples has min(n, batches) of them, and its 95 % interval
 /// uses Student's t with one degree of freedom fewer.
 pub const STDERR_BATCHES_ATTRIBUTE: &str = "stderr_batches";
 
-/// Samples of batch `b` among the first `n` samples of a pixel (sample i in batch i mod 16).
+/// Samples of batch `b` of `k` among the first `n` samples of a pixel (sample i in batch
+/// i mod k).
 #[inline]
-pub fn batch_count(n: u64, b: usize) -> u64 {
-    n / PIXEL_BATCHES as u64 + ((b as u64) < n % PIXEL_BATCHES as u64) as u64
+pub fn batch_count(n: u64, b: usize, k: u32) -> u64 {
+    let k = k as u64;
+    n / k + ((b as u64) < n % k) as u64
 }
 
-/// Standard error of Σ Sᵦ / n from the sums Sᵦ of the independent batches of `n` samples
-/// (batch sizes by [`batch_count`]): the ratio estimator's
-/// √(K/(K−1) · Σᵦ (Sᵦ − x̄ nᵦ)²) / n over the K = min(n, 16) non-empty batches, which is the
-/// spread of the batch means over √K when the batches are equal. 0 below 2 batches.
-pub fn batch_standard_error(sums: &[f64; PIXEL_BATCHES], n: u64) -> f64 {
-    let k = n.min(PIXEL_BATCHES as u64) as usize;
-    if k < 2 {
+/// Standard error of Σ / n from the slot sums `slots` of `n` samples drawn from `k`
+/// independent batches ([`fold_batches`]; batch sizes by [`batch_count`]): the ratio
+/// estimator's √(K/(K−1) · Σᵦ (Sᵦ − x̄ nᵦ)²) / n over the K = min(n, k) non-empty batches,
+/// which is the spread of the batch means over √K when the batches are equal. 0 below 2
+/// batches.
+pub fn batch_standard_error(slots: &[f64; PIXEL_BATCHES], n: u64, k: u32) -> f64 {
+    let sums = fold_batches(slots, k);
+    let kk = n.min(k as u64) as usize;
+    if kk < 2 {
         return 0.0;
     }
     let nf = n as f64;
     let mean = sums.iter().sum::<f64>() / nf;
-    let ss: f64 = (0..k)
-        .map(|b| (sums[b] - mean * batch_count(n, b) as f64).powi(2))
+    let ss: f64 = (0..kk)
+        .map(|b| (sums[b] - mean * batch_count(n, b, k) as f64).powi(2))
         .sum();
-    (ss * k as f64 / (k - 1) as f64).sqrt() / nf
+    (ss * kk as f64 / (kk - 1) as f64).sqrt() / nf
 }
 
 /// Running sums for one pixel (its illuminance, when estimated, is kept apart in
@@ -146,17 +178,17 @@ impl PixelSums {
         self.batch_y[b] += xyz[1];
         self.count += 1;
     }
-    /// Independent batches behind the camera samples' standard errors (min(samples, 16)); the
-    /// 95 % intervals use Student's t with one degree of freedom fewer
-    /// ([`Self::y_ci95_half_width`]).
-    pub fn batches(&self) -> u32 {
-        self.count.min(PIXEL_BATCHES as u64) as u32
+    /// Independent batches behind the camera samples' standard errors in a render of `k`
+    /// batches per pixel (min(samples, k)); the 95 % intervals use Student's t with one degree
+    /// of freedom fewer ([`Self::y_ci95_half_width`]).
+    pub fn batches(&self, k: u32) -> u32 {
+        self.count.min(k as u64) as u32
     }
-    /// Half-width (cd/m²) of the 95 % interval of the mean luminance: t₀.₉₇₅ with
-    /// [`Self::batches`] − 1 degrees of freedom times [`Self::y_standard_error`] (infinite
-    /// below 2 batches).
-    pub fn y_ci95_half_width(&self) -> f64 {
-        crate::sampling::t95(self.batches().saturating_sub(1)) * self.y_standard_error()
+    /// Half-width (cd/m²) of the 95 % interval of the mean luminance in a render of `k` batches
+    /// per pixel: t₀.₉₇₅ with [`Self::batches`] − 1 degrees of freedom times
+    /// [`Self::y_standard_error`] (infinite below 2 batches).
+    pub fn y_ci95_half_width(&self, k: u32) -> f64 {
+        crate::sampling::t95(self.batches(k).saturating_sub(1)) * self.y_standard_error(k)
     }
     /// Add the splats of `paths` light paths (see [`crate::integrator::light_path`]): their
     /// Σ X, Σ Y, Σ Z and Σ Y² on this pixel (Σ E and Σ E² go to
@@ -204,11 +236,12 @@ impl PixelSums {
         );
         [c[0] + l[0], c[1] + l[1], c[2] + l[2]]
     }
-    /// Standard error (cd/m²) of the mean luminance: that of the camera samples from the spread
-    /// of their batches ([`batch_standard_error`]) and, with light-traced caustics, that of the
-    /// light paths from their sample variance, added in quadrature (independent estimates).
-    pub fn y_standard_error(&self) -> f64 {
-        let cam = batch_standard_error(&self.batch_y, self.count);
+    /// Standard error (cd/m²) of the mean luminance in a render of `k` batches per pixel: that
+    /// of the camera samples from the spread of their batches ([`batch_standard_error`]) and,
+    /// with light-traced caustics, that of the light paths from their sample variance, added
+    /// in quadrature (independent estimates).
+    pub fn y_standard_error(&self, k: u32) -> f64 {
+        let cam = batch_standard_error(&self.batch_y, self.count, k);
         let light = standard_error(self.splat_xyz[1], self.splat_y2, self.light_paths);
         (cam * cam + light * light).sqrt()
     }
@@ -405,11 +438,17 @@ pub struct Film {
     /// after the film's own fields, see `state`).
     #[serde(skip)]
     pub health: Option<HealthFilm>,
+    /// Independent sample sequences (batches) per pixel, one of [`PIXEL_BATCH_CHOICES`]: the
+    /// standard errors come from the spread of their means (written to render states after
+    /// the light-and-health sums, see `state`).
+    #[serde(skip, default = "default_pixel_batches")]
+    pub pixel_batches: u32,
 }
 
 impl Film {
     pub fn new(width: usize, height: usize) -> Self {
         Self {
+            pixel_batches: DEFAULT_PIXEL_BATCHES,
             width,
             height,
             pixels: vec![PixelSums::default(); width * height],
@@ -437,6 +476,7 @@ impl Film {
         Some(PixelE {
             sums: &self.pixels[i],
             e: &e[i],
+            batches: self.pixel_batches,
         })
     }
     /// The image's pixels with their illuminance sums (none if the film has none).
@@ -444,7 +484,11 @@ impl Film {
         self.pixels
             .iter()
             .zip(self.e.iter().flatten())
-            .map(|(sums, e)| PixelE { sums, e })
+            .map(|(sums, e)| PixelE {
+                sums,
+                e,
+                batches: self.pixel_batches,
+            })
     }
     pub fn new_adaptive(width: usize, height: usize) -> Self {
         Self {
@@ -610,7 +654,7 @@ impl Film {
     pub fn y_stderr_image(&self) -> Vec<f32> {
         self.pixels
             .iter()
-            .map(|p| p.y_standard_error() as f32)
+            .map(|p| p.y_standard_error(self.pixel_batches) as f32)
             .collect()
     }
     /// Illuminance channels: (E with the sentinel where undefined, its standard error, coverage).
@@ -665,10 +709,10 @@ mod tests {
         for y in [1.0, 2.0, 3.0, 4.0] {
             p.add([0.0, y, 0.0]);
         }
-        assert!((p.y_standard_error() - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
+        assert!((p.y_standard_error(16) - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
         assert!((p.y_standard_error_iid() - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
         assert_eq!(p.mean_xyz()[1], 2.5);
-        assert_eq!(p.batches(), 4);
+        assert_eq!(p.batches(16), 4);
     }
 
     #[test]
@@ -680,22 +724,26 @@ mod tests {
             e.add(p.count, Some(2.0 * (i % 16) as f64));
             p.add([0.0, (i % 16) as f64, 0.0]);
         }
-        let pe = PixelE { sums: &p, e: &e };
+        let pe = PixelE {
+            sums: &p,
+            e: &e,
+            batches: 16,
+        };
         let se = (340.0f64 / 15.0).sqrt() / 4.0;
         assert!(
-            (p.y_standard_error() - se).abs() < 1e-12,
+            (p.y_standard_error(16) - se).abs() < 1e-12,
             "{}",
-            p.y_standard_error()
+            p.y_standard_error(16)
         );
         assert!((pe.e_standard_error() - 2.0 * se).abs() < 1e-12);
         assert!((pe.e_ci95_half_width() - 2.131_449_545_6 * 2.0 * se).abs() < 1e-9);
-        assert!((p.y_ci95_half_width() - 2.131_449_545_6 * se).abs() < 1e-9);
+        assert!((p.y_ci95_half_width(16) - 2.131_449_545_6 * se).abs() < 1e-9);
         // Variation only within batches, equal batch means: no spread at all.
         let mut q = PixelSums::default();
         for i in 0..64u64 {
             q.add([0.0, (i / 16) as f64, 0.0]);
         }
-        assert_eq!(q.y_standard_error(), 0.0);
+        assert_eq!(q.y_standard_error(16), 0.0);
         // The iid estimate sees the within-batch spread: s² = 80/63.
         assert!((q.y_standard_error_iid() - (80.0f64 / 63.0 / 64.0).sqrt()).abs() < 1e-12);
     }
@@ -707,8 +755,31 @@ mod tests {
         for _ in 0..20 {
             p.add([0.0, 1.0, 0.0]);
         }
-        assert_eq!(p.y_standard_error(), 0.0);
-        assert_eq!((batch_count(20, 3), batch_count(20, 4)), (2, 1));
+        assert_eq!(p.y_standard_error(16), 0.0);
+        assert_eq!((batch_count(20, 3, 16), batch_count(20, 4, 16)), (2, 1));
+    }
+
+    #[test]
+    fn fewer_batches_gather_the_slots() {
+        // 64 samples of value i mod 16 in a render of 4 batches: batch b holds the slots
+        // b, b + 4, b + 8, b + 12, whose values are b, b + 4, b + 8, b + 12 four times each,
+        // so the 4 batch means are b + 6 (sd √(5/3)) and se = sd/2.
+        let mut p = PixelSums::default();
+        for i in 0..64u64 {
+            p.add([0.0, (i % 16) as f64, 0.0]);
+        }
+        let se = (5.0f64 / 3.0).sqrt() / 2.0;
+        assert!((p.y_standard_error(4) - se).abs() < 1e-12);
+        assert!((p.y_ci95_half_width(4) - 3.182_446_305_3 * se).abs() < 1e-9);
+        assert_eq!((p.batches(4), p.batches(2)), (4, 2));
+        // 6 samples in 4 batches: sizes 2, 2, 1, 1; sample i in batch i mod 4.
+        assert_eq!(
+            (0..4).map(|b| batch_count(6, b, 4)).collect::<Vec<_>>(),
+            [2, 2, 1, 1]
+        );
+        let folded = fold_batches(&p.batch_y, 4);
+        assert_eq!(folded[..4], [96.0, 112.0, 128.0, 144.0]);
+        assert!(folded[4..].iter().all(|&v| v == 0.0));
     }
 
     #[test]

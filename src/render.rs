@@ -1,9 +1,7 @@
 //! Rendering an image: tiles in parallel (rayon), every sample regenerated from
 //! (seed, pixel, sample index), so the result does not depend on the number of threads.
 
-use crate::film::{
-    radiance_to_xyz, Film, HealthPixel, IlluminanceSums, PixelE, PixelSums, PIXEL_BATCHES,
-};
+use crate::film::{radiance_to_xyz, Film, HealthPixel, IlluminanceSums, PixelE, PixelSums};
 use crate::integrator::sun_view::SunInView;
 use crate::integrator::{trace, PathStart, RayStats};
 use crate::sampling::{batch_stream, Sampler};
@@ -55,9 +53,9 @@ pub fn render_pixel(
     let deposit = sun.and_then(|s| s.at(pixel)).unwrap_or([0.0; 3]);
     let with_sun = |v: [f64; 3]| [v[0] + deposit[0], v[1] + deposit[1], v[2] + deposit[2]];
     for s in first..first + count {
-        // Sample s is sample s / 16 of batch s mod 16, whose independently scrambled sequence
+        // Sample s is sample s / K of batch s mod K, whose independently scrambled sequence
         // makes the batch means independent (the pixel's standard error is their spread).
-        let (batch, index) = pixel_batch(pixel, s);
+        let (batch, index) = pixel_batch(pixel, s, world.settings.pixel_batches);
         let mut sampler = Sampler::new(seed, batch, index);
         // Dimensions 0–1: position in the pixel (the best-stratified Sobol pair), 2–3: lens,
         // 4: wavelengths; paths continue from dimension 8.
@@ -120,12 +118,14 @@ pub fn render_pixel(
     }
 }
 
-/// The stream and index of sample `s` of pixel `pixel`: sample s / 16 of the pixel's batch
-/// s mod 16 ([`PIXEL_BATCHES`]), each batch its own scramble, so each batch is a prefix of its
-/// sequence however the samples are split into passes.
+/// The stream and index of sample `s` of pixel `pixel` in a render of `k` batches per pixel
+/// (a divisor of [`crate::film::PIXEL_BATCHES`]): sample s / k of the pixel's batch s mod k, each batch its
+/// own scramble, so each batch is a prefix of its sequence however the samples are split into
+/// passes. Fewer batches put more samples in each well-stratified sequence: a lower error for
+/// the same samples, from fewer independent batch means.
 #[inline]
-pub fn pixel_batch(pixel: u64, s: u64) -> (u64, u64) {
-    let k = PIXEL_BATCHES as u64;
+pub fn pixel_batch(pixel: u64, s: u64, k: u32) -> (u64, u64) {
+    let k = k as u64;
     (batch_stream(pixel, (s % k) as u32), s / k)
 }
 
@@ -277,13 +277,14 @@ pub enum StopReason {
     Interrupted,
 }
 
-/// Whether pixel `i` still needs samples under `target`, judged on its decision buffer; and
-/// whether it counts toward the fraction (not below the floor).
+/// Whether pixel `i` still needs samples under `target`, judged on its decision buffer of `k`
+/// batches per pixel; and whether it counts toward the fraction (not below the floor).
 fn pixel_converged(
     d: &PixelSums,
     e: Option<PixelE>,
     target: &TargetError,
     floor: f64,
+    k: u32,
 ) -> (bool, bool) {
     if d.count < MIN_DECISION_SAMPLES {
         return (false, true);
@@ -292,7 +293,7 @@ fn pixel_converged(
     if y < floor {
         return (true, false);
     }
-    let mut ok = d.y_ci95_half_width() <= target.relative * y;
+    let mut ok = d.y_ci95_half_width(k) <= target.relative * y;
     if let Some(pe) = e {
         if let Some(mean) = pe.mean_e() {
             if pe.e.count_e >= MIN_DECISION_SAMPLES && mean > 0.0 {
@@ -327,8 +328,9 @@ fn plan_pass(world: &World, film: &Film, prog: &Progressive) -> (Vec<u64>, Optio
             let e = film.decision_e.as_ref().map(|e| PixelE {
                 sums: &d[i],
                 e: &e[i],
+                batches: film.pixel_batches,
             });
-            let (ok, counts) = pixel_converged(&d[i], e, t, floor);
+            let (ok, counts) = pixel_converged(&d[i], e, t, floor, film.pixel_batches);
             if counts {
                 eligible += 1;
                 converged += ok as u64;
@@ -655,6 +657,7 @@ pub fn render(
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> anyhow::Result<RenderResult> {
     let mut film = Film::new(world.camera.width, world.camera.height);
+    film.pixel_batches = world.settings.pixel_batches;
     let prog = Progressive {
         max_spp: world.settings.spp,
         ..Default::default()

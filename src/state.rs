@@ -25,8 +25,9 @@ pub const MAGIC: &str = "candela-render-state";
 /// in buffers of their own (12 because no single flipped bit turns it into one of the
 /// unchecked versions 1–3, see [`RenderState::decode`]), 13 the shard a state renders
 /// ([`ShardInfo`]; no single flipped bit turns 13 into 1–3 either), 14 the light-and-health
-/// sums (likewise); other versions are refused with a message.
-pub const VERSION: u32 = 14;
+/// sums (likewise), 15 the number of independent sample batches per pixel (likewise); other
+/// versions are refused with a message.
+pub const VERSION: u32 = 15;
 
 /// Bytes of the checksum at the end of the file.
 const CHECKSUM_BYTES: usize = 8;
@@ -116,6 +117,7 @@ struct StateRef<'a> {
     meters: &'a [MeterSums],
     merged_seeds: &'a [u64],
     health: Option<HealthRef<'a>>,
+    pixel_batches: u32,
 }
 
 /// The light-and-health sums of a film ([`HealthFilm`]) as written: the channels, whether the
@@ -343,6 +345,7 @@ pub fn scene_hash(scene_text: &[u8], world: &World) -> u64 {
     h = mix64(h ^ world.caustics.is_some() as u64);
     h = mix64(h ^ world.settings.light_paths_per_sample.to_bits() as u64);
     h = mix64(h ^ world.settings.light_sampler as u64);
+    h = mix64(h ^ world.settings.pixel_batches as u64);
     mix64(h ^ ((world.camera.width as u64) << 32 | world.camera.height as u64))
 }
 
@@ -385,6 +388,7 @@ impl RenderState {
             shard: self.shard,
             meters: &self.meters,
             health: HealthRef::of(&self.film),
+            pixel_batches: self.film.pixel_batches,
         }
         .save(path)
     }
@@ -413,6 +417,7 @@ impl RenderState {
             shard,
             meters,
             health: HealthRef::of(film),
+            pixel_batches: film.pixel_batches,
         }
         .save(path)
     }
@@ -567,6 +572,12 @@ impl RenderState {
             1 => Some(take_health(&mut bytes, n, p.illuminance)?),
             t => return Err(format!("its light-and-health tag is {t}, not 0 or 1")),
         };
+        let pixel_batches: u32 = take(&mut bytes, "its batches per pixel")?;
+        if !crate::film::PIXEL_BATCH_CHOICES.contains(&pixel_batches) {
+            return Err(format!(
+                "it claims {pixel_batches} independent sample batches per pixel, not 2, 4, 8 or 16"
+            ));
+        }
         if !bytes.is_empty() {
             return Err(format!("{} bytes follow its last field", bytes.len()));
         }
@@ -583,6 +594,7 @@ impl RenderState {
             e,
             decision_e,
             health,
+            pixel_batches,
         };
         film.check(p.illuminance)?;
         Ok(Self {
@@ -634,6 +646,20 @@ mod tests {
             meters: Vec::new(),
             merged_seeds: Vec::new(),
         }
+    }
+
+    #[test]
+    fn batches_per_pixel_round_trip_and_bad_ones_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("k.state");
+        let mut st = health_state();
+        st.film.pixel_batches = 4;
+        st.save(&path).unwrap();
+        assert_eq!(RenderState::load(&path).unwrap().film.pixel_batches, 4);
+        st.film.pixel_batches = 3;
+        st.save(&path).unwrap();
+        let e = RenderState::load(&path).unwrap_err().to_string();
+        assert!(e.contains("3 independent sample batches per pixel"), "{e}");
     }
 
     #[test]

@@ -50,7 +50,9 @@ fn render_checked(world: &candela::world::World, what: &str) -> f64 {
     for (i, p) in r.film.pixels.iter().enumerate() {
         let xyz = p.mean_xyz();
         assert!(
-            xyz.iter().all(|v| v.is_finite()) && p.y_standard_error().is_finite(),
+            xyz.iter().all(|v| v.is_finite())
+                && p.y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES)
+                    .is_finite(),
             "{what}: pixel {i} not finite: {xyz:?}"
         );
     }
@@ -400,6 +402,19 @@ fn huge_sample_counts_are_accepted_as_asked_and_depth_is_bounded() {
     assert!(build("max_depth: 10000", "").is_ok());
     let e = build("rr_depth: 4294967295", "").err().unwrap().to_string();
     assert!(e.contains("render.rr_depth"), "{e}");
+    // Batches per pixel: a divisor of 16 that leaves at least two.
+    for k in [0u32, 1, 3, 5, 12, 32, u32::MAX] {
+        let e = build(&format!("pixel_batches: {k}"), "")
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("render.pixel_batches"), "{k}: {e}");
+    }
+    for k in [2u32, 4, 8, 16] {
+        let w = build(&format!("pixel_batches: {k}"), "").unwrap();
+        assert_eq!(w.settings.pixel_batches, k);
+    }
+    assert_eq!(build("", "").unwrap().settings.pixel_batches, 16);
     // Overrides from the command line are checked the same way.
     let text = base.replace("RENDER", "").replace("MEASURE", "");
     let p = Path::new("scene.ron");

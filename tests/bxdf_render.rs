@@ -249,7 +249,10 @@ fn glass_sphere_truncated_furnace() {
             for x in 0..res {
                 let e = pixel_footprint_mean(&w, x, y, expected_ray);
                 let p = &film.pixels[y * res + x];
-                let (v, se) = (p.mean_xyz()[1], p.y_standard_error());
+                let (v, se) = (
+                    p.mean_xyz()[1],
+                    p.y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES),
+                );
                 sum_d += v - e;
                 var_d += se * se;
                 sum_e += e;

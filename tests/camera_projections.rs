@@ -333,7 +333,10 @@ fn fisheyes_in_a_uniform_sky_integrate_to_the_illuminance_at_the_eye() {
                         continue;
                     }
                     let wgt = c.pixel_projected_solid_angle_sr(x, y) / c.pixel_coverage(x, y);
-                    var += (wgt * film.pixels[y * c.width + x].y_standard_error()).powi(2);
+                    var += (wgt
+                        * film.pixels[y * c.width + x]
+                            .y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES))
+                    .powi(2);
                 }
             }
             let se = var.sqrt();

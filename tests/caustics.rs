@@ -153,7 +153,11 @@ fn light_traced_caustic_agrees_with_path_traced_caustic() {
         let m = top.iter().map(|&i| f.pixels[i].mean_xyz()[1]).sum::<f64>() / top.len() as f64;
         let v = top
             .iter()
-            .map(|&i| f.pixels[i].y_standard_error().powi(2))
+            .map(|&i| {
+                f.pixels[i]
+                    .y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES)
+                    .powi(2)
+            })
             .sum::<f64>();
         (m, v.sqrt() / top.len() as f64)
     };

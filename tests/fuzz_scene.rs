@@ -134,7 +134,9 @@ fn check(bytes: &[u8], path: &Path) {
         for (i, p) in r.film.pixels.iter().enumerate() {
             let xyz = p.mean_xyz();
             assert!(
-                xyz.iter().all(|v| v.is_finite()) && p.y_standard_error().is_finite(),
+                xyz.iter().all(|v| v.is_finite())
+                    && p.y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES)
+                        .is_finite(),
                 "pixel {i} is not finite: {xyz:?}\n{text}"
             );
         }

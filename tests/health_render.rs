@@ -81,15 +81,15 @@ fn check_pixels(film: &Film, der: f64, l_sky: f64) -> f64 {
         let mel = h.melanopic_edl_batches(i).unwrap();
         let d: [f64; PIXEL_BATCHES] = std::array::from_fn(|b| mel[b] - der * p.batch_y[b]);
         let mean_d = d.iter().sum::<f64>() / p.count as f64;
-        let se_d = batch_standard_error(&d, p.count);
+        let se_d = batch_standard_error(&d, p.count, candela::film::DEFAULT_PIXEL_BATCHES);
         assert!(
             mean_d.abs() <= 5.0 * se_d,
             "pixel {i}: m-EDL − DER·L_v = {mean_d} ± {se_d}"
         );
-        let edl = h.melanopic_edl(i, p).unwrap();
+        let edl = h.melanopic_edl(i, p, 16).unwrap();
         assert!(edl.stderr < 0.02 * edl.mean, "pixel {i}: {edl:?}");
         covered_l += ((edl.mean - der * RHO * l_sky).abs() <= t * edl.stderr) as usize;
-        let edi = h.melanopic_edi(i, p, e[i].count_e).unwrap();
+        let edi = h.melanopic_edi(i, p, e[i].count_e, 16).unwrap();
         covered_e += ((edi.mean - der * PI * l_sky).abs() <= t * edi.stderr) as usize;
         ratio += edl.mean / (der * p.mean_xyz()[1]);
     }
@@ -184,7 +184,7 @@ fn mesopic_luminance_of_a_dim_plane() {
     let t = t95(PIXEL_BATCHES as u32 - 1);
     let mut covered = 0;
     for (i, p) in film.pixels.iter().enumerate() {
-        let m = h.mesopic(i, p).unwrap();
+        let m = h.mesopic(i, p, 16).unwrap();
         assert!(
             (m.mean - want.luminance_cd_m2).abs() <= 5.0 * m.stderr && m.stderr < 0.02 * m.mean,
             "pixel {i}: L_mes = {} ± {}, expected {want:?}",
@@ -259,7 +259,9 @@ fn spectral_exr_round_trips_through_colour_science() {
     for (i, p) in film.pixels.iter().enumerate() {
         sum_bands += y[i] / n;
         sum_y += p.mean_xyz()[1] / n;
-        var += p.y_standard_error().powi(2);
+        var += p
+            .y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES)
+            .powi(2);
     }
     let se = var.sqrt() / n;
     let rel = sum_bands / (banding * sum_y) - 1.0;

@@ -83,7 +83,11 @@ fn luminance_is_rho_e_over_pi_of_the_illuminance_channel() {
     for (i, p) in film.pixels_e().enumerate() {
         let l = p.mean_xyz()[1];
         let e = p.mean_e().unwrap();
-        let se = (p.y_standard_error().powi(2) + (rho / PI * p.e_standard_error()).powi(2)).sqrt();
+        let se = (p
+            .y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES)
+            .powi(2)
+            + (rho / PI * p.e_standard_error()).powi(2))
+        .sqrt();
         assert!(
             (l - rho * e / PI).abs() <= 5.0 * se,
             "pixel {i}: L = {l}, ρE/π = {} (± {se})",
@@ -226,7 +230,7 @@ fn integrating_sphere_interreflection() {
         );
         // The wall's luminance: L = ρ E / π.
         let l = p.mean_xyz()[1];
-        let lse = p.y_standard_error();
+        let lse = p.y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES);
         assert!(
             (l - expected_l).abs() <= 5.0 * lse,
             "pixel {i}: L = {l} ± {lse}, expected {expected_l}"

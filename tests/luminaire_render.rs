@@ -24,7 +24,7 @@ fn meter(light: &str, target: [f64; 3], spp: u32) -> (f64, f64) {
     let film = render(&world(&text), 2);
     (
         film.pixels[0].mean_xyz()[1],
-        film.pixels[0].y_standard_error(),
+        film.pixels[0].y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES),
     )
 }
 

@@ -424,7 +424,10 @@ fn gltf_file_is_a_whole_scene() {
         100.0 * 2.0 / d2.powf(1.5) * RHO / std::f64::consts::PI
     });
     let p = &film.pixels[py * w as usize + px];
-    let (l, se) = (p.mean_xyz()[1], p.y_standard_error());
+    let (l, se) = (
+        p.mean_xyz()[1],
+        p.y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES),
+    );
     eprintln!(
         "foot pixel ({px}, {py}) of ({fx:.2}, {fy:.2}): {l} ± {se} cd/m², expected {want} (25ρ/π = {})",
         25.0 * RHO / std::f64::consts::PI

@@ -65,9 +65,10 @@ fn adaptive_render_to_target_error_is_unbiased() {
     assert!((m[1] - 2.0).abs() <= 4.0 * se, "mean {} ± {se}", m[1]);
     // The decision buffer, not the image, met the target.
     let d = film.decision.as_ref().unwrap();
-    assert!(d
-        .iter()
-        .all(|p| 1.96 * p.y_standard_error() <= 0.03 * p.mean_xyz()[1]));
+    assert!(d.iter().all(
+        |p| 1.96 * p.y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES)
+            <= 0.03 * p.mean_xyz()[1]
+    ));
 }
 
 #[test]

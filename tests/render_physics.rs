@@ -72,7 +72,7 @@ fn spot_meter(scene_body: &str, eye: [f64; 3], target: [f64; 3], spp: u32) -> (f
     let film = render(&world(&text), 2);
     (
         film.pixels[0].mean_xyz()[1],
-        film.pixels[0].y_standard_error(),
+        film.pixels[0].y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES),
     )
 }
 

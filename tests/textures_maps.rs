@@ -67,7 +67,9 @@ fn columns_mean(film: &Film, cols: std::ops::Range<usize>) -> (f64, f64) {
         for x in cols.clone() {
             let p = &film.pixels[y * film.width + x];
             m += p.mean_xyz()[1];
-            v += p.y_standard_error().powi(2);
+            v += p
+                .y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES)
+                .powi(2);
             n += 1.0;
         }
     }

@@ -291,6 +291,13 @@ pub struct RenderDesc {
     /// How next-event estimation chooses a light (see `light::sampler`).
     #[serde(default)]
     pub light_sampler: LightSamplerDesc,
+    /// Independent sample sequences per pixel (2, 4, 8 or 16) behind its standard error.
+    #[serde(default = "default_pixel_batches")]
+    pub pixel_batches: u32,
+}
+
+fn default_pixel_batches() -> u32 {
+    crate::film::DEFAULT_PIXEL_BATCHES
 }
 
 /// See `light::LightSamplerKind`.
@@ -332,6 +339,7 @@ impl Default for RenderDesc {
             caustics: CausticsDesc::LightTracing,
             light_paths_per_sample: default_light_paths_per_sample(),
             light_sampler: LightSamplerDesc::Bvh,
+            pixel_batches: default_pixel_batches(),
         }
     }
 }

@@ -266,7 +266,7 @@ pub struct PixelValue {
     pub stderr: f64,
 }
 
-fn batched(sums: &[f64], at: usize, n: u64) -> (PixelValue, [f64; PIXEL_BATCHES]) {
+fn batched(sums: &[f64], at: usize, n: u64, k: u32) -> (PixelValue, [f64; PIXEL_BATCHES]) {
     let b: [f64; PIXEL_BATCHES] = std::array::from_fn(|k| sums[at + k]);
     let mean = if n == 0 {
         0.0
@@ -276,7 +276,7 @@ fn batched(sums: &[f64], at: usize, n: u64) -> (PixelValue, [f64; PIXEL_BATCHES]
     (
         PixelValue {
             mean,
-            stderr: batch_standard_error(&b, n),
+            stderr: batch_standard_error(&b, n, k),
         },
         b,
     )
@@ -284,10 +284,10 @@ fn batched(sums: &[f64], at: usize, n: u64) -> (PixelValue, [f64; PIXEL_BATCHES]
 
 /// Pixel estimates of the health channels, given the pixel's own sums.
 impl HealthFilm {
-    /// m-EDL (cd/m²) of pixel `i` with its standard error.
-    pub fn melanopic_edl(&self, i: usize, p: &PixelSums) -> Option<PixelValue> {
+    /// m-EDL (cd/m²) of pixel `i` with its standard error (`k` batches per pixel).
+    pub fn melanopic_edl(&self, i: usize, p: &PixelSums, k: u32) -> Option<PixelValue> {
         let o = offsets(&self.channels, self.illuminance);
-        Some(batched(self.pixel(i), o.mel_l?, p.count).0)
+        Some(batched(self.pixel(i), o.mel_l?, p.count, k).0)
     }
     /// The batch sums of m-EDL (cd/m²) of pixel `i`, as [`PixelSums::batch_y`] holds Y's.
     pub fn melanopic_edl_batches(&self, i: usize) -> Option<[f64; PIXEL_BATCHES]> {
@@ -298,13 +298,19 @@ impl HealthFilm {
     /// m-EDI (lx) of pixel `i` over the samples that saw a receiving surface (`count_e` of
     /// them; None if none did), with its standard error, as [`super::PixelE::mean_e`] does
     /// for illuminance.
-    pub fn melanopic_edi(&self, i: usize, p: &PixelSums, count_e: u64) -> Option<PixelValue> {
+    pub fn melanopic_edi(
+        &self,
+        i: usize,
+        p: &PixelSums,
+        count_e: u64,
+        k: u32,
+    ) -> Option<PixelValue> {
         let o = offsets(&self.channels, self.illuminance);
         let at = o.mel_e?;
         if count_e == 0 || p.count == 0 {
             return None;
         }
-        let (v, b) = batched(self.pixel(i), at, p.count);
+        let (v, b) = batched(self.pixel(i), at, p.count, k);
         let coverage = count_e as f64 / p.count as f64;
         Some(PixelValue {
             mean: b.iter().sum::<f64>() / count_e as f64,
@@ -312,14 +318,14 @@ impl HealthFilm {
         })
     }
     /// Scotopic luminance (scotopic cd/m²) of pixel `i`.
-    pub fn scotopic(&self, i: usize, p: &PixelSums) -> Option<PixelValue> {
+    pub fn scotopic(&self, i: usize, p: &PixelSums, k: u32) -> Option<PixelValue> {
         let o = offsets(&self.channels, self.illuminance);
-        Some(batched(self.pixel(i), o.scotopic?, p.count).0)
+        Some(batched(self.pixel(i), o.scotopic?, p.count, k).0)
     }
     /// CIE 191 mesopic luminance (cd/m²) of pixel `i` from its L_v and S/P = L_s / L_v, with
-    /// the jackknife standard error over the 16 batches: the estimate recomputed with each
+    /// the jackknife standard error over the `k` batches: the estimate recomputed with each
     /// batch left out, whose spread gives the error of a smooth function of batch means.
-    pub fn mesopic(&self, i: usize, p: &PixelSums) -> Option<PixelValue> {
+    pub fn mesopic(&self, i: usize, p: &PixelSums, k: u32) -> Option<PixelValue> {
         let o = offsets(&self.channels, self.illuminance);
         let at = o.scotopic?;
         let s = self.pixel(i);
@@ -333,22 +339,24 @@ impl HealthFilm {
         };
         let (lp_sum, ls_sum) = (p.sum_xyz[1], (0..PIXEL_BATCHES).map(|k| s[at + k]).sum());
         let mean = f(lp_sum, ls_sum, n);
-        let k = n.min(PIXEL_BATCHES as u64) as usize;
-        let stderr = if k < 2 {
+        let batches = n.min(k as u64) as usize;
+        let stderr = if batches < 2 {
             0.0
         } else {
-            let loo: Vec<f64> = (0..k)
+            let lp_b = super::fold_batches(&p.batch_y, k);
+            let ls_b = super::fold_batches(&std::array::from_fn(|b| s[at + b]), k);
+            let loo: Vec<f64> = (0..batches)
                 .map(|b| {
                     f(
-                        lp_sum - p.batch_y[b],
-                        ls_sum - s[at + b],
-                        n - super::batch_count(n, b),
+                        lp_sum - lp_b[b],
+                        ls_sum - ls_b[b],
+                        n - super::batch_count(n, b, k),
                     )
                 })
                 .collect();
-            let m = loo.iter().sum::<f64>() / k as f64;
+            let m = loo.iter().sum::<f64>() / batches as f64;
             let ss: f64 = loo.iter().map(|v| (v - m).powi(2)).sum();
-            (ss * (k - 1) as f64 / k as f64).sqrt()
+            (ss * (batches - 1) as f64 / batches as f64).sqrt()
         };
         Some(PixelValue { mean, stderr })
     }

@@ -32,12 +32,16 @@ pub fn add_health_layers(film: &Film, layers: &mut Layers) {
     };
     let mut notes = Vec::new();
     if h.channels.melanopic {
-        let v = |i: usize| h.melanopic_edl(i, &film.pixels[i]).unwrap_or_default();
+        let v = |i: usize| {
+            h.melanopic_edl(i, &film.pixels[i], film.pixel_batches)
+                .unwrap_or_default()
+        };
         push(CHANNEL_M_EDL, &|i| v(i).mean as f32);
         push(CHANNEL_M_EDL_STDERR, &|i| v(i).stderr as f32);
         notes.push("melanopic.EDL: melanopic equivalent daylight (D65) luminance m-EDL in cd/m^2 (CIE S 026), stderr.melanopic.EDL its standard error".to_string());
         if let Some(e) = &film.e {
-            let v = |i: usize| h.melanopic_edi(i, &film.pixels[i], e[i].count_e);
+            let v =
+                |i: usize| h.melanopic_edi(i, &film.pixels[i], e[i].count_e, film.pixel_batches);
             push(CHANNEL_M_EDI, &|i| {
                 v(i).map_or(ILLUMINANCE_SENTINEL, |v| v.mean as f32)
             });
@@ -48,10 +52,16 @@ pub fn add_health_layers(film: &Film, layers: &mut Layers) {
         }
     }
     if h.channels.mesopic {
-        let s = |i: usize| h.scotopic(i, &film.pixels[i]).unwrap_or_default();
+        let s = |i: usize| {
+            h.scotopic(i, &film.pixels[i], film.pixel_batches)
+                .unwrap_or_default()
+        };
         push(CHANNEL_SCOTOPIC, &|i| s(i).mean as f32);
         push(CHANNEL_SCOTOPIC_STDERR, &|i| s(i).stderr as f32);
-        let m = |i: usize| h.mesopic(i, &film.pixels[i]).unwrap_or_default();
+        let m = |i: usize| {
+            h.mesopic(i, &film.pixels[i], film.pixel_batches)
+                .unwrap_or_default()
+        };
         push(CHANNEL_MESOPIC, &|i| m(i).mean as f32);
         push(CHANNEL_MESOPIC_STDERR, &|i| m(i).stderr as f32);
         push(CHANNEL_MESOPIC_M, &|i| {

@@ -108,6 +108,8 @@ impl IlluminanceSums {
 pub struct PixelE<'a> {
     pub sums: &'a PixelSums,
     pub e: &'a IlluminanceSums,
+    /// Independent batches per pixel of the render ([`super::Film::pixel_batches`]).
+    pub batches: u32,
 }
 
 /// The pixel's luminance estimates ([`PixelSums::mean_xyz`], …) through the view.
@@ -148,7 +150,7 @@ impl PixelE<'_> {
         if self.e.count_e == 0 {
             return 0.0;
         }
-        let cam = batch_standard_error(&self.e.batch_e, self.sums.count);
+        let cam = batch_standard_error(&self.e.batch_e, self.sums.count, self.batches);
         let light = if self.has_e_splats() {
             standard_error(self.e.splat_e, self.e.splat_e2, self.sums.light_paths)
         } else {
@@ -159,7 +161,8 @@ impl PixelE<'_> {
     /// Half-width (lx) of the 95 % interval of [`Self::mean_e`], as for luminance
     /// ([`PixelSums::y_ci95_half_width`]).
     pub fn e_ci95_half_width(&self) -> f64 {
-        crate::sampling::t95(self.sums.batches().saturating_sub(1)) * self.e_standard_error()
+        crate::sampling::t95(self.sums.batches(self.batches).saturating_sub(1))
+            * self.e_standard_error()
     }
     /// The standard error (lx) of [`Self::mean_e`] that treats the camera samples as
     /// independent (√(s²/n) with the sample variance): an over-estimate for stratified

@@ -268,7 +268,7 @@ pub fn film_layers(scene: &str, film: &Film, illuminance: bool) -> Layers {
         ),
         (
             crate::film::STDERR_BATCHES_ATTRIBUTE.to_string(),
-            crate::film::PIXEL_BATCHES.to_string(),
+            film.pixel_batches.to_string(),
         ),
         (
             "spp".to_string(),

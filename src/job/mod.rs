@@ -315,13 +315,16 @@ fn initial_film(
 ) -> Result<Film> {
     let (w, h) = (world.camera.width, world.camera.height);
     if !job.resume {
-        return Ok(if job.target.is_some() {
+        let mut film = if job.target.is_some() {
             Film::new_adaptive(w, h)
         } else {
             Film::new(w, h)
-        });
+        };
+        film.pixel_batches = world.settings.pixel_batches;
+        return Ok(film);
     }
     let st = RenderState::load(state_path)?;
+
     if st.scene_hash != hash || st.seed != world.settings.seed {
         bail!(
             "cannot resume from {}: the scene file {}, a file it refers to (mesh, spectrum, luminaire data) or its settings (seed, max depth, resolution, illuminance, caustics) changed since the state was written",

@@ -264,6 +264,7 @@ pub fn report_json(r: &ReportInput) -> Value {
         "settings": {
             "width": film.width, "height": film.height,
             "spp": w.settings.spp, "max_depth": w.settings.max_depth, "rr_depth": w.settings.rr_depth,
+            "pixel_batches": w.settings.pixel_batches,
             "seed": w.settings.seed, "threads": r.render.threads, "illuminance": w.settings.illuminance,
             "caustics": if w.caustics.is_some() { "light-tracing" } else { "path-tracing" },
             "meter_samples": w.measure.samples,

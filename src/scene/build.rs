@@ -248,7 +248,17 @@ pub fn build_for(
         ));
     }
     let filter = PixelFilter::build(&ctx, &r.filter)?;
+    if !crate::film::PIXEL_BATCH_CHOICES.contains(&r.pixel_batches) {
+        return Err(ctx.err(
+            "render.pixel_batches",
+            format!(
+                "{} is not one of 2, 4, 8 or 16: the independent sample sequences per pixel whose spread gives its standard error",
+                r.pixel_batches
+            ),
+        ));
+    }
     let settings = RenderSettings {
+        pixel_batches: r.pixel_batches,
         spp,
         max_depth,
         rr_depth: r.rr_depth,

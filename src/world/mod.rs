@@ -42,6 +42,9 @@ pub struct RenderSettings {
     pub light_paths_per_sample: f32,
     /// How next-event estimation chooses a light ([`crate::light::sampler`]).
     pub light_sampler: LightSamplerKind,
+    /// Independent sample sequences (batches) per pixel, one of
+    /// [`crate::film::PIXEL_BATCH_CHOICES`] (see [`crate::render::pixel_batch`]).
+    pub pixel_batches: u32,
 }
 
 /// Estimator of the caustic paths light → specular surfaces → non-specular surface → camera.
@@ -67,6 +70,7 @@ impl Default for RenderSettings {
             caustics: Caustics::LightTracing,
             light_paths_per_sample: crate::description::schema::DEFAULT_LIGHT_PATHS_PER_SAMPLE,
             light_sampler: LightSamplerKind::Bvh,
+            pixel_batches: crate::film::DEFAULT_PIXEL_BATCHES,
         }
     }
 }

@@ -40,7 +40,9 @@ pub fn image_mean(film: &Film) -> ([f64; 3], f64) {
         for k in 0..3 {
             m[k] += x[k] / n;
         }
-        var += p.y_standard_error().powi(2);
+        var += p
+            .y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES)
+            .powi(2);
     }
     (m, var.sqrt() / n)
 }
@@ -51,7 +53,7 @@ pub fn image_mean(film: &Film) -> ([f64; 3], f64) {
 pub fn assert_every_pixel(film: &Film, expected: f64, k: f64) {
     for (i, p) in film.pixels.iter().enumerate() {
         let y = p.mean_xyz()[1];
-        let se = p.y_standard_error();
+        let se = p.y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES);
         assert!(
             (y - expected).abs() <= k * se,
             "pixel {i}: Y = {y} cd/m², expected {expected} ± {k}·{se}"
@@ -70,7 +72,10 @@ pub fn assert_pixel_coverage(film: &Film, expected: f64, min_coverage: f64) {
     let held = film
         .pixels
         .iter()
-        .filter(|p| (p.mean_xyz()[1] - expected).abs() <= p.y_ci95_half_width())
+        .filter(|p| {
+            (p.mean_xyz()[1] - expected).abs()
+                <= p.y_ci95_half_width(candela::film::DEFAULT_PIXEL_BATCHES)
+        })
         .count();
     let coverage = held as f64 / film.pixels.len() as f64;
     assert!(
@@ -189,7 +194,10 @@ fn check_values(
 }
 
 pub fn luminance(p: &candela::film::PixelSums) -> (f64, f64) {
-    (p.mean_xyz()[1], p.y_standard_error())
+    (
+        p.mean_xyz()[1],
+        p.y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES),
+    )
 }
 
 /// Straight-through transmittance of a thin non-absorbing slab (relative index `eta`) at
@@ -397,7 +405,9 @@ pub fn block_means(film: &Film, b: usize) -> Vec<(f64, f64)> {
                 for x in bx * b..(bx + 1) * b {
                     let p = &film.pixels[y * w + x];
                     m += p.mean_xyz()[1];
-                    v += p.y_standard_error().powi(2);
+                    v += p
+                        .y_standard_error(candela::film::DEFAULT_PIXEL_BATCHES)
+                        .powi(2);
                 }
             }
             let n = (b * b) as f64;
