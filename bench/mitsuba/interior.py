@@ -56,8 +56,21 @@ def timed(cmd):
     return p.stdout, p.stderr, wall, float(u) + float(s), float(m) / 1024.0
 
 
-def run_candela(args, spp, seed, stem):
-    cmd = [args.candela, "render", RON, "--out", stem, "--spp", str(spp), "--threads", str(args.threads),
+def scene_with_batches(k):
+    """interior.ron, or with render.pixel_batches k (other than the default 16) a copy of it in
+    target/bench (the scene refers to no other file)."""
+    if k == 16:
+        return RON
+    path = os.path.join(OUT, f"interior-pixel-batches-{k}.ron")
+    with open(RON, encoding="utf-8") as f:
+        text = f.read()
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text.replace("render: (", f"render: (pixel_batches: {k}, ", 1))
+    return path
+
+
+def run_candela(args, spp, seed, stem, batches=16):
+    cmd = [args.candela, "render", scene_with_batches(batches), "--out", stem, "--spp", str(spp), "--threads", str(args.threads),
            "--seed", str(seed), "--quiet", "--overwrite", "--checkpoint-interval", "0s"]
     _, _, wall, cpu, rss = timed(cmd)
     with open(stem + ".report.json", encoding="utf-8") as f:
@@ -217,6 +230,8 @@ def main():
     ap.add_argument("--ref-parts", type=int, default=8)
     ap.add_argument("--fresh-refs", action="store_true")
     ap.add_argument("--mitsuba-sampler", default="multijitter")
+    ap.add_argument("--pixel-batches", type=int, default=16, choices=(2, 4, 8, 16),
+                    help="candela's render.pixel_batches in the timed runs (references: 16)")
     ap.add_argument("--scalar", action="store_true", help="also time Mitsuba scalar_spectral (one ray at a time)")
     ap.add_argument("--candela", default=compare.CANDELA, help="candela binary (default target/release/candela)")
     ap.add_argument("--json", default=os.path.join(OUT, "mitsuba-interior-results.json"))
@@ -231,7 +246,7 @@ def main():
 
     meta = dict(compare.machine_info(), date=datetime.date.today().isoformat(), reps=args.reps, spp=args.spp,
                 threads=args.threads, ref_spp=args.ref_spp, ref_parts=args.ref_parts, mitsuba=mi.__version__,
-                sampler=args.mitsuba_sampler, candela_binary=args.candela,
+                sampler=args.mitsuba_sampler, candela_binary=args.candela, pixel_batches=args.pixel_batches,
                 candela=subprocess.run([args.candela, "--version"], capture_output=True, text=True).stdout.strip())
     cref, mref = candela_reference(args), mitsuba_reference(args)
     for ref in (cref, mref):
@@ -250,7 +265,8 @@ def main():
         groups["scalar"] = []
     for rep in range(args.reps):
         log(f"round {rep + 1}/{args.reps} at {args.spp} spp")
-        groups["candela"].append(finish(run_candela(args, args.spp, rep + 1, os.path.join(runs, "interior-candela")), cref, mask))
+        groups["candela"].append(finish(run_candela(args, args.spp, rep + 1, os.path.join(runs, "interior-candela"),
+                                                    args.pixel_batches), cref, mask))
         groups["mitsuba"].append(finish(run_mitsuba(args, args.spp, rep + 1, os.path.join(runs, "interior-mitsuba.npy")), mref, mask))
         if args.scalar:
             # Same code as the LLVM variant, so the same converged image: the LLVM reference.

@@ -91,9 +91,21 @@ class Images:
         self.key = h.hexdigest()[:16]  # candela's: also its version
 
     # ---------- candela ----------
-    def candela(self, spp, seed, tag, illuminance):
+    def scene(self, batches):
+        """The image scene, or with render.pixel_batches `batches` (other than 16) a copy of it."""
+        path = os.path.join(self.d, f"office-{self.n}-image.ron")
+        if batches == 16:
+            return path
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+        variant = os.path.join(self.d, f"office-{self.n}-image-pixel-batches-{batches}.ron")
+        with open(variant, "w", encoding="utf-8") as f:
+            f.write(text.replace("render: (", f"render: (pixel_batches: {batches}, ", 1))
+        return variant
+
+    def candela(self, spp, seed, tag, illuminance, batches=16):
         out = os.path.join(self.d, "out-" + tag)
-        cmd = [self.a.candela, "render", os.path.join(self.d, f"office-{self.n}-image.ron"), "--spp", str(spp),
+        cmd = [self.a.candela, "render", self.scene(batches), "--spp", str(spp),
                "--threads", str(self.a.threads), "--seed", str(seed), "--out", out, "--quiet", "--overwrite",
                "--checkpoint-interval", "0s"] + (["--illuminance"] if illuminance else [])
         _, wall, cpu = timed(cmd, stdout=subprocess.DEVNULL)
@@ -287,6 +299,8 @@ def main():
     ap.add_argument("--ref-spp", type=int, default=256, help="candela reference spp per part")
     ap.add_argument("--ref-parts", type=int, default=4)
     ap.add_argument("--calib-spp", type=int, default=64, help="candela run that sets its spp")
+    ap.add_argument("--pixel-batches", type=int, default=16, choices=(2, 4, 8, 16),
+                    help="candela's render.pixel_batches in the calibration and timed runs (references: 16)")
     ap.add_argument("--rad-ref-ad", type=int, default=256)
     ap.add_argument("--rad-ref-runs", type=int, default=4)
     ap.add_argument("--ref-step", type=int, default=4, help="Radiance reference at every STEP-th pixel centre")
@@ -313,9 +327,9 @@ def main():
                 rm, rse = b.radiance_mc_reference(q == "E")
                 entry["agreement"][q] = agreement(ref[q], ref["var" + q], rm, rse, mask, a.ref_step)
                 log(f"N={n} {q}: agreement {json.dumps(entry['agreement'][q])}")
-        cal = b.candela(a.calib_spp, 7, "calib", True)
+        cal = b.candela(a.calib_spp, 7, "calib", True, a.pixel_batches)
         cal_rms = {q: rel_rms(cal[q], ref[q], ref["var" + q], mask)[0] for q in ("Y", "E")}
-        entry["calibration"] = {"spp": a.calib_spp, "rel_rms": cal_rms}
+        entry["calibration"] = {"spp": a.calib_spp, "rel_rms": cal_rms, "pixel_batches": a.pixel_batches}
         log(f"N={n}: candela {a.calib_spp} spp: rel. RMS Y {cal_rms['Y']:.3%}, E {cal_rms['E']:.3%}")
         for quality in a.qualities.split(","):
             for q in a.quantities.split(","):
@@ -328,7 +342,7 @@ def main():
                     rr_runs.append(rr)
                     if spp is None:
                         spp = max(1, math.ceil(a.calib_spp * (cal_rms[q] / max(rr["rel_rms"], 1e-6)) ** 2))
-                    cr = b.candela(spp, 100 + rep, f"timed-{quality}-{q}", ill)
+                    cr = b.candela(spp, 100 + rep, f"timed-{quality}-{q}", ill, a.pixel_batches)
                     cr["rel_rms"], cr["bias"] = rel_rms(cr[q], ref[q], ref["var" + q], mask)
                     for k in ("Y", "varY", "E", "varE"):
                         cr.pop(k, None)
