@@ -190,3 +190,43 @@ fn job_settings_are_checked_before_the_scene_is_read() {
         .unwrap();
     assert!(format!("{e:#}").contains("/nonexistent/scene.ron"), "{e:#}");
 }
+
+/// With `render.pixel_batches: 4` a render resumed from its state is the render done at once:
+/// sample i of a pixel is sample i / 4 of batch i mod 4 however the samples are split, and the
+/// state carries the number of batches.
+#[test]
+fn resume_with_four_batches_per_pixel_is_the_render_done_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("lit.ron");
+    std::fs::write(
+        &scene,
+        SCENE
+            .replace("Constant(0.0)", "Constant(0.5)")
+            .replace("seed: 5)", "seed: 5, pixel_batches: 4)"),
+    )
+    .unwrap();
+    let run = |name: &str, spp: u32, resume: bool, save: bool| {
+        let mut job = RenderJob::new(&scene);
+        job.out = Some(dir.path().join(name));
+        job.checkpoint_interval = None;
+        job.max_spp = Some(spp);
+        job.resume = resume;
+        job.save_state = save;
+        job::run(&job, &mut Silent, &AtomicBool::new(false)).expect("job")
+    };
+    let whole = run("whole", 12, false, false);
+    run("part", 5, false, true);
+    let resumed = run("part", 12, true, true);
+    assert_eq!(whole.render.film.pixel_batches, 4);
+    assert_eq!(resumed.render.film.pixel_batches, 4);
+    let y = |o: &job::RenderOutputs| -> Vec<f64> {
+        o.render
+            .film
+            .pixels
+            .iter()
+            .flat_map(|p| [p.mean_xyz()[1], p.y_standard_error(4)])
+            .collect()
+    };
+    assert!(y(&whole).iter().any(|&v| v > 0.0));
+    assert_eq!(y(&whole), y(&resumed));
+}
