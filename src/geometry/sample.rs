@@ -20,6 +20,23 @@ impl SceneGeometry {
         (pr.bounds(), n)
     }
 
+    /// A quad's origin and edges, or a triangle's vertices (with `true`); None for a sphere or
+    /// a disk. With [`SceneGeometry::prim_bounds_normal`]'s normal and
+    /// [`SceneGeometry::prim_area`], what a light needs to sample a flat primitive without
+    /// looking it up each time (see [`crate::light::area`]).
+    pub fn prim_corners(&self, prim: u32) -> Option<([Vec3; 3], bool)> {
+        match self.prim(prim) {
+            Prim::Triangle(v) => Some((v, true)),
+            Prim::Quad {
+                origin,
+                edge_u,
+                edge_v,
+                ..
+            } => Some(([origin, edge_u, edge_v], false)),
+            Prim::Sphere { .. } | Prim::Disk { .. } => None,
+        }
+    }
+
     /// Uniform by area on the primitive: point, unit front-face geometric normal; the pdf
     /// w.r.t. area is `1 / prim_area(prim)`. `u` ∈ [0,1)². The point's error bound is
     /// [`super::point_error_bound`] (it is computed in f64).
@@ -160,7 +177,10 @@ impl SceneGeometry {
         })
     }
 
-    fn area_to_solid_angle(area: f32, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
+    /// The density w.r.t. solid angle at `reference` of a point `p` (normal `n`) sampled
+    /// uniformly on `area` m² (0 where it would be infinite or NaN).
+    #[inline]
+    pub fn area_to_solid_angle(area: f32, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
         let w = p.as_dvec3() - reference.as_dvec3();
         let d2 = w.length_squared();
         if d2 == 0.0 {

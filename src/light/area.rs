@@ -5,7 +5,7 @@
 use super::{EmissionPoint, LightFlags, LightSample};
 use crate::description::context::{Context, Role, SceneError};
 use crate::description::schema::{Amount, EmissionDesc};
-use crate::geometry::{Hit, SceneGeometry};
+use crate::geometry::{Hit, SceneGeometry, SurfacePoint};
 use crate::photometry::luminous_integral;
 use crate::sampling::pick_from_cdf;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
@@ -39,6 +39,57 @@ pub struct AreaLight {
     radiance: Radiance,
     /// Emits from both faces (otherwise only from the front face).
     pub two_sided: bool,
+    /// One per `prims` when all are flat (and, for a textured light, quads, whose texture
+    /// coordinates are the sample numbers); otherwise empty, and the scene samples them.
+    flat: Vec<FlatPrim>,
+}
+
+/// A flat primitive of a light as its samples need it, copied from the scene at build, so
+/// that a sample skips the primitive's lookup and recomputing its area and normal: a quad's
+/// origin and edges or a triangle's vertices, with `Prim::sample_area`'s arithmetic, so the
+/// points and densities equal the scene's bit for bit (tests/area_light_prims.rs).
+#[derive(Clone, Copy, Debug)]
+struct FlatPrim {
+    corners: [Vec3; 3],
+    triangle: bool,
+    /// Unit front-face normal.
+    n: Vec3,
+    /// Area, m².
+    area: f32,
+}
+
+impl FlatPrim {
+    fn new(geom: &SceneGeometry, prim: u32) -> Option<Self> {
+        let (corners, triangle) = geom.prim_corners(prim)?;
+        Some(FlatPrim {
+            corners,
+            triangle,
+            n: geom.prim_bounds_normal(prim).1?,
+            area: geom.prim_area(prim),
+        })
+    }
+
+    /// The point uniform by area for `u` ∈ [0, 1)², computed in f64.
+    #[inline(always)]
+    fn point(&self, u: Vec2) -> Vec3 {
+        let (u0, u1) = (u.x as f64, u.y as f64);
+        let [a, b, c] = self.corners.map(|v| v.as_dvec3());
+        if self.triangle {
+            let (b0, b1, b2) = crate::sampling::uniform_triangle(u0, u1);
+            (b0 * a + b1 * b + b2 * c).as_vec3()
+        } else {
+            (a + u0 * b + u1 * c).as_vec3()
+        }
+    }
+}
+
+/// The flat primitives of `prims` (see [`AreaLight::flat`]).
+fn flat_prims(geom: &SceneGeometry, prims: &[u32], textured: bool) -> Vec<FlatPrim> {
+    prims
+        .iter()
+        .map(|&p| FlatPrim::new(geom, p).filter(|f| !(textured && f.triangle)))
+        .collect::<Option<Vec<_>>>()
+        .unwrap_or_default()
 }
 
 /// What an area light's surface emits.
@@ -193,6 +244,7 @@ impl AreaLight {
                 ctx.scaled_emission(&format!("{field}.emission.spectrum"), &afield, &d65, l)?;
                 let prim_luminance =
                     mean_luminances(&prims, geometry, |tex| t.luminance(tex) * l as f32 as f64);
+                let flat = flat_prims(geometry, &prims, true);
                 return Ok(Self {
                     object,
                     prims,
@@ -204,6 +256,7 @@ impl AreaLight {
                         prim_luminance,
                     },
                     two_sided,
+                    flat,
                 });
             }
         };
@@ -219,6 +272,7 @@ impl AreaLight {
         };
         let radiance =
             ctx.scaled_emission(&format!("{field}.emission.spectrum"), &afield, s, luminance)?;
+        let flat = flat_prims(geometry, &prims, false);
         Ok(Self {
             object,
             prims,
@@ -226,6 +280,7 @@ impl AreaLight {
             total_area: total as f32,
             radiance: Radiance::Uniform(radiance),
             two_sided,
+            flat,
         })
     }
 
@@ -244,7 +299,7 @@ impl AreaLight {
     }
 
     /// Radiance (W·m⁻²·sr⁻¹·nm⁻¹) leaving the surface where its texture coordinates are `tex`.
-    #[inline]
+    #[inline(always)]
     pub fn radiance_at(&self, tex: Vec2, wl: &SampledWavelengths) -> SampledSpectrum {
         match &self.radiance {
             Radiance::Uniform(r) => r.sample(wl),
@@ -315,6 +370,21 @@ impl AreaLight {
         Some(ls)
     }
 
+    /// The flat primitive of id `prim` (one of `prims`), if the light keeps them.
+    #[inline]
+    fn flat(&self, prim: u32) -> Option<&FlatPrim> {
+        if self.flat.is_empty() {
+            return None;
+        }
+        // `prims` ascend, and an object's primitives are usually consecutive ids.
+        let k = prim.wrapping_sub(self.prims[0]) as usize;
+        if self.prims.get(k) == Some(&prim) {
+            return self.flat.get(k);
+        }
+        let k = self.prims.binary_search(&prim).ok()?;
+        self.flat.get(k)
+    }
+
     /// A point on primitive `prim` (one of `prims`) seen from `p`, by solid angle; `pdf` is
     /// the density within that primitive (its choice is the caller's).
     pub fn sample_li_prim(
@@ -325,8 +395,23 @@ impl AreaLight {
         u: Vec2,
         wl: &SampledWavelengths,
     ) -> Option<LightSample> {
-        // The texture coordinates only matter to a textured emission.
-        let (sp, pdf_sa) = geom.sample_prim_solid_angle_with(prim, p, u, self.is_textured())?;
+        let sp = match self.flat(prim) {
+            Some(f) => {
+                let q = f.point(u);
+                let pdf = SceneGeometry::area_to_solid_angle(f.area, p, q, f.n);
+                (pdf > 0.0 && pdf.is_finite()).then_some((
+                    SurfacePoint {
+                        p: q,
+                        n: f.n,
+                        tex: u,
+                    },
+                    pdf,
+                ))
+            }
+            // The texture coordinates only matter to a textured emission.
+            None => geom.sample_prim_solid_angle_with(prim, p, u, self.is_textured()),
+        };
+        let (sp, pdf_sa) = sp?;
         let d = sp.p - p;
         let dist = d.length();
         if dist == 0.0 || pdf_sa.is_nan() || pdf_sa <= 0.0 || !pdf_sa.is_finite() {
@@ -350,8 +435,20 @@ impl AreaLight {
     /// Density (solid angle) with which [`AreaLight::sample_li`] from `p` would have produced
     /// the ray that hit the light at `hit`.
     pub fn pdf_li_hit(&self, geom: &SceneGeometry, p: Vec3, hit: &Hit) -> f32 {
-        let p_prim = geom.prim_area(hit.prim) / self.total_area;
-        p_prim * geom.pdf_prim_solid_angle(hit.prim, p, hit)
+        let area = self
+            .flat(hit.prim)
+            .map_or_else(|| geom.prim_area(hit.prim), |f| f.area);
+        area / self.total_area * self.pdf_li_hit_prim(geom, p, hit)
+    }
+
+    /// Density (solid angle) with which [`AreaLight::sample_li_prim`] from `p`, given the
+    /// primitive hit, would have produced the ray that hit the light at `hit`.
+    #[inline]
+    pub fn pdf_li_hit_prim(&self, geom: &SceneGeometry, p: Vec3, hit: &Hit) -> f32 {
+        match self.flat(hit.prim) {
+            Some(f) => SceneGeometry::area_to_solid_angle(f.area, p, hit.p, hit.ng),
+            None => geom.pdf_prim_solid_angle(hit.prim, p, hit),
+        }
     }
 
     /// Radiance leaving the surface toward the viewer, given the hit.

@@ -358,12 +358,12 @@ impl LightBvh {
                 return None;
             }
             let wk = w[k];
-            let pk = wk / sum;
-            pmf *= pk;
-            u = ((target - acc) / wk).clamp(0.0, ONE_MINUS_EPSILON);
+            pmf *= wk / sum;
             if node.leaves >> k & 1 == 1 {
                 return (pmf > 0.0).then_some((node.child[k] as usize, pmf));
             }
+            // Only a further level needs the rescaled sample number.
+            u = ((target - acc) / wk).clamp(0.0, ONE_MINUS_EPSILON);
             at = node.child[k] as usize;
         }
     }

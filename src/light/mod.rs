@@ -278,7 +278,7 @@ impl Light {
     /// hit, would have produced the ray that hit this area light at `hit`.
     pub fn pdf_li_hit_prim(&self, geom: &SceneGeometry, p: Vec3, hit: &Hit) -> f32 {
         match self {
-            Light::Area(_) => geom.pdf_prim_solid_angle(hit.prim, p, hit),
+            Light::Area(a) => a.pdf_li_hit_prim(geom, p, hit),
             _ => 0.0,
         }
     }
