@@ -385,6 +385,12 @@ impl Distribution {
         } else {
             plane
         };
+        self.eval_in_range(plane, angle)
+    }
+
+    /// [`Self::eval_angles`] of a Type C plane angle already in [0°, 360°).
+    #[inline]
+    fn eval_in_range(&self, plane: f64, angle: f64) -> f64 {
         let na = self.angles.len();
         let (Some((i, s)), Some((j, t))) =
             (bracket(&self.planes, plane), bracket(&self.angles, angle))
@@ -433,8 +439,10 @@ impl Distribution {
         }
         let [x, y, z] = d;
         let gamma = ((-y).clamp(-1.0, 1.0).acos() as f64).to_degrees();
-        let c = (((-z).atan2(x)) as f64).to_degrees().rem_euclid(360.0);
-        self.eval_angles(c, gamma)
+        // atan2 lies in [−180°, 180°]: one addition instead of a floating-point remainder.
+        let c = (((-z).atan2(x)) as f64).to_degrees();
+        let c = if c < 0.0 { c + 360.0 } else { c };
+        self.eval_in_range(c, gamma)
     }
 
     /// Candela toward a unit direction of the luminaire frame.
@@ -616,6 +624,38 @@ pub fn polar_value(dist: &Distribution, c: f64, t: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn single_precision_directions_give_the_double_precision_candela() {
+        // A batwing-like Type C table, full circle of planes, evaluated from f32 directions
+        // all round the sphere: within the angles' f32 rounding of the f64 evaluation.
+        let planes: Vec<f64> = (0..=24).map(|i| i as f64 * 15.0).collect();
+        let angles: Vec<f64> = (0..=36).map(|j| j as f64 * 2.5).collect();
+        let values: Vec<f64> = planes
+            .iter()
+            .flat_map(|&c| {
+                angles.iter().map(move |&g| {
+                    400.0 + 900.0 * (g.to_radians()).sin() * (1.0 + 0.2 * c.to_radians().cos())
+                })
+            })
+            .collect();
+        let d = Distribution::new(Kind::C, planes, angles, values);
+        let mut worst = 0.0f64;
+        for k in 0..20_000 {
+            let (u, v) = (
+                (k as f64 + 0.5) / 20_000.0,
+                (k as f64 * 0.618_033_988_75).fract(),
+            );
+            let z = 1.0 - 2.0 * u;
+            let r = (1.0 - z * z).sqrt();
+            let phi = std::f64::consts::TAU * v;
+            let w = [r * phi.cos(), z, r * phi.sin()].map(|c| c as f32);
+            let exact = d.eval(w.map(f64::from));
+            let fast = d.eval_f32(w);
+            worst = worst.max((fast - exact).abs() / 1300.0);
+        }
+        assert!(worst < 1e-5, "{worst}");
+    }
 
     #[test]
     fn bracket_index_agrees_with_the_binary_search() {
