@@ -235,9 +235,11 @@ mod simd {
         }
     }
 
-    /// `intersect_quad_f64` on the lanes of `g`, up to the division.
+    /// `intersect_quad_f64` on the lanes of `g`, up to the division. With `EARLY`, `None` when
+    /// no lane's plane is met within `(0, t_max)` (a shadow ray's usual case, which then skips
+    /// the parameters' dot products).
     #[inline(always)]
-    fn partial(g: &QuadGroup, r: &Ray) -> Partial {
+    fn partial<const EARLY: bool>(g: &QuadGroup, r: &Ray) -> Option<Partial> {
         // SAFETY: AVX2 is enabled at compile time; every load reads one [f64; 4] of `g`, which
         // `QuadGroup`'s alignment keeps 32-byte aligned.
         unsafe {
@@ -259,6 +261,9 @@ mod simd {
                 _mm256_cmp_pd::<_CMP_GT_OQ>(mul(num, den), zero),
                 _mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_andnot_pd(sign_bit, num), mul(den_abs, r.t_lim)),
             );
+            if EARLY && _mm256_movemask_pd(in_range) == 0 {
+                return None;
+            }
             // The scalar test's ×±1 (the sign of d·n) is a sign flip; d·n = ±0 or NaN fails
             // `in_range`.
             let flip = and(den, sign_bit);
@@ -280,14 +285,14 @@ mod simd {
                     _mm256_cmp_pd::<_CMP_LE_OQ>(vd, den_abs),
                 ),
             );
-            Partial {
+            Some(Partial {
                 num,
                 den,
                 den_abs,
                 sd,
                 vd,
                 candidates: and(in_range, inside),
-            }
+            })
         }
     }
 
@@ -348,7 +353,9 @@ mod simd {
             );
             let mut ids = _mm256_setr_epi64x(0, 1, 2, 3);
             for g in groups {
-                let p = partial(g, &r);
+                let Some(p) = partial::<false>(g, &r) else {
+                    unreachable!()
+                };
                 let key = keys(&p, &r, ids);
                 let less = _mm256_castsi256_pd(_mm256_cmpgt_epi64(best, key));
                 best = _mm256_castpd_si256(_mm256_blendv_pd(
@@ -405,7 +412,9 @@ mod simd {
         unsafe {
             let no_hit = _mm256_set1_epi64x(NO_HIT);
             groups.iter().any(|g| {
-                let p = partial(g, &r);
+                let Some(p) = partial::<true>(g, &r) else {
+                    return false;
+                };
                 _mm256_movemask_pd(p.candidates) != 0 && {
                     let key = keys(&p, &r, _mm256_setzero_si256());
                     _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpgt_epi64(no_hit, key))) != 0
@@ -429,7 +438,9 @@ mod simd {
         unsafe {
             let no_hit = _mm256_set1_epi64x(NO_HIT);
             for (gi, g) in groups.iter().enumerate() {
-                let p = partial(g, &r);
+                let Some(p) = partial::<true>(g, &r) else {
+                    continue;
+                };
                 if _mm256_movemask_pd(p.candidates) == 0 {
                     continue;
                 }
