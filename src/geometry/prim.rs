@@ -44,6 +44,9 @@ pub(crate) struct QuadPre {
     pub du: DVec3,
     /// (n × edge_u) / |n|².
     pub dv: DVec3,
+    /// The part of a hit point's error bound that the point's f64 evaluation contributes (see
+    /// [`quad_hit_geom`]), which depends on the quad alone.
+    pub err: Vec3,
 }
 
 impl Prim {
@@ -61,6 +64,7 @@ impl Prim {
                 unit_n: n.normalize().as_vec3(),
                 du: ev.cross(n) / nn,
                 dv: n.cross(eu) / nn,
+                err: f64_error(quad_point_magnitude(origin.as_dvec3(), eu, ev)),
             },
         }
     }
@@ -280,13 +284,22 @@ pub(crate) fn intersect_quad_f64(
     if !(t > 0.0 && t32 > 0.0 && t32 < t_max) {
         return None;
     }
-    // In [0, 1] up to the division's rounding, which `min` removes.
+    let (a, b) = quad_params(sd, vd, den_abs);
+    Some((t32, a, b))
+}
+
+/// A quad hit's parameters (s, t) from s·|d·n|, t·|d·n| and |d·n| (see [`intersect_quad_f64`]).
+#[inline(always)]
+pub(crate) fn quad_params(sd: f64, vd: f64, den_abs: f64) -> (f32, f32) {
     let inv = 1.0 / den_abs;
-    Some((
-        t32,
-        ((sd * inv) as f32).min(1.0),
-        ((vd * inv) as f32).min(1.0),
-    ))
+    (quad_param(sd * inv), quad_param(vd * inv))
+}
+
+/// A quad hit's parameter from its product with |d·n| times 1/|d·n| (see [`quad_params`]).
+#[inline(always)]
+pub(crate) fn quad_param(x: f64) -> f32 {
+    // In [0, 1] up to the division's rounding, which `min` removes.
+    (x as f32).min(1.0)
 }
 
 #[inline]
@@ -367,9 +380,14 @@ pub(crate) fn quad_hit_geom(
         p,
         ng: q.unit_n,
         uv: Vec2::new(a, b),
-        error: rounded_error(p, o.abs() + eu.abs() + ev.abs()),
+        error: rounded_error_with(p, q.err),
         bary: Vec3::ZERO,
     }
+}
+
+/// The magnitude of the terms of a quad point's f64 evaluation (see [`quad_hit_geom`]).
+fn quad_point_magnitude(o: DVec3, eu: DVec3, ev: DVec3) -> DVec3 {
+    o.abs() + eu.abs() + ev.abs()
 }
 
 /// Geometric data of a hit, before shading normals and ids are filled in.
@@ -388,7 +406,18 @@ const F64_REL: f64 = 1.0 / (1u64 << 45) as f64;
 /// magnitude `mag` per axis.
 #[inline]
 fn rounded_error(p: Vec3, mag: DVec3) -> Vec3 {
-    p.abs() * gamma(2) + (mag * F64_REL).as_vec3() + Vec3::splat(f32::MIN_POSITIVE)
+    rounded_error_with(p, f64_error(mag))
+}
+
+/// The f64 evaluation's part of [`rounded_error`].
+fn f64_error(mag: DVec3) -> Vec3 {
+    (mag * F64_REL).as_vec3()
+}
+
+/// [`rounded_error`] with its f64 part `f64_err` given.
+#[inline(always)]
+fn rounded_error_with(p: Vec3, f64_err: Vec3) -> Vec3 {
+    p.abs() * gamma(2) + f64_err + Vec3::splat(f32::MIN_POSITIVE)
 }
 
 impl Prim {

@@ -121,7 +121,23 @@ impl SceneGeometry {
     ///
     /// This is [`SceneGeometry::intersect_basic`]'s traversal followed by the full hit record
     /// (point, unit normals, shading normal, error bounds).
+    #[inline(always)]
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
+        // A scene of a few quads and nothing else: the query in the caller (whose use of the
+        // hit then needs no copy of it through memory), the hit record from the quads' data.
+        if self.small.active() && self.instances.is_none() {
+            if !Self::ray_ok(origin, dir, t_max) {
+                return None;
+            }
+            let (prim, t, a, b) = self.small.closest(origin, dir, t_max)?;
+            return Some(self.small_hit(prim, dir, t, a, b));
+        }
+        self.intersect_any(origin, dir, t_max)
+    }
+
+    /// [`SceneGeometry::intersect`] in any scene.
+    #[inline(never)]
+    fn intersect_any(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Hit> {
         Some(match self.closest_any(origin, dir, t_max)? {
             Found::Flat((prim, t, a, b)) => self.hit_record(prim, origin, dir, t, a, b),
             Found::Instanced(set, h) => set.make_hit(h, dir),
@@ -350,14 +366,45 @@ impl SceneGeometry {
         }
     }
 
+    /// [`SceneGeometry::hit_record`] in a scene of a few quads, which have neither vertex
+    /// normals nor texture coordinates.
+    #[inline(always)]
+    fn small_hit(&self, prim: u32, dir: Vec3, t: f32, a: f32, b: f32) -> Hit {
+        let g = self.small.hit_geom(prim, a, b);
+        Hit {
+            t,
+            p: g.p,
+            ng: g.ng,
+            ns: g.ng,
+            uv: g.uv,
+            tex: g.uv,
+            prim,
+            object: self.prim_object[prim as usize],
+            instance: super::NO_INSTANCE,
+            front_face: dir.dot(g.ng) < 0.0,
+            error: g.error,
+        }
+    }
+
     /// True if anything is hit with `t` in `(0, t_max)` (any-hit traversal, for shadow rays).
     /// Same ray conventions as [`SceneGeometry::intersect`].
+    #[inline(always)]
     pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        // A scene of a few quads and nothing else: the query in the caller.
+        if self.small.active() && self.instances.is_none() {
+            return Self::ray_ok(origin, dir, t_max) && self.small.occluded(origin, dir, t_max);
+        }
+        self.occluded_any(origin, dir, t_max)
+    }
+
+    /// [`SceneGeometry::occluded`] in any scene.
+    #[inline(never)]
+    fn occluded_any(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
         if !Self::ray_ok(origin, dir, t_max) {
             return false;
         }
         if self.small.active() {
-            if self.small.any_hit(origin, dir, t_max, |_, _, _| false) {
+            if self.small.occluded(origin, dir, t_max) {
                 return true;
             }
         } else if !self.tris.is_empty() {
