@@ -3,7 +3,7 @@
 
 use crate::film::{radiance_to_xyz, Film, HealthPixel, IlluminanceSums, PixelE, PixelSums};
 use crate::integrator::sun_view::SunInView;
-use crate::integrator::{trace, PathStart, RayStats};
+use crate::integrator::{PathStart, RayStats};
 use crate::sampling::{batch_stream, Sampler};
 use crate::spectrum::SampledWavelengths;
 use crate::world::World;
@@ -74,28 +74,16 @@ pub fn render_pixel(
             sun_deposited: sun.is_some(),
             ..PathStart::image(world, ray.origin)
         };
-        let (l, first_hit) = if e.is_some() {
-            crate::integrator::path::trace_with_first_hit(
-                world,
-                ray.origin,
-                ray.dir,
-                start,
-                &mut wl,
-                &mut sampler,
-                stats,
-            )
-        } else {
-            let l = trace(
-                world,
-                ray.origin,
-                ray.dir,
-                start,
-                &mut wl,
-                &mut sampler,
-                stats,
-            );
-            (l, None)
-        };
+        let (l, first_hit) = crate::integrator::path::trace_seen(
+            world,
+            ray.origin,
+            ray.dir,
+            start,
+            &mut wl,
+            &mut sampler,
+            stats,
+            e.is_some(),
+        );
         if let Some(e) = e.as_deref_mut() {
             let mel = health.as_ref().is_some_and(|h| h.wants_irradiance());
             let seen = (ray.dir, first_hit, &l, &wl);

@@ -120,9 +120,11 @@ pub fn trace_tallied<T: FnMut(Vec3, SampledSpectrum)>(
     trace_impl(world, origin, dir, start, wl, sampler, stats, tally, false).0
 }
 
-/// [`trace`], and the first intersection of the ray (`intersect`'s hit, before any normal map):
-/// the surface the camera sees, for estimates at it that would otherwise trace the ray again.
-pub fn trace_with_first_hit(
+/// [`trace`], and with `keep_first_hit` the first intersection of the ray (`intersect`'s hit,
+/// before any normal map): the surface the camera sees, for estimates at it that would
+/// otherwise trace the ray again.
+#[allow(clippy::too_many_arguments)]
+pub fn trace_seen(
     world: &World,
     origin: Vec3,
     dir: Vec3,
@@ -130,7 +132,9 @@ pub fn trace_with_first_hit(
     wl: &mut SampledWavelengths,
     sampler: &mut Sampler,
     stats: &mut RayStats,
+    keep_first_hit: bool,
 ) -> (SampledSpectrum, Option<Hit>) {
+    let mut no_tally = |_, _| {};
     trace_impl(
         world,
         origin,
@@ -139,8 +143,8 @@ pub fn trace_with_first_hit(
         wl,
         sampler,
         stats,
-        &mut |_, _| {},
-        true,
+        &mut no_tally,
+        keep_first_hit,
     )
 }
 
