@@ -390,5 +390,6 @@ def read_state(path: Union[str, os.PathLike]) -> Dict[str, Any]:
     """A render state (NAME.state; checksum and values checked as for ``--resume``): ``scene``,
     ``seed``, ``merged_seeds``, ``max_depth`` (None: unlimited), ``illuminance``, ``width``,
     ``height``, ``adaptive``, ``total_samples``, ``samples_per_pixel``, ``shard`` ((index,
-    count, spp) or None), and ``channels``: the estimate it holds, as its EXR would have it."""
+    count, spp) or None), ``pixel_batches`` (independent sample batches per pixel), and
+    ``channels``: the estimate it holds, as its EXR would have it."""
     return _candela.read_state(os.fspath(path))

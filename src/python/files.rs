@@ -66,6 +66,7 @@ fn read_state(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("total_samples", st.film.total_samples())?;
     d.set_item("samples_per_pixel", st.film.samples_per_pixel())?;
     d.set_item("shard", st.shard.map(|s| (s.index, s.count, s.spp)))?;
+    d.set_item("pixel_batches", st.film.pixel_batches)?;
     d.set_item("meter_sums", st.meters.len())?;
     let layers = crate::job::files::film_layers(&st.scene, &st.film, st.illuminance);
     d.set_item("channels", channel_dict(py, &layers)?)?;

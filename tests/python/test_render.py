@@ -129,6 +129,7 @@ def test_progress_callback_cancels(tmp_path, scene_path):
     assert calls[1][1] == 48 * 36 * 1_000_000 and 0 < calls[1][0] < calls[2][0]
     st = candela.read_state(tmp_path / "small-room.state")
     assert st["total_samples"] == calls[-1][0] and st["width"] == 48
+    assert st["pixel_batches"] == 16
 
 
 def test_cancel_event_stops_render(tmp_path, scene_path):
