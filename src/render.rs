@@ -357,6 +357,14 @@ pub fn render_progressive(
     on_pass: &mut dyn FnMut(&PassStatus),
     on_checkpoint: &mut dyn FnMut(&Film) -> anyhow::Result<()>,
 ) -> anyhow::Result<(RenderResult, StopReason)> {
+    // The samples are drawn in the world's batches and their errors taken in the film's: one
+    // number, or the standard errors would be wrong.
+    anyhow::ensure!(
+        film.pixel_batches == world.settings.pixel_batches,
+        "the film holds samples in {} batches per pixel, but the scene renders {} (render.pixel_batches)",
+        film.pixel_batches,
+        world.settings.pixel_batches
+    );
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()?;

@@ -282,3 +282,32 @@ fn adaptive_buffers_have_independent_illuminance_samples() {
         "{differ} of {both} pixels differ"
     );
 }
+
+/// A film whose batches per pixel differ from the scene's is refused before a sample is
+/// taken: its standard errors would fold the samples into the wrong batches.
+#[test]
+fn a_film_of_other_batches_is_refused() {
+    let w = world(&FURNACE.replace("max_depth: 64)", "max_depth: 64, pixel_batches: 4)"));
+    let mut film = Film::new(10, 10);
+    let e = render_progressive(
+        &w,
+        &mut film,
+        Some(1),
+        &Progressive::default(),
+        &AtomicBool::new(false),
+        &mut |_| {},
+        &mut |_| Ok(()),
+    )
+    .err()
+    .expect("refused")
+    .to_string();
+    assert!(e.contains("render.pixel_batches"), "{e}");
+    assert_eq!(film.total_samples(), 0);
+    film.pixel_batches = 4;
+    let p = Progressive {
+        max_spp: 4,
+        ..Default::default()
+    };
+    run(&w, &mut film, &p, None);
+    assert_eq!(film.total_samples(), 400);
+}

@@ -51,6 +51,7 @@ pub use bvh::BUILD_PEAK_BYTES_PER_PRIM;
 pub(crate) use desc::mesh_err;
 pub use instance::{InstanceGroup, NO_INSTANCE};
 pub use io::{load_obj, load_obj_model, load_ply, ObjGroup, ObjModel};
+pub use prim::flat_point;
 pub use query::RayHit;
 pub use robust::{
     gamma, next_float_down, next_float_up, offset_ray_origin, point_error_bound, shadow_ray,

@@ -560,10 +560,8 @@ impl Prim {
     pub fn sample_area(&self, u: Vec2) -> (Vec3, Vec3) {
         let (u0, u1) = (u.x as f64, u.y as f64);
         match *self {
-            Prim::Triangle([p0, p1, p2]) => {
-                let (b0, b1, b2) = crate::sampling::uniform_triangle(u0, u1);
-                let p = b0 * p0.as_dvec3() + b1 * p1.as_dvec3() + b2 * p2.as_dvec3();
-                let p = p.as_vec3();
+            Prim::Triangle(v) => {
+                let p = flat_point(v, true, u);
                 (p, self.normal_at(p))
             }
             Prim::Sphere { center, radius } => {
@@ -577,8 +575,7 @@ impl Prim {
                 edge_v,
                 ..
             } => {
-                let p = origin.as_dvec3() + u0 * edge_u.as_dvec3() + u1 * edge_v.as_dvec3();
-                let p = p.as_vec3();
+                let p = flat_point([origin, edge_u, edge_v], false, u);
                 (p, self.normal_at(p))
             }
             Prim::Disk {
@@ -594,6 +591,22 @@ impl Prim {
                 (p.as_vec3(), n.as_vec3())
             }
         }
+    }
+}
+
+/// The point uniform by area for `u` ∈ [0, 1)², computed in f64, of a triangle (`corners` its
+/// vertices, `triangle` true) or a quad (`corners` its origin and two edges): what
+/// [`Prim::sample_area`] samples, also for lights that keep their primitives' corners
+/// ([`crate::light::area`]).
+#[inline(always)]
+pub fn flat_point(corners: [Vec3; 3], triangle: bool, u: Vec2) -> Vec3 {
+    let (u0, u1) = (u.x as f64, u.y as f64);
+    let [a, b, c] = corners.map(|v| v.as_dvec3());
+    if triangle {
+        let (b0, b1, b2) = crate::sampling::uniform_triangle(u0, u1);
+        (b0 * a + b1 * b + b2 * c).as_vec3()
+    } else {
+        (a + u0 * b + u1 * c).as_vec3()
     }
 }
 

@@ -46,8 +46,9 @@ pub struct AreaLight {
 
 /// A flat primitive of a light as its samples need it, copied from the scene at build, so
 /// that a sample skips the primitive's lookup and recomputing its area and normal: a quad's
-/// origin and edges or a triangle's vertices, with `Prim::sample_area`'s arithmetic, so the
-/// points and densities equal the scene's bit for bit (tests/area_light_prims.rs).
+/// origin and edges or a triangle's vertices, sampled by the scene's own
+/// [`crate::geometry::flat_point`], so the points and densities equal the scene's bit for bit
+/// (tests/area_light_prims.rs).
 #[derive(Clone, Copy, Debug)]
 struct FlatPrim {
     corners: [Vec3; 3],
@@ -69,17 +70,10 @@ impl FlatPrim {
         })
     }
 
-    /// The point uniform by area for `u` ∈ [0, 1)², computed in f64.
+    /// The point uniform by area for `u` ∈ [0, 1)², as the scene samples it.
     #[inline(always)]
     fn point(&self, u: Vec2) -> Vec3 {
-        let (u0, u1) = (u.x as f64, u.y as f64);
-        let [a, b, c] = self.corners.map(|v| v.as_dvec3());
-        if self.triangle {
-            let (b0, b1, b2) = crate::sampling::uniform_triangle(u0, u1);
-            (b0 * a + b1 * b + b2 * c).as_vec3()
-        } else {
-            (a + u0 * b + u1 * c).as_vec3()
-        }
+        crate::geometry::flat_point(self.corners, self.triangle, u)
     }
 }
 
