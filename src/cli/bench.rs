@@ -56,13 +56,13 @@ pub enum BenchMode {
 pub use candela::job::check_threads;
 
 /// Largest triangle count of a generated benchmark mesh: its peak memory,
-/// [`BYTES_PER_TRIANGLE`] a triangle, is then about 17 GiB.
+/// [`BYTES_PER_TRIANGLE`] a triangle, is then about 21 GiB.
 pub const MAX_TRIANGLES: usize = 50_000_000;
 
 /// Peak memory per triangle while a generated benchmark mesh and its BVH are built (the BVH
-/// builder's working memory; the finished geometry keeps about 53 bytes a triangle). Measured
-/// peak RSS: 337 bytes a triangle between 1 M and 4 M triangles, in all three modes.
-pub const BYTES_PER_TRIANGLE: u64 = 360;
+/// builder's working memory; the finished geometry keeps about 69 bytes a triangle). Measured
+/// peak RSS of `bench traversal`: 424–429 bytes a triangle at 1 M and 4 M triangles.
+pub const BYTES_PER_TRIANGLE: u64 = 460;
 
 /// Peak memory per primary ray of `bench traversal` (RES² of them): the primary, diffuse and
 /// shadow batches while they are generated, or the batches and their bytes while they are

@@ -1,7 +1,7 @@
 //! Building the scene BVH: primitives from the shapes (validated, zero-area triangles
 //! dropped), their padded bounds, a binary BVH over them (obvhs's PLOC and reinsertion for
 //! ordinary inputs; a top-down SAH build of bounded height for the inputs PLOC handles badly),
-//! obvhs's CWBVH (8-wide, compressed nodes) from it with empty child slots made unhittable, and
+//! the 8-wide tree with float child boxes collapsed from it (`wide`), and
 //! the primitives laid out in leaf order.
 //!
 //! Any set of valid primitives builds in O(n log n)-ish time into a tree at most
@@ -16,48 +16,32 @@ pub(super) use small::SmallQuads;
 
 use super::prim::Prim;
 use super::robust::gamma;
+use super::wide::WideBvh;
 use super::{GeometryError, SceneGeometry, Shape};
 use glam::Vec3;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
-use obvhs::cwbvh::CwBvh;
 
 /// Largest distance from the origin (m, per axis) of any primitive's bounds: beyond it the
 /// BVH builder's f32 surface-area costs overflow (7 astronomical units: room for a sun).
 pub const MAX_COORDINATE: f32 = 1e12;
 
-/// Bound on the depth of the CWBVH (node levels), which sizes the traversal stack. The binary
-/// tree it is made from is kept below it, and no CWBVH is deeper than its binary tree.
+/// Bound on the depth of the wide BVH (node levels), which sizes the traversal stack. The
+/// binary tree it is made from is kept below it, and no wide BVH is deeper than its binary tree.
 pub(super) const MAX_DEPTH: usize = 64;
 
 /// Most levels of the binary tree.
 const MAX_BVH2_HEIGHT: u32 = MAX_DEPTH as u32 - 1;
 
 /// Peak memory of [`SceneGeometry::build`] per primitive, bytes, beyond its input: the
-/// primitives, their boxes and ids, the binary and the wide tree (measured: 170–250 B for
-/// 10⁵–10⁷ triangles, tests/bvh_cad_bench.rs).
-pub const BUILD_PEAK_BYTES_PER_PRIM: u64 = 300;
+/// primitives, their boxes and ids, the binary and the wide tree (measured: 386 B for 10⁷
+/// random triangles, tests/bvh_cad_bench.rs).
+pub const BUILD_PEAK_BYTES_PER_PRIM: u64 = 400;
 
-/// obvhs's `BvhBuildParams::medium_build()` values for the steps after PLOC.
+/// obvhs's `BvhBuildParams::medium_build()` value for the reinsertion after PLOC.
 const REINSERTION_BATCH_RATIO: f32 = 0.05;
-const MAX_PRIMS_PER_LEAF: u32 = 3;
-
-/// Depth of a CWBVH (1 for a single root node; 0 if empty).
-pub(super) fn cwbvh_depth(bvh: &CwBvh) -> u32 {
-    if bvh.nodes.is_empty() {
-        return 0;
-    }
-    let mut max = 0;
-    let mut stack = vec![(0u32, 1u32)];
-    while let Some((n, d)) = stack.pop() {
-        max = max.max(d);
-        let node = &bvh.nodes[n as usize];
-        for k in 0..node.imask.count_ones() {
-            stack.push((node.child_base_idx + k, d + 1));
-        }
-    }
-    max
-}
+/// Most primitives in a leaf of the scene's BVH.
+const MAX_PRIMS_PER_LEAF: u32 = 6;
 
 /// Height of a binary tree (1 for a single leaf), or `None` once it exceeds `limit`.
 fn bvh2_height(bvh: &Bvh2, limit: u32) -> Option<u32> {
@@ -93,37 +77,16 @@ fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
     sah::build(aabbs, MAX_BVH2_HEIGHT)
 }
 
-/// The CWBVH over `aabbs` (not empty), leaves of at most `max_prims_per_leaf`, with empty
-/// child slots made unhittable.
-pub(super) fn build_cwbvh(aabbs: &[Aabb], max_prims_per_leaf: u32) -> CwBvh {
-    let mut bvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
-        &build_bvh2(aabbs),
-        max_prims_per_leaf,
-        true,
-        false,
-    );
-    bvh.nodes.shrink_to_fit();
-    // Empty child slots get inverted boxes (min 255 > max 0) so the node test misses them
-    // (it does not check the slot's meta byte).
-    for node in &mut bvh.nodes {
-        for k in 0..8 {
-            if node.child_meta[k] == 0 {
-                node.child_min_x[k] = 255;
-                node.child_min_y[k] = 255;
-                node.child_min_z[k] = 255;
-                node.child_max_x[k] = 0;
-                node.child_max_y[k] = 0;
-                node.child_max_z[k] = 0;
-            }
-        }
-    }
-    bvh
+/// The wide BVH over `aabbs` (not empty), leaves of at most `max_leaf` primitives, and the
+/// `aabbs` indices in leaf order.
+pub(super) fn build_wide(aabbs: &[Aabb], max_leaf: u32) -> (WideBvh, Vec<u32>) {
+    WideBvh::from_bvh2(&build_bvh2(aabbs), max_leaf)
 }
 
-/// Refuses a CWBVH too deep for the traversal stack (which the binary tree's height bound
-/// already excludes).
-pub(super) fn check_depth(bvh: &CwBvh, n: usize) -> Result<(), GeometryError> {
-    let depth = cwbvh_depth(bvh);
+/// Refuses a BVH too deep for the traversal stack (which the binary tree's height bound
+/// already excludes: no level of the wide tree is made of fewer than one binary level).
+pub(super) fn check_depth(bvh: &WideBvh, n: usize) -> Result<(), GeometryError> {
+    let depth = bvh.depth();
     if depth as usize >= MAX_DEPTH {
         return Err(GeometryError::InvalidShape {
             shape: "scene",
@@ -364,34 +327,34 @@ impl SceneGeometry {
         } else {
             (lo, hi)
         };
-        let mut bvh = if prims.is_empty() {
-            CwBvh::default()
+        let (bvh, order) = if prims.is_empty() {
+            (WideBvh::default(), Vec::new())
         } else {
-            build_cwbvh(&aabbs, MAX_PRIMS_PER_LEAF)
+            build_wide(&aabbs, MAX_PRIMS_PER_LEAF)
         };
         // The traversal stack's bound, which the binary tree's height already guarantees.
         check_depth(&bvh, prims.len())?;
         drop(aabbs);
 
         // Lay primitives out in leaf order so the traversal indexes them directly.
-        let order = &bvh.primitive_indices;
+        let order = &order;
         let small = if prims.len() <= small::MAX_QUADS {
             SmallQuads::new(&order.iter().map(|&i| prims[i as usize]).collect::<Vec<_>>())
         } else {
             SmallQuads::default()
         };
         let mut others = Vec::new();
-        let tris: Vec<[Vec3; 3]> = order
-            .iter()
-            .map(|&i| match prims[i as usize] {
+        let tris = super::pages::HugeArray::collect(
+            order.len(),
+            order.iter().map(|&i| match prims[i as usize] {
                 Prim::Triangle(v) => v,
                 p => {
                     others.push(p);
                     let marker = Vec3::new(f32::from_bits((others.len() - 1) as u32), 0.0, 0.0);
                     [Vec3::NAN, marker, Vec3::ZERO]
                 }
-            })
-            .collect();
+            }),
+        );
         drop(prims);
         let prim_object: Vec<u32> = order.iter().map(|&i| objects[i as usize]).collect();
         let prim_normals: Vec<[u32; 3]> = if any_normals {
@@ -404,9 +367,7 @@ impl SceneGeometry {
         } else {
             Vec::new()
         };
-        // Traversal only needs the node array once the primitives are in leaf order.
-        bvh.primitive_indices = Vec::new();
-        bvh.exact_node_aabbs = None;
+        // Traversal only needs the float nodes once the primitives are in leaf order.
         let mut by_obj: Vec<(u32, u32)> = prim_object
             .iter()
             .enumerate()

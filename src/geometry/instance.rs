@@ -1,21 +1,21 @@
 //! Instances: a mesh stored once and placed many times. Each distinct mesh is a bottom-level
-//! BVH (a [`SceneGeometry`] of its own, in object space); a top-level CWBVH over the instances'
+//! BVH (a [`SceneGeometry`] of its own, in object space); a top-level BVH over the instances'
 //! world bounds (one instance per leaf) leads to them, and rays are carried into an instance's
 //! object space (in f64, rounded once) for its bottom level. Ray parameters are the same in
 //! both spaces (the direction is transformed, not normalized), so `t` needs no conversion.
 //! Hits come back in world space: points through the instance transform with an error bound
 //! that covers its rounding, normals through its inverse transpose.
 //!
-//! Memory: [`Instance`] is 144 bytes and its index 4, plus one top-level node (80 bytes) per
+//! Memory: [`Instance`] is 144 bytes and its index 4, plus one top-level node (256 bytes) per
 //! about 4–8 instances; the mesh costs what it costs once.
 
-use super::bvh::{build_cwbvh, check_depth, padded_aabb};
+use super::bvh::{build_wide, check_depth, padded_aabb};
 use super::prim::{PrimT, RayPre};
 use super::robust::gamma;
 use super::traverse::{prefetch, traverse, LeafTest};
+use super::wide::WideBvh;
 use super::{GeometryError, Hit, SceneGeometry, Shape, Transform};
 use glam::{Affine3A, DVec3, Vec2, Vec3, Vec3A};
-use obvhs::cwbvh::CwBvh;
 
 /// [`Hit::instance`] of a hit on a primitive that is not instanced.
 pub const NO_INSTANCE: u32 = u32::MAX;
@@ -47,7 +47,7 @@ pub(super) struct Instance {
 
 /// The instanced part of a scene: the top level and the meshes.
 pub(super) struct InstanceSet {
-    tlas: CwBvh,
+    tlas: WideBvh,
     /// In top-level leaf order.
     insts: Vec<Instance>,
     /// The leaf of each instance, in the caller's order ([`Hit::instance`] → `insts`).
@@ -251,19 +251,18 @@ impl InstanceSet {
                 message: "too many instances (at most 2^32 − 1)".into(),
             });
         }
-        let tlas = build_cwbvh(&aabbs, 1);
+        let (tlas, order) = build_wide(&aabbs, 1);
         check_depth(&tlas, insts.len())?;
         drop(aabbs);
         for (i, inst) in insts.iter_mut().enumerate() {
             inst.index = i as u32;
         }
         let mut leaf_of = vec![0u32; insts.len()];
-        for (leaf, &i) in tlas.primitive_indices.iter().enumerate() {
+        for (leaf, &i) in order.iter().enumerate() {
             leaf_of[i as usize] = leaf as u32;
         }
         let mut by_leaf: Vec<Option<Instance>> = insts.into_iter().map(Some).collect();
-        let insts: Vec<Instance> = tlas
-            .primitive_indices
+        let insts: Vec<Instance> = order
             .iter()
             .map(|&i| {
                 by_leaf[i as usize]
@@ -271,9 +270,6 @@ impl InstanceSet {
                     .expect("each instance is one leaf")
             })
             .collect();
-        let mut tlas = tlas;
-        tlas.primitive_indices = Vec::new();
-        tlas.exact_node_aabbs = None;
         Ok(Some(InstanceSet {
             tlas,
             insts,
@@ -302,7 +298,7 @@ impl InstanceSet {
     }
 
     pub(super) fn memory_bytes(&self) -> usize {
-        self.tlas.nodes.capacity() * std::mem::size_of::<obvhs::cwbvh::node::CwBvhNode>()
+        self.tlas.memory_bytes()
             + self.insts.capacity() * std::mem::size_of::<Instance>()
             + self.leaf_of.capacity() * std::mem::size_of::<u32>()
             + self
@@ -313,7 +309,7 @@ impl InstanceSet {
     }
 
     pub(super) fn tlas_depth(&self) -> u32 {
-        super::bvh::cwbvh_depth(&self.tlas)
+        self.tlas.depth()
     }
 
     /// Closest hit in `(0, t_max)`: (instance in leaf order, object-space ray, primitive, t, a, b).
@@ -357,7 +353,7 @@ impl InstanceSet {
             dir,
             best: None,
         };
-        traverse::<true>(&self.tlas.nodes, origin, dir, t_max, &mut c);
+        traverse::<true>(&self.tlas, origin, dir, t_max, &mut c);
         c.best
     }
 
@@ -460,7 +456,7 @@ impl InstanceSet {
             pass,
             hit: false,
         };
-        traverse::<false>(&self.tlas.nodes, origin, dir, t_max, &mut a);
+        traverse::<false>(&self.tlas, origin, dir, t_max, &mut a);
         a.hit
     }
 
@@ -521,7 +517,7 @@ impl SceneGeometry {
             .map_or(0, |s| s.stored_triangle_count())
     }
 
-    /// CWBVH nodes of the instances: the top level and each instanced mesh's (80 bytes each).
+    /// BVH nodes of the instances: the top level and each instanced mesh's (256 bytes each).
     pub fn instance_node_count(&self) -> usize {
         self.instances.as_ref().map_or(0, |s| {
             s.tlas.nodes.len() + s.meshes.iter().map(|m| m.bvh.nodes.len()).sum::<usize>()

@@ -1,4 +1,4 @@
-//! Geometry: shapes, transforms, mesh loading, the scene BVH (obvhs CWBVH) with closest-hit and
+//! Geometry: shapes, transforms, mesh loading, the scene BVH (8-wide, float boxes) with closest-hit and
 //! shadow queries, robust ray offsets and area / solid-angle sampling of primitives.
 //!
 //! Units are metres. All queries are designed to be scale-independent: they work for scenes
@@ -39,6 +39,7 @@ pub mod gltf;
 mod instance;
 mod io;
 pub mod mtl;
+mod pages;
 mod prim;
 mod query;
 mod robust;
@@ -46,6 +47,7 @@ mod sample;
 mod scene;
 mod tangent;
 mod traverse;
+mod wide;
 
 pub use bvh::BUILD_PEAK_BYTES_PER_PRIM;
 pub(crate) use desc::mesh_err;

@@ -179,12 +179,12 @@ pub(crate) fn triangle_tail(r: &RayPre, t_max: f32, pt: [Vec3; 3], e: [f32; 3]) 
     p1t.z *= r.sz;
     p2t.z *= r.sz;
     let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled <= t_max * det) {
+    if (det < 0.0 && t_scaled >= 0.0) || (det > 0.0 && t_scaled <= 0.0) {
         return None;
     }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled >= t_max * det) {
-        return None;
-    }
+    // Only the rounded t is compared with t_max (not t_scaled with t_max·det, which rounds
+    // differently): a triangle then replaces the closest hit so far exactly when its t is
+    // smaller, so the closest t does not depend on the order the triangles are tested in.
     let inv_det = 1.0 / det;
     let t = t_scaled * inv_det;
     if t >= t_max || t.is_nan() {

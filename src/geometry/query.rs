@@ -268,7 +268,7 @@ impl SceneGeometry {
             pre,
             best: (u32::MAX, t_max, 0.0, 0.0),
         };
-        traverse::<true>(&self.bvh.nodes, pre.o, pre.d, t_max, &mut c);
+        traverse::<true>(&self.bvh, pre.o, pre.d, t_max, &mut c);
         (c.best.0 != u32::MAX).then_some(c.best)
     }
 
@@ -546,7 +546,7 @@ impl SceneGeometry {
             pass,
             hit: false,
         };
-        traverse::<false>(&self.bvh.nodes, pre.o, pre.d, t_max, &mut a);
+        traverse::<false>(&self.bvh, pre.o, pre.d, t_max, &mut a);
         a.hit
     }
 

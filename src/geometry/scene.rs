@@ -2,20 +2,19 @@
 //! objects and their primitives, bounds and size statistics. Building it is in `bvh`, ray
 //! queries in `query` (over the node walk in `traverse`), primitive sampling in `sample`.
 
-use super::bvh::{cwbvh_depth, SmallQuads};
+use super::bvh::SmallQuads;
 use super::instance::InstanceSet;
 use super::prim::Prim;
+use super::wide::WideBvh;
 use glam::Vec3;
-use obvhs::cwbvh::node::CwBvhNode;
-use obvhs::cwbvh::CwBvh;
 
 /// All primitives of the scene in one BVH.
 pub struct SceneGeometry {
-    pub(super) bvh: CwBvh,
+    pub(super) bvh: WideBvh,
     /// Primitives in BVH leaf order; the primitive id is the index into this array. Triangles
     /// are stored inline (their vertices); any other primitive as a marker (NaN first
     /// coordinate, then its index into `others` as the bits of the second vertex's x).
-    pub(super) tris: Vec<[Vec3; 3]>,
+    pub(super) tris: super::pages::HugeArray<[Vec3; 3]>,
     /// The non-triangle primitives.
     pub(super) others: Vec<Prim>,
     pub(super) prim_object: Vec<u32>,
@@ -82,10 +81,10 @@ impl SceneGeometry {
 
     /// Depth of the BVH (number of node levels).
     pub fn bvh_depth(&self) -> u32 {
-        cwbvh_depth(&self.bvh)
+        self.bvh.depth()
     }
 
-    /// Number of CWBVH nodes (80 bytes each).
+    /// Number of BVH nodes (256 bytes each).
     pub fn node_count(&self) -> usize {
         self.bvh.nodes.len()
     }
@@ -93,9 +92,8 @@ impl SceneGeometry {
     /// Approximate heap memory in bytes (BVH nodes, primitive data, per-primitive ids, normals,
     /// instances and their meshes).
     pub fn memory_bytes(&self) -> usize {
-        self.bvh.nodes.capacity() * std::mem::size_of::<CwBvhNode>()
-            + self.bvh.primitive_indices.capacity() * 4
-            + self.tris.capacity() * std::mem::size_of::<[Vec3; 3]>()
+        self.bvh.memory_bytes()
+            + self.tris.memory_bytes()
             + self.others.capacity() * std::mem::size_of::<Prim>()
             + self.prim_object.capacity() * 4
             + self.prim_normals.capacity() * 12

@@ -1,4 +1,4 @@
-//! The CWBVH node walk shared by the closest-hit and any-hit queries: the node test, the
+//! The BVH node walk shared by the closest-hit and any-hit queries: the node test, the
 //! traversal stack and the [`LeafTest`] a query plugs its primitive tests into.
 //!
 //! obvhs's own `CwBvhNode::intersect_ray` clamps the box entry distance to a hard-coded
@@ -6,142 +6,104 @@
 //! 0.1 mm to the ray origin (and every node for rays shorter than 0.1 mm); it also replaces
 //! direction components below `f32::EPSILON` by ±1/ε, which can cull valid boxes for nearly
 //! axis-parallel rays; and its traversal stack (32 entries) is not bounds-checked in release
-//! builds. We therefore keep obvhs as the builder and node layout but traverse its nodes with
-//! our own loop ([`traverse`]: a distance-ordered stack sized for the depth the build
-//! guarantees) and our own node test ([`node_test`]): entry clamped to 0, exact reciprocal
-//! directions, and per-node conservative padding of the slab distances by their
-//! floating-point error bound, so no box containing a valid hit is ever culled.
+//! builds. We therefore keep obvhs as the builder but traverse its tree, converted to float
+//! child boxes ([`WideNode`]), with our own loop ([`traverse`]: a distance-ordered stack sized
+//! for the depth the build guarantees) and our own node test ([`node_test`]): entry clamped to
+//! 0, exact reciprocal directions, and slab distances widened by a bound on their
+//! floating-point error, so no box containing a valid hit is ever culled.
 
 use super::bvh::MAX_DEPTH;
-use super::robust::gamma;
-use glam::{Vec3, Vec3A};
-use obvhs::cwbvh::node::CwBvhNode;
-use std::mem::{offset_of, MaybeUninit};
+use super::wide::{WideBvh, WideNode};
+use glam::Vec3;
+use std::mem::MaybeUninit;
 
 /// Ray data for the node test.
 struct NodeRay {
-    o: Vec3A,
-    inv: Vec3A,
-    /// gamma(7)·|inv|: the rounding-error bound of the slab distances per unit of |p−o| + 255e.
-    g7_inv_abs: Vec3A,
-    /// Byte offsets in a [`CwBvhNode`] of the near and far plane arrays per axis, chosen once
-    /// per ray from the direction's signs (near = min plane for a positive direction).
+    inv: [f32; 3],
+    /// Per axis, o·(1/d) plus (near) or minus (far) the bound on the slab distances' rounding
+    /// error: a slab distance is `plane·inv − off`, one FMA.
+    near_off: [f32; 3],
+    far_off: [f32; 3],
+    /// Index in [`WideNode::planes`] of the near and far plane array per axis, chosen once per
+    /// ray from the direction's signs (near = min plane for a positive direction).
     near: [usize; 3],
     far: [usize; 3],
 }
 
-const INV_LIMIT: f32 = 1e30;
+/// Bound on |1/d| per axis. With every plane and origin within `MAX_COORDINATE` (10¹²) of the
+/// origin, no slab distance or offset overflows f32; a clamped axis (|d| < 10⁻²⁶) only
+/// shortens that axis' slab for hits beyond 10¹² m.
+const INV_LIMIT: f32 = 1e26;
 
 impl NodeRay {
+    /// `bound`: per axis, the largest |plane| of the BVH's child boxes.
     #[inline(always)]
-    fn new(o: Vec3, d: Vec3) -> Self {
+    fn new(o: Vec3, d: Vec3, bound: Vec3) -> Self {
         // 1/±0 = ±∞ is clamped to ±INV_LIMIT (d is finite and non-zero, so no NaN).
-        let inv =
-            (Vec3A::ONE / Vec3A::from(d)).clamp(Vec3A::splat(-INV_LIMIT), Vec3A::splat(INV_LIMIT));
-        // From the reciprocal, so that −0 (reciprocal −∞ → −INV_LIMIT) counts as negative.
-        // The min and max plane arrays of axis a are at MIN_X + 16a and MIN_X + 16a + 8.
-        let neg = inv.cmplt(Vec3A::ZERO).bitmask() as usize;
-        const MIN_X: usize = offset_of!(CwBvhNode, child_min_x);
-        const _: () = assert!(
-            offset_of!(CwBvhNode, child_max_x) == MIN_X + 8
-                && offset_of!(CwBvhNode, child_min_y) == MIN_X + 16
-                && offset_of!(CwBvhNode, child_max_y) == MIN_X + 24
-                && offset_of!(CwBvhNode, child_min_z) == MIN_X + 32
-                && offset_of!(CwBvhNode, child_max_z) == MIN_X + 40
-        );
-        let near = |a: usize| MIN_X + 16 * a + 8 * ((neg >> a) & 1);
-        let far = |a: usize| near(a) ^ 8;
+        let inv = (Vec3::ONE / d).clamp(Vec3::splat(-INV_LIMIT), Vec3::splat(INV_LIMIT));
+        // The computed distance fl(P·inv − fl32(o·inv ± pad)), against the exact (P − o)/d,
+        // is off by at most (2|P| + 3|o|)·|inv|·u/(1 − 2u) + 2u·pad (the error of inv, of the
+        // FMA and of rounding the offset to f32; o·inv is exact in f64). pad below exceeds
+        // it, so near distances are never too large nor far ones too small.
+        let g = super::robust::gamma(4) as f64;
+        let mut near_off = [0.0; 3];
+        let mut far_off = [0.0; 3];
+        let mut near = [0; 3];
+        let mut far = [0; 3];
+        for a in 0..3 {
+            let (o, inv_a) = (o[a] as f64, inv[a] as f64);
+            let oi = o * inv_a;
+            let pad = (2.0 * bound[a] as f64 + 3.0 * o.abs()) * inv_a.abs() * g;
+            let m = f32::MAX as f64;
+            near_off[a] = (oi + pad).clamp(-m, m) as f32;
+            far_off[a] = (oi - pad).clamp(-m, m) as f32;
+            // From the reciprocal, so that −0 (reciprocal −∞ → −INV_LIMIT) counts as negative.
+            let neg = usize::from(inv[a] < 0.0);
+            near[a] = 2 * a + neg;
+            far[a] = 2 * a + 1 - neg;
+        }
         Self {
-            o: o.into(),
-            inv,
-            g7_inv_abs: gamma(7) * inv.abs(),
-            near: [near(0), near(1), near(2)],
-            far: [far(0), far(1), far(2)],
+            inv: inv.to_array(),
+            near_off,
+            far_off,
+            near,
+            far,
         }
     }
 }
 
-// The node test loads p and the e bytes as one 16-byte vector.
-const _: () = assert!(offset_of!(CwBvhNode, p) == 0 && offset_of!(CwBvhNode, e) == 12);
-
-/// The 8 plane bytes at byte offset `off` of `node`.
-#[inline(always)]
-fn planes(node: &CwBvhNode, off: usize) -> &[u8; 8] {
-    debug_assert!(off + 8 <= std::mem::size_of::<CwBvhNode>());
-    // SAFETY: `off` is the offset of one of the node's six `[u8; 8]` plane arrays.
-    unsafe { &*((node as *const CwBvhNode as *const u8).add(off) as *const [u8; 8]) }
-}
-
 /// Slab test of the 8 children of `node` against the ray segment [0, t_max]. Returns the
-/// mask of hit (non-empty) child slots and every slot's entry distance. The plane distances
-/// are computed as `q·(e/d) + (p−o)/d` (q = quantized plane) and widened by a bound on their
-/// rounding error, so the test is conservative.
+/// mask of hit (non-empty) child slots and every slot's entry distance.
 #[inline(always)]
-fn node_test(node: &CwBvhNode, r: &NodeRay, t_max: f32, tmin_out: &mut [f32; 8]) -> u32 {
+fn node_test(node: &WideNode, r: &NodeRay, t_max: f32, tmin_out: &mut [f32; 8]) -> u32 {
     // AVX2 (all 8 children at once; built with `target-cpu=native` on any recent x86-64).
-    // FMA rounds once where mul + add rounded twice, so the padding stays conservative.
     #[cfg(all(
         target_arch = "x86_64",
         target_feature = "avx2",
         target_feature = "fma"
     ))]
-    // SAFETY: the target features are enabled at compile time; loads stay within the node.
+    // SAFETY: the target features are enabled at compile time; the plane indices are below 6.
     unsafe {
         use std::arch::x86_64::*;
-        let np = node as *const CwBvhNode as *const u8;
-        // p in lanes 0–2 of both 128-bit halves (lane 3 holds the e bytes and imask), the
-        // extent 2^(e−127) per axis from the e bytes, and the ray data likewise duplicated:
-        // every per-axis value is then one in-lane permute away from a full broadcast.
-        let p = _mm256_broadcast_ps(&*(np as *const __m128));
-        // The e bytes and imask (bytes 12–15), broadcast from memory, one byte per lane.
-        let e4 = _mm256_set1_epi32((np.add(12) as *const i32).read_unaligned());
-        let e_bytes = _mm256_setr_epi8(
-            0, -128, -128, -128, 1, -128, -128, -128, 2, -128, -128, -128, 3, -128, -128, -128, 0,
-            -128, -128, -128, 1, -128, -128, -128, 2, -128, -128, -128, 3, -128, -128, -128,
-        );
-        let e = _mm256_castsi256_ps(_mm256_slli_epi32::<23>(_mm256_shuffle_epi8(e4, e_bytes)));
-        let dup = |v: &Vec3A| _mm256_broadcast_ps(&*(v as *const Vec3A as *const __m128));
-        let (o, inv, g7_inv) = (dup(&r.o), dup(&r.inv), dup(&r.g7_inv_abs));
-        let rel = _mm256_sub_ps(p, o);
-        let base = _mm256_mul_ps(rel, inv);
-        let scale = _mm256_mul_ps(e, inv);
-        let rel_abs = _mm256_andnot_ps(_mm256_set1_ps(-0.0), rel);
-        let pad = _mm256_mul_ps(_mm256_fmadd_ps(e, _mm256_set1_ps(255.0), rel_abs), g7_inv);
-        let near = _mm256_sub_ps(base, pad);
-        let far = _mm256_add_ps(base, pad);
-        let lane = |v: __m256, a: usize| -> __m256 {
-            match a {
-                0 => _mm256_permute_ps::<0b00_00_00_00>(v),
-                1 => _mm256_permute_ps::<0b01_01_01_01>(v),
-                _ => _mm256_permute_ps::<0b10_10_10_10>(v),
-            }
-        };
-        let q8 = |off: usize| {
-            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
-                planes(node, off).as_ptr() as *const __m128i,
-            )))
-        };
-        let slab = |a: usize| {
-            let s = lane(scale, a);
-            (
-                _mm256_fmadd_ps(q8(r.near[a]), s, lane(near, a)),
-                _mm256_fmadd_ps(q8(r.far[a]), s, lane(far, a)),
+        let slab = |plane: usize, a: usize, off: &[f32; 3]| {
+            _mm256_fmsub_ps(
+                _mm256_loadu_ps(node.planes.get_unchecked(plane).as_ptr()),
+                _mm256_set1_ps(*r.inv.get_unchecked(a)),
+                _mm256_set1_ps(*off.get_unchecked(a)),
             )
         };
-        let (tnx, tfx) = slab(0);
-        let (tny, tfy) = slab(1);
-        let (tnz, tfz) = slab(2);
+        let near = |a: usize| slab(*r.near.get_unchecked(a), a, &r.near_off);
+        let far = |a: usize| slab(*r.far.get_unchecked(a), a, &r.far_off);
         let tmin = _mm256_max_ps(
-            _mm256_max_ps(tnx, tny),
-            _mm256_max_ps(tnz, _mm256_setzero_ps()),
+            _mm256_max_ps(near(0), near(1)),
+            _mm256_max_ps(near(2), _mm256_setzero_ps()),
         );
         let tmax = _mm256_min_ps(
-            _mm256_min_ps(tfx, tfy),
-            _mm256_min_ps(tfz, _mm256_set1_ps(t_max)),
+            _mm256_min_ps(far(0), far(1)),
+            _mm256_min_ps(far(2), _mm256_set1_ps(t_max)),
         );
         _mm256_storeu_ps(tmin_out.as_mut_ptr(), tmin);
-        // Empty slots have inverted boxes (see `SceneGeometry::build`), and should one still
-        // pass it decodes as an empty leaf.
+        // Empty slots have inverted boxes: +∞ entry, −∞ exit.
         _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax)) as u32
     }
 
@@ -152,35 +114,20 @@ fn node_test(node: &CwBvhNode, r: &NodeRay, t_max: f32, tmin_out: &mut [f32; 8])
         target_feature = "fma"
     )))]
     {
-        let e = node.compute_extent();
-        let rel = Vec3A::from(node.p) - r.o;
-        let scale = e * r.inv;
-        let base = rel * r.inv;
-        let pad = (rel.abs() + 255.0 * e) * r.g7_inv_abs;
-        let base_near = base - pad;
-        let base_far = base + pad;
-        let (nx, ny, nz) = (
-            planes(node, r.near[0]),
-            planes(node, r.near[1]),
-            planes(node, r.near[2]),
-        );
-        let (fx, fy, fz) = (
-            planes(node, r.far[0]),
-            planes(node, r.far[1]),
-            planes(node, r.far[2]),
-        );
         let mut hit_mask = 0u32;
         for k in 0..8 {
-            let tmin = (nx[k] as f32 * scale.x + base_near.x)
-                .max(ny[k] as f32 * scale.y + base_near.y)
-                .max(nz[k] as f32 * scale.z + base_near.z)
+            let d =
+                |p: usize, a: usize, off: &[f32; 3]| node.planes[p][k].mul_add(r.inv[a], -off[a]);
+            let tmin = d(r.near[0], 0, &r.near_off)
+                .max(d(r.near[1], 1, &r.near_off))
+                .max(d(r.near[2], 2, &r.near_off))
                 .max(0.0);
-            let tmax = (fx[k] as f32 * scale.x + base_far.x)
-                .min(fy[k] as f32 * scale.y + base_far.y)
-                .min(fz[k] as f32 * scale.z + base_far.z)
+            let tmax = d(r.far[0], 0, &r.far_off)
+                .min(d(r.far[1], 1, &r.far_off))
+                .min(d(r.far[2], 2, &r.far_off))
                 .min(t_max);
             tmin_out[k] = tmin;
-            if tmin <= tmax && node.child_meta[k] & 0x20 != 0 {
+            if tmin <= tmax {
                 hit_mask |= 1 << k;
             }
         }
@@ -233,7 +180,7 @@ fn le_mask(tmin: &[f32; 8], t: f32) -> u32 {
 }
 
 /// The primitive tests of a traversal: `leaf(first, unary, t_max)` tests the leaf's primitives
-/// `first..` (`unary` = their count in unary: 1, 3 or 7, or 0 for none) and returns the new
+/// `first..` (`unary` = their count n in unary, 2ⁿ − 1, at most 31 bits) and returns the new
 /// t_max (smaller on a closer hit), or `None` to stop the traversal (any hit).
 pub(super) trait LeafTest {
     fn leaf(&mut self, first: u32, unary: u32, t_max: f32) -> Option<f32>;
@@ -255,23 +202,24 @@ pub(super) fn prefetch(p: *const u8) {
     let _ = p;
 }
 
-/// CWBVH traversal with a CPU-style stack of inner nodes ([`Key`]s). The leaf children of a
+/// BVH traversal with a CPU-style stack of inner nodes ([`Key`]s). The leaf children of a
 /// node are tested as soon as the node test finds them, before its inner children. With
 /// `ORDERED` (closest hit) the inner children that still start before the (possibly reduced)
 /// `t_max` are visited nearest first, and stack entries that start beyond the current `t_max`
 /// are skipped; without it (any hit) the order is arbitrary.
 #[inline(always)]
 pub(super) fn traverse<const ORDERED: bool>(
-    nodes: &[CwBvhNode],
+    bvh: &WideBvh,
     origin: Vec3,
     dir: Vec3,
     mut t_max: f32,
     leaves: &mut impl LeafTest,
 ) {
+    let nodes = &bvh.nodes[..];
     if nodes.is_empty() {
         return;
     }
-    let r = NodeRay::new(origin, dir);
+    let r = NodeRay::new(origin, dir, bvh.plane_bound);
     let mut stack = [const { MaybeUninit::<Key>::uninit() }; STACK_SIZE];
     let mut sp = 0usize;
     let mut cull = cull_key(t_max);
@@ -299,9 +247,9 @@ pub(super) fn traverse<const ORDERED: bool>(
             let t0 = t_max;
             while leaf_mask != 0 {
                 let k = leaf_mask.trailing_zeros();
-                let meta = node.child_meta[k as usize] as u32;
-                let first = node.primitive_base_idx + (meta & 0x1f);
-                match leaves.leaf(first, meta >> 5, t_max) {
+                let first = node.primitive_base_idx + node.leaf_offset[k as usize] as u32;
+                let unary = (1u32 << node.leaf_count[k as usize]) - 1;
+                match leaves.leaf(first, unary, t_max) {
                     Some(t) => t_max = t,
                     None => return,
                 }
@@ -378,5 +326,133 @@ pub(super) fn traverse<const ORDERED: bool>(
             }
         }
         return;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whether the segment [0, t_max] of the ray meets the box, in f64 (exact enough: its
+    /// rounding is 10⁹ times below the node test's padding).
+    fn meets(o: Vec3, d: Vec3, t_max: f32, lo: [f32; 3], hi: [f32; 3]) -> bool {
+        let (mut t0, mut t1) = (0.0f64, t_max as f64);
+        for a in 0..3 {
+            let (o, d) = (o[a] as f64, d[a] as f64);
+            if d == 0.0 {
+                if o < lo[a] as f64 || o > hi[a] as f64 {
+                    return false;
+                }
+                continue;
+            }
+            let (n, f) = ((lo[a] as f64 - o) / d, (hi[a] as f64 - o) / d);
+            t0 = t0.max(n.min(f));
+            t1 = t1.min(n.max(f));
+        }
+        t0 <= t1
+    }
+
+    #[test]
+    fn node_test_never_culls_a_box_the_ray_meets() {
+        // Rays aimed at box corners, edges and faces (so many graze them), from near and far,
+        // with scenes near the origin and far from it; every box the exact test finds is hit.
+        let mut s = 7u64;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 40) as f32) / (1u64 << 24) as f32
+        };
+        let (mut exact_hits, mut misses) = (0, 0);
+        for case in 0..20_000 {
+            let scale = [1.0f32, 1e3, 1e6][case % 3];
+            let centre = Vec3::splat([0.0f32, 5e4, -3e7][case % 5 % 3]);
+            let mut node = WideNode {
+                planes: [[0.0; 8]; 6],
+                child_base_idx: 0,
+                primitive_base_idx: 0,
+                leaf_offset: [0; 8],
+                leaf_count: [1; 8],
+                imask: 0,
+            };
+            let mut bound = Vec3::ZERO;
+            for k in 0..8 {
+                let c = centre + (Vec3::new(rnd(), rnd(), rnd()) - 0.5) * scale;
+                let h = Vec3::new(rnd(), rnd(), rnd()) * scale * 0.1 * rnd();
+                let (lo, hi) = (c - h, c + h);
+                for a in 0..3 {
+                    node.planes[2 * a][k] = lo[a];
+                    node.planes[2 * a + 1][k] = hi[a];
+                }
+                bound = bound.max(lo.abs()).max(hi.abs());
+            }
+            // Aim at a corner, edge point or face point of box 0 .. 7.
+            let k = case % 8;
+            let mut corner = |a: usize| node.planes[2 * a + (rnd() < 0.5) as usize][k];
+            let mut target = Vec3::new(corner(0), corner(1), corner(2));
+            let free = case % 4; // 3: a corner; else move along one axis within the box
+            if free < 3 {
+                let (lo, hi) = (node.planes[2 * free][k], node.planes[2 * free + 1][k]);
+                target[free] = lo + (hi - lo) * rnd();
+            }
+            let o =
+                target + (Vec3::new(rnd(), rnd(), rnd()) - 0.5) * scale * [0.01f32, 3.0][case % 2];
+            let mut d = target - o;
+            if case % 7 == 0 {
+                d[case % 3] *= 1e-30; // nearly axis-parallel
+            }
+            if d == Vec3::ZERO || !d.is_finite() {
+                continue;
+            }
+            let t_max = [f32::INFINITY, 1.0, 0.5][case % 3];
+            let r = NodeRay::new(o, d, bound);
+            let mut tmin = [0.0f32; 8];
+            let mask = node_test(&node, &r, t_max, &mut tmin);
+            for j in 0..8 {
+                let lo = [node.planes[0][j], node.planes[2][j], node.planes[4][j]];
+                let hi = [node.planes[1][j], node.planes[3][j], node.planes[5][j]];
+                if meets(o, d, t_max, lo, hi) {
+                    exact_hits += 1;
+                    assert!(
+                        mask & (1 << j) != 0,
+                        "case {case}: box {j} {lo:?}..{hi:?} culled for o {o} d {d} t_max {t_max}"
+                    );
+                } else {
+                    misses += 1;
+                }
+            }
+        }
+        assert!(
+            exact_hits > 10_000 && misses > 10_000,
+            "{exact_hits} {misses}"
+        );
+    }
+
+    #[test]
+    fn empty_slots_are_never_hit() {
+        let node = WideNode {
+            planes: [
+                [f32::INFINITY; 8],
+                [f32::NEG_INFINITY; 8],
+                [f32::INFINITY; 8],
+                [f32::NEG_INFINITY; 8],
+                [f32::INFINITY; 8],
+                [f32::NEG_INFINITY; 8],
+            ],
+            child_base_idx: 0,
+            primitive_base_idx: 0,
+            leaf_offset: [0; 8],
+            leaf_count: [0; 8],
+            imask: 0,
+        };
+        for d in [
+            Vec3::X,
+            -Vec3::ONE,
+            Vec3::new(1e-30, -1.0, 0.0),
+            Vec3::new(0.0, 0.0, -3.0),
+        ] {
+            let r = NodeRay::new(Vec3::new(1.0, -2.0, 3.0), d, Vec3::splat(10.0));
+            assert_eq!(node_test(&node, &r, f32::INFINITY, &mut [0.0; 8]), 0, "{d}");
+        }
     }
 }

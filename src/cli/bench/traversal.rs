@@ -674,7 +674,7 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
         args.build_reps.max(1)
     );
     println!(
-        "| candela (obvhs CWBVH8, medium build, no pre-splits; {} nodes, depth {}) | {:.3} | {:.1} | {:.1} |",
+        "| candela (obvhs PLOC binary tree, medium build, collapsed to 8-wide float nodes, leaves ≤ 6; {} nodes, depth {}) | {:.3} | {:.1} | {:.1} |",
         geo.node_count(),
         geo.bvh_depth(),
         candela_build,
