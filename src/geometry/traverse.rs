@@ -368,12 +368,8 @@ mod tests {
             let scale = [1.0f32, 1e3, 1e6][case % 3];
             let centre = Vec3::splat([0.0f32, 5e4, -3e7][case % 5 % 3]);
             let mut node = WideNode {
-                planes: [[0.0; 8]; 6],
-                child_base_idx: 0,
-                primitive_base_idx: 0,
-                leaf_offset: [0; 8],
                 leaf_count: [1; 8],
-                imask: 0,
+                ..WideNode::EMPTY
             };
             let mut bound = Vec3::ZERO;
             for k in 0..8 {
@@ -430,21 +426,7 @@ mod tests {
 
     #[test]
     fn empty_slots_are_never_hit() {
-        let node = WideNode {
-            planes: [
-                [f32::INFINITY; 8],
-                [f32::NEG_INFINITY; 8],
-                [f32::INFINITY; 8],
-                [f32::NEG_INFINITY; 8],
-                [f32::INFINITY; 8],
-                [f32::NEG_INFINITY; 8],
-            ],
-            child_base_idx: 0,
-            primitive_base_idx: 0,
-            leaf_offset: [0; 8],
-            leaf_count: [0; 8],
-            imask: 0,
-        };
+        let node = WideNode::EMPTY;
         for d in [
             Vec3::X,
             -Vec3::ONE,

@@ -31,6 +31,25 @@ pub(super) struct WideNode {
     pub imask: u8,
 }
 
+impl WideNode {
+    /// A node whose 8 slots are all empty.
+    pub const EMPTY: WideNode = WideNode {
+        planes: [
+            [f32::INFINITY; 8],
+            [f32::NEG_INFINITY; 8],
+            [f32::INFINITY; 8],
+            [f32::NEG_INFINITY; 8],
+            [f32::INFINITY; 8],
+            [f32::NEG_INFINITY; 8],
+        ],
+        child_base_idx: 0,
+        primitive_base_idx: 0,
+        leaf_offset: [0; 8],
+        leaf_count: [0; 8],
+        imask: 0,
+    };
+}
+
 /// A BVH of [`WideNode`]s (node 0 the root; empty for an empty scene).
 #[derive(Clone, Debug, Default)]
 pub(super) struct WideBvh {
@@ -194,21 +213,7 @@ impl WideBvh {
     pub fn from_bvh2(bvh2: &Bvh2, max_leaf: u32) -> (Self, Vec<u32>) {
         let max_leaf = max_leaf.clamp(1, MAX_LEAF);
         let plan = Plan::new(bvh2, max_leaf);
-        let empty = WideNode {
-            planes: [
-                [f32::INFINITY; 8],
-                [f32::NEG_INFINITY; 8],
-                [f32::INFINITY; 8],
-                [f32::NEG_INFINITY; 8],
-                [f32::INFINITY; 8],
-                [f32::NEG_INFINITY; 8],
-            ],
-            child_base_idx: 0,
-            primitive_base_idx: 0,
-            leaf_offset: [0; 8],
-            leaf_count: [0; 8],
-            imask: 0,
-        };
+        let empty = WideNode::EMPTY;
         let count = plan.node_count();
         let mut nodes = HugeArray::collect(count, std::iter::repeat_n(empty, count));
         let mut next = 1;
