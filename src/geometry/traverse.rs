@@ -247,13 +247,17 @@ pub(super) fn traverse<const ORDERED: bool>(
             let t0 = t_max;
             while leaf_mask != 0 {
                 let k = leaf_mask.trailing_zeros();
+                leaf_mask &= leaf_mask - 1;
+                // A leaf that starts beyond a hit found in this node's other leaves.
+                if ORDERED && tmin[k as usize] > t_max {
+                    continue;
+                }
                 let first = node.primitive_base_idx + node.leaf_offset[k as usize] as u32;
                 let unary = (1u32 << node.leaf_count[k as usize]) - 1;
                 match leaves.leaf(first, unary, t_max) {
                     Some(t) => t_max = t,
                     None => return,
                 }
-                leaf_mask &= leaf_mask - 1;
             }
             if ORDERED && t_max != t0 {
                 cull = cull_key(t_max);
