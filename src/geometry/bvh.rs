@@ -337,7 +337,6 @@ impl SceneGeometry {
         drop(aabbs);
 
         // Lay primitives out in leaf order so the traversal indexes them directly.
-        let order = &order;
         let small = if prims.len() <= small::MAX_QUADS {
             SmallQuads::new(&order.iter().map(|&i| prims[i as usize]).collect::<Vec<_>>())
         } else {
@@ -367,7 +366,6 @@ impl SceneGeometry {
         } else {
             Vec::new()
         };
-        // Traversal only needs the float nodes once the primitives are in leaf order.
         let mut by_obj: Vec<(u32, u32)> = prim_object
             .iter()
             .enumerate()

@@ -1,16 +1,11 @@
 //! The BVH node walk shared by the closest-hit and any-hit queries: the node test, the
 //! traversal stack and the [`LeafTest`] a query plugs its primitive tests into.
 //!
-//! obvhs's own `CwBvhNode::intersect_ray` clamps the box entry distance to a hard-coded
-//! `1e-4` and ignores `ray.tmin`, which silently culls every node lying entirely closer than
-//! 0.1 mm to the ray origin (and every node for rays shorter than 0.1 mm); it also replaces
-//! direction components below `f32::EPSILON` by ±1/ε, which can cull valid boxes for nearly
-//! axis-parallel rays; and its traversal stack (32 entries) is not bounds-checked in release
-//! builds. We therefore keep obvhs as the builder but traverse its tree, converted to float
-//! child boxes ([`WideNode`]), with our own loop ([`traverse`]: a distance-ordered stack sized
-//! for the depth the build guarantees) and our own node test ([`node_test`]): entry clamped to
-//! 0, exact reciprocal directions, and slab distances widened by a bound on their
-//! floating-point error, so no box containing a valid hit is ever culled.
+//! The loop ([`traverse`]) keeps a distance-ordered stack sized for the depth the build
+//! guarantees; the node test ([`node_test`]) clamps the entry to 0, uses exact reciprocal
+//! directions and widens the slab distances by a bound on their floating-point error, so no
+//! box containing a valid hit is ever culled (obvhs's own CWBVH walk clamps the entry to
+//! `1e-4` and replaces tiny direction components, which can cull valid boxes).
 
 use super::bvh::MAX_DEPTH;
 use super::wide::{WideBvh, WideNode};

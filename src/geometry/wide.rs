@@ -51,7 +51,7 @@ impl WideNode {
 }
 
 /// A BVH of [`WideNode`]s (node 0 the root; empty for an empty scene).
-#[derive(Clone, Debug, Default)]
+#[derive(Default)]
 pub(super) struct WideBvh {
     pub nodes: HugeArray<WideNode>,
     /// Per axis, the largest |plane| of any child box (m): bounds the rounding error of the
