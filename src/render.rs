@@ -418,6 +418,15 @@ pub fn render_progressive(
     // Each tile's results, kept from pass to pass: the memory is reused instead of allocated
     // (and its pages faulted in afresh) for every pass.
     let mut tiles: Vec<TileResult> = (0..n_tiles).map(|_| TileResult::default()).collect();
+    let tile_rect = |t: usize| {
+        let (x0, y0) = ((t % tiles_x) * TILE, (t / tiles_x) * TILE);
+        (x0, y0, (x0 + TILE).min(w) - x0, (y0 + TILE).min(h) - y0)
+    };
+    // The image sums after the pass: a second film buffer that the tiles write in place and
+    // that replaces the film's when the pass completes (an interrupted pass leaves the film
+    // as it was). Gathering them per tile and copying them back took a sixth of the render's
+    // time on a small scene: memory a long pass leaves untouched is slow to walk again.
+    let mut next_pixels = vec![PixelSums::default(); w * h];
     let reason = 'passes: loop {
         let (plan, frac) = plan_pass(world, film, prog);
         status.converged_fraction = frac;
@@ -438,6 +447,7 @@ pub fn render_progressive(
         }
         let adaptive = film.decision.is_some();
         let film_ref: &Film = film;
+        let next = DisjointSlice::new(&mut next_pixels);
         let completed: Vec<bool> = pool.install(|| {
             tiles
                 .par_iter_mut()
@@ -513,7 +523,9 @@ pub fn render_progressive(
                                     );
                                 }
                             }
-                            r.pixels.push((i, est));
+                            // SAFETY: pixel i belongs to this tile alone, and the buffer is
+                            // read only after the pass.
+                            unsafe { next.write(i, est) };
                             r.decision.extend(dec);
                             r.e.extend(est_e);
                             r.decision_e.extend(dec_e);
@@ -559,10 +571,12 @@ pub fn render_progressive(
                 light.push((b, sums, per_buffer));
             }
         }
-        for r in &tiles {
+        std::mem::swap(&mut film.pixels, &mut next_pixels);
+        for (t, r) in tiles.iter().enumerate() {
             stats.merge(&r.stats);
-            for (k, &(i, est)) in r.pixels.iter().enumerate() {
-                film.pixels[i] = est;
+            let (x0, y0, tw, th) = tile_rect(t);
+            for k in 0..tw * th {
+                let i = (y0 + k / tw) * w + x0 + k % tw;
                 if let Some(d) = film.decision.as_mut() {
                     d[i] = r.decision[k];
                 }
@@ -608,6 +622,10 @@ pub fn render_progressive(
     };
     // The status the stop decision saw (the last pass's report predates it).
     on_pass(&status);
+    // The pass buffers go before the film is copied: the render's peak holds two copies of
+    // the sums (see `crate::scene::build::bytes_per_pixel`).
+    drop(tiles);
+    drop(next_pixels);
     Ok((
         RenderResult {
             film: film.clone(),
@@ -619,12 +637,41 @@ pub fn render_progressive(
     ))
 }
 
+/// A slice that several threads write at distinct indices.
+struct DisjointSlice<'a, T> {
+    ptr: *mut T,
+    len: usize,
+    _slice: std::marker::PhantomData<&'a mut [T]>,
+}
+
+// SAFETY: the slice is borrowed mutably for 'a, and `write`'s contract keeps the threads'
+// writes apart.
+unsafe impl<T: Send> Sync for DisjointSlice<'_, T> {}
+
+impl<'a, T: Copy> DisjointSlice<'a, T> {
+    fn new(s: &'a mut [T]) -> Self {
+        Self {
+            ptr: s.as_mut_ptr(),
+            len: s.len(),
+            _slice: std::marker::PhantomData,
+        }
+    }
+    /// Set item `i`.
+    ///
+    /// # Safety
+    /// No other thread writes or reads item `i` while the slice lives.
+    unsafe fn write(&self, i: usize, v: T) {
+        assert!(i < self.len);
+        // SAFETY: in bounds; `T: Copy` has nothing to drop; exclusive by the contract.
+        unsafe { self.ptr.add(i).write(v) };
+    }
+}
+
 #[derive(Default)]
 struct TileResult {
-    /// The pixels' indices and image sums; their decision buffer's and illuminance sums (image,
-    /// decision), when the film has them, in the same order: apart, so that a render without
-    /// them carries none.
-    pixels: Vec<(usize, PixelSums)>,
+    /// The pixels' decision buffer's and illuminance sums (image, decision), when the film has
+    /// them, pixel by pixel (row by row within the tile): apart, so that a render without them
+    /// carries none. (The image sums go straight to the next film buffer.)
     decision: Vec<PixelSums>,
     e: Vec<IlluminanceSums>,
     decision_e: Vec<IlluminanceSums>,
@@ -636,7 +683,6 @@ struct TileResult {
 impl TileResult {
     /// Empty, keeping the vectors' memory for the next pass.
     fn clear(&mut self) {
-        self.pixels.clear();
         self.decision.clear();
         self.e.clear();
         self.decision_e.clear();

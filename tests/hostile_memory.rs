@@ -278,16 +278,16 @@ fn memory_guard_covers_caustics_and_checkpoints() {
     // (adaptive; with --falsecolour for adaptive_fc), one run each on a 2-core machine shared
     // with other jobs.
     let measured = [
-        ("cornell-box", 2048, plain, false, false, 2_531_560u64),
-        ("cornell-box", 2048, adaptive, false, false, 5_095_536),
-        ("cornell-glass", 2048, plain, false, true, 2_797_668),
-        ("cornell-glass", 2048, plain, true, true, 4_900_532),
-        ("cornell-glass", 2048, adaptive_fc, true, true, 9_205_472),
-        ("cornell-glass", 2048, adaptive, false, true, 5_229_996),
-        ("bench-cornell", 2048, plain, false, true, 2_929_684),
-        ("cornell-box", 1024, plain, false, false, 660_116),
-        ("cornell-glass", 1024, plain, false, true, 662_772),
-        ("cornell-box", 1024, adaptive, false, false, 1_349_844),
+        ("cornell-box", 2048, plain, false, false, 2_572_412u64),
+        ("cornell-box", 2048, adaptive, false, false, 5_155_612),
+        ("cornell-glass", 2048, plain, false, true, 2_587_852),
+        ("cornell-glass", 2048, plain, true, true, 4_705_780),
+        ("cornell-glass", 2048, adaptive_fc, true, true, 9_173_140),
+        ("cornell-glass", 2048, adaptive, false, true, 5_108_080),
+        ("bench-cornell", 2048, plain, false, true, 2_588_528),
+        ("cornell-box", 1024, plain, false, false, 672_360),
+        ("cornell-glass", 1024, plain, false, true, 675_144),
+        ("cornell-box", 1024, adaptive, false, false, 1_296_448),
     ];
     for (scene, side, mode, illuminance, caustics, kb) in measured {
         let px = side as u64 * side as u64;

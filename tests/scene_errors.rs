@@ -245,13 +245,13 @@ fn memory_estimate_depends_on_the_mode() {
     // Peak RSS (GNU time's %M) of `candela render scenes/cornell-box.ron` at 2048² (4 194 304
     // pixels), release build, `--threads 2 --checkpoint-interval 0s`, `--spp 2` or
     // `--target-error 1% --max-spp 4`, one run each on a 2-core machine shared with other
-    // jobs: 1 918 680 kB plain, 4 661 660 kB adaptive, 9 117 860 kB adaptive with
+    // jobs: 1 919 324 kB plain, 4 203 140 kB adaptive, 7 021 352 kB adaptive with
     // --illuminance --falsecolour; the estimate of the render's own buffers is within 10 %.
     let px = 2048.0 * 2048.0;
     for (bpp, measured_kb) in [
-        (bytes_per_pixel(&plain, false), 1_918_680.0),
-        (bytes_per_pixel(&adaptive, false), 4_661_660.0),
-        (bytes_per_pixel(&all, true), 9_117_860.0),
+        (bytes_per_pixel(&plain, false), 1_919_324.0),
+        (bytes_per_pixel(&adaptive, false), 4_203_140.0),
+        (bytes_per_pixel(&all, true), 7_021_352.0),
     ] {
         let est = bpp as f64 * px;
         let measured = measured_kb * 1024.0;

@@ -58,20 +58,22 @@ fn sums_bytes(illuminance: bool) -> u64 {
 }
 
 /// Peak memory of a render's own buffers per pixel in `mode`, without the render state (see
-/// [`peak_bytes_per_pixel`] for the whole job). The film, the pass's results (pixel index and
-/// sums) and, at the end, the finished render's copy of the film, plus the image, EXR and PNG
-/// buffers (48 B) and the pass plan (8 B). How much of a pass's results the allocator still
-/// holds when the copy is made is measured, not derived: at 2048² the peak held two copies of
-/// the pixel sums and three of the illuminance sums of a plain render, and six copies of both
-/// with adaptive sampling (two buffers, each in the film, the pass's results and the copy),
-/// whose per-pass statistics, illuminance channels and false-colour maps are within that
-/// but for 32 B. Measured peak RSS: see tests/scene_errors.rs.
+/// [`peak_bytes_per_pixel`] for the whole job). During a pass: the film, the next film buffer
+/// that the pass's image sums go to, and the tiles' decision and illuminance sums; at the end,
+/// once those are freed, the film and the finished render's copy of it; plus the image, EXR
+/// and PNG buffers (48 B) and the pass plan (8 B). How much of the tiles' sums the allocator
+/// still holds when the copy is made is measured, not derived: at 2048² the peak held two
+/// copies of the pixel sums and three of the illuminance sums of a plain render, and five
+/// copies of the pixel sums and four of the illuminance sums with adaptive sampling (two
+/// buffers, each in the film and the copy, and the tiles' decision sums), whose per-pass
+/// statistics, illuminance channels and false-colour maps are within that but for 32 B.
+/// Measured peak RSS: see tests/scene_errors.rs.
 pub fn bytes_per_pixel(mode: &RunMode, illuminance: bool) -> u64 {
     let e = if illuminance { E_SUMS } else { 0 };
     if !mode.adaptive {
         return 2 * PIXEL_SUMS + 3 * e + 56;
     }
-    let adaptive = 6 * sums_bytes(illuminance);
+    let adaptive = 5 * PIXEL_SUMS + 4 * e;
     if illuminance || mode.falsecolour {
         adaptive + 32
     } else {
