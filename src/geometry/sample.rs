@@ -186,11 +186,13 @@ impl SceneGeometry {
         if d2 == 0.0 {
             return 0.0;
         }
-        let cos = (n.as_dvec3().dot(w) / d2.sqrt()).abs();
-        if cos == 0.0 || area <= 0.0 {
+        // d²/(A·cos θ) with cos θ = |n·w|/d: d³/(A·|n·w|), one division (the density is on
+        // the light-sampling path of every bounce, where a chain of divisions shows).
+        let den = n.as_dvec3().dot(w).abs() * area as f64;
+        if den.is_nan() || den <= 0.0 {
             return 0.0;
         }
-        let pdf = (d2 / (cos * area as f64)) as f32;
+        let pdf = (d2 * d2.sqrt() / den) as f32;
         if pdf.is_finite() {
             pdf
         } else {
