@@ -356,12 +356,7 @@ mod tests {
         // Rays aimed at box corners, edges and faces (so many graze them), from near and far,
         // with scenes near the origin and far from it; every box the exact test finds is hit.
         let mut s = 7u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 40) as f32) / (1u64 << 24) as f32
-        };
+        let mut rnd = || crate::sampling::test_uniform(&mut s);
         let (mut exact_hits, mut misses) = (0, 0);
         for case in 0..20_000 {
             let scale = [1.0f32, 1e3, 1e6][case % 3];

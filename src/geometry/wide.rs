@@ -299,12 +299,7 @@ mod tests {
     /// Boxes of varied sizes round random points, some far from the origin.
     fn boxes(n: usize) -> Vec<Aabb> {
         let mut s = 1u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 40) as f32) / (1u64 << 24) as f32
-        };
+        let mut rnd = || crate::sampling::test_uniform(&mut s);
         (0..n)
             .map(|i| {
                 let off = if i % 3 == 0 { 1e5 } else { 0.0 };

@@ -347,12 +347,7 @@ mod tests {
     use super::*;
 
     fn rand_dir(s: &mut u64) -> Vec3 {
-        let mut next = || {
-            *s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((*s >> 40) as f32) / (1u64 << 24) as f32
-        };
+        let mut next = || crate::sampling::test_uniform(s);
         let z = 1.0 - 2.0 * next();
         let phi = 2.0 * PI * next();
         let r = (1.0 - z * z).max(0.0).sqrt();

@@ -200,12 +200,7 @@ mod tests {
     /// Boxes of varied sizes round random points, a few of them repeated.
     fn random_boxes(n: usize, seed: u64) -> Vec<Aabb> {
         let mut s = seed;
-        let mut r = move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut r = move || crate::sampling::test_uniform(&mut s);
         let mut v: Vec<Aabb> = (0..n)
             .map(|_| {
                 let c = Vec3A::new(r(), r(), r()) * 100.0;

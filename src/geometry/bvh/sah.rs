@@ -362,12 +362,7 @@ mod tests {
     #[test]
     fn random_boxes() {
         let mut s = 1u64;
-        let mut r = move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut r = move || crate::sampling::test_uniform(&mut s);
         let aabbs: Vec<Aabb> = (0..200_000)
             .map(|_| {
                 let c = Vec3A::new(r(), r(), r()) * 100.0;
