@@ -6,13 +6,18 @@ call and settings), so for the same scene and seed it writes the same images, bi
 returns the image as numpy arrays with the report as a dict. See docs/python.md.
 
 Errors candela reports (a bad scene, a bad option, a damaged file) raise :class:`CandelaError`
-whose message is candela's own: it names the file, the line:column or the field path.
+whose message is candela's own: it names the file, the line:column, the field path or the
+argument. A file that cannot be read or written raises :class:`FileError`, which is both a
+CandelaError and an OSError (with ``errno`` when the system refused).
 """
 
 from __future__ import annotations
 
+import glob
 import json
+import operator
 import os
+import stat
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,12 +26,13 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Union
 import numpy as np
 
 from . import _candela
-from ._candela import Cancelled, CandelaError, __version__
+from ._candela import Cancelled, CandelaError, FileError, __version__
 from . import colour
 
 __all__ = [
     "CandelaError",
     "Cancelled",
+    "FileError",
     "Scene",
     "RenderResult",
     "render",
@@ -52,6 +58,38 @@ def _jsonable(o: Any) -> Any:
     raise TypeError(f"a scene dict holds a {type(o).__name__}, which has no RON form")
 
 
+MAX_NAME_BYTES = 210
+"""Longest scene name in UTF-8 bytes: NAME.illuminance.png, the longest output name besides a
+grid's, with the temporary file written beside it (29 bytes more) fits the 255 bytes of a file
+name on most file systems."""
+
+_MARK = "\n// candela: written by the Python module for a scene from text or a dict; a render of\n// another scene of this name into this directory may replace it.\n"
+"""The last lines of a scene file the module writes: such a file may be replaced, no other."""
+
+
+def _check_name(name: Any) -> str:
+    """``name`` as a plain file-name stem, or TypeError / CandelaError naming it."""
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a str, got {type(name).__name__}")
+    shown = repr(name) if len(name) <= 60 else repr(name[:60]) + "…"
+    if name in ("", ".", ".."):
+        raise CandelaError(f"name must be a file-name stem (outputs are NAME.exr, …), got {shown}")
+    bad = [c for c in name if c in "/\\" or c in (os.sep, os.altsep or "/")
+           or ord(c) < 0x20 or 0x7F <= ord(c) < 0xA0]
+    if bad:
+        raise CandelaError(
+            f"name must be a file-name stem without path separators or control characters, got {shown}")
+    try:
+        n = len(name.encode("utf-8"))
+    except UnicodeEncodeError:
+        raise CandelaError(f"name must be valid Unicode text (no lone surrogates), got {shown}") from None
+    if n > MAX_NAME_BYTES:
+        raise CandelaError(
+            f"name is {n} bytes long in UTF-8; at most {MAX_NAME_BYTES} leave room for the outputs' "
+            f"suffixes and temporary files within a file name, got {shown}")
+    return name
+
+
 class Scene:
     """A scene: a RON file, RON text or a Python dict (checked for syntax, types and unknown
     fields on creation; values are checked when it renders, or by :meth:`check`).
@@ -63,36 +101,53 @@ class Scene:
     docs/scene-format.md.
 
     A scene from text or a dict is written to the output directory as ``NAME.ron`` before it
-    renders, so files it refers to (meshes, spectra, luminaires) need absolute paths.
+    renders, so files it refers to (meshes, spectra, luminaires) need absolute paths. ``name``
+    is a file-name stem (no path separators, no control characters, at most
+    :data:`MAX_NAME_BYTES` bytes). ``NAME.ron`` never replaces a file the module did not
+    write: an existing one is used if it holds the same scene, replaced if the module wrote it
+    (and no render state of that name would be left behind, unless ``overwrite=True``), and
+    refused otherwise.
     """
 
     def __init__(self, *, path: Optional[Path] = None, text: Optional[str] = None,
                  name: str = "scene") -> None:
         self.path = path
         self.text = text
-        self.name = name
+        self.name = _check_name(name)
 
     @classmethod
     def from_file(cls, path: Union[str, os.PathLike]) -> "Scene":
-        """A scene file (RON); raises CandelaError naming the file and line:column."""
-        p = Path(path)
-        try:
-            text = p.read_text(encoding="utf-8")
-        except OSError as e:
-            raise CandelaError(f"cannot read scene file {p}: {e}") from None
-        _candela.check_scene_text(text, str(p))
-        return cls(path=p, name=p.stem)
+        """A scene file (RON); raises CandelaError naming the file and line:column, FileError
+        if it cannot be read."""
+        p = Path(_fspath(path, "path"))
+        _candela.read_scene_file(str(p))
+        return cls(path=p, name=p.stem if p.stem not in ("", ".", "..") else "scene")
 
     @classmethod
     def from_ron(cls, text: str, name: str = "scene") -> "Scene":
-        """RON text of a scene; ``name`` names the outputs (``NAME.exr``, …)."""
+        """RON text of a scene; ``name`` names the outputs (``NAME.exr``, …) and the scene
+        file written beside them (``NAME.ron``)."""
+        name = _check_name(name)
+        if not isinstance(text, str):
+            raise TypeError(f"text must be a str, got {type(text).__name__}")
         _candela.check_scene_text(text, f"{name}.ron")
         return cls(text=text, name=name)
 
     @classmethod
     def from_dict(cls, scene: Mapping[str, Any], name: str = "scene") -> "Scene":
         """A scene as a dict (see the class doc); raises CandelaError naming the field path."""
-        text = _candela.scene_dict_to_ron(json.dumps(scene, default=_jsonable))
+        name = _check_name(name)
+        if not isinstance(scene, Mapping):
+            raise TypeError(f"scene must be a dict, got {type(scene).__name__}")
+        try:
+            dumped = json.dumps(scene, default=_jsonable)
+        except RecursionError:
+            raise CandelaError("scene dict: nested too deeply to be a scene") from None
+        except ValueError as e:  # a circular reference
+            raise CandelaError(f"scene dict: {e}") from None
+        except TypeError as e:
+            raise TypeError(f"scene dict: {e}") from None
+        text = _candela.scene_dict_to_ron(dumped)
         return cls(text=text, name=name)
 
     @property
@@ -101,7 +156,7 @@ class Scene:
         if self.text is not None:
             return self.text
         assert self.path is not None
-        return self.path.read_text(encoding="utf-8")
+        return _candela.read_scene_file(str(self.path))
 
     def check(self) -> tuple:
         """Builds the scene as a render would (every value checked, referenced files read);
@@ -109,15 +164,99 @@ class Scene:
         if self.path is not None:
             return _candela.check_scene_file(str(self.path))
         with tempfile.TemporaryDirectory(prefix="candela-") as d:
-            return _candela.check_scene_file(self._write(Path(d)))
+            return _candela.check_scene_file(self._write(Path(d), overwrite=False))
 
-    def _write(self, directory: Path) -> str:
-        p = directory / f"{self.name}.ron"
-        p.write_text(self.ron, encoding="utf-8")
-        return str(p)
+    def _write(self, directory: Path, overwrite: bool) -> str:
+        """Writes the scene as DIRECTORY/NAME.ron without ever replacing a file the module did
+        not write (see the class doc); returns its path."""
+        target = directory / f"{self.name}.ron"
+        data = (self.ron + _MARK).encode("utf-8")
+        try:
+            st = os.lstat(target)
+        except FileNotFoundError:
+            st = None
+        if st is not None:
+            if not stat.S_ISREG(st.st_mode):
+                raise CandelaError(
+                    f"name={self.name!r}: {target} exists and is not a regular file (a directory, "
+                    "link or special file); choose another name or out")
+            if st.st_size == len(data) and _read_prefix(target, len(data) + 1) == data:
+                return str(target)  # the same scene, written earlier
+            tail = _read_tail(target, st.st_size, len(_MARK.encode()))
+            if tail != _MARK.encode():
+                raise CandelaError(
+                    f"name={self.name!r}: {target} exists and was not written by candela for a "
+                    "scene; a scene from text or a dict is written as NAME.ron beside its outputs "
+                    "and never replaces another file: choose another name or out")
+            states = [p for p in glob.glob(os.path.join(glob.escape(str(directory)),
+                                                        glob.escape(self.name) + ".*state"))
+                      if p == f"{directory / self.name}.state"
+                      or p.startswith(f"{directory / self.name}.shard-")]
+            if states and not overwrite:
+                raise CandelaError(
+                    f"name={self.name!r}: {target} holds another scene, rendered into "
+                    f"{os.path.basename(states[0])}: continue that render with the same scene, or "
+                    "replace both with overwrite=True (or choose another name or out)")
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.name}.", suffix=".tmp", dir=directory)
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+                f.flush()
+                os.fsync(f.fileno())
+            if st is None:
+                try:
+                    # A link never replaces: a file made meanwhile by another process stays.
+                    os.link(tmp, target)
+                except FileExistsError:
+                    if _read_prefix(target, len(data) + 1) == data:
+                        return str(target)  # written by a render of the same scene meanwhile
+                    raise CandelaError(
+                        f"name={self.name!r}: {target} was created by someone else meanwhile; "
+                        "render again") from None
+            else:
+                os.replace(tmp, target)
+        finally:
+            try:
+                os.unlink(tmp)
+            except FileNotFoundError:
+                pass
+        return str(target)
 
     def __repr__(self) -> str:
         return f"Scene(path={str(self.path)!r})" if self.path else f"Scene(name={self.name!r}, text=…)"
+
+
+def _read_prefix(path: Path, n: int) -> bytes:
+    """At most n bytes from the start of a regular file (never blocking on a FIFO put there
+    meanwhile)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0))
+    try:
+        return os.read(fd, n)
+    finally:
+        os.close(fd)
+
+
+def _read_tail(path: Path, size: int, n: int) -> bytes:
+    """The last n bytes of a regular file of `size` bytes."""
+    if size < n:
+        return b""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0))
+    try:
+        os.lseek(fd, size - n, os.SEEK_SET)
+        return os.read(fd, n)
+    finally:
+        os.close(fd)
+
+
+def _fspath(p: Any, name: str) -> str:
+    """A path argument as str, or TypeError naming it."""
+    try:
+        f = os.fspath(p)
+    except TypeError:
+        raise TypeError(f"{name} must be a path (str or os.PathLike), got {type(p).__name__}") from None
+    if isinstance(f, bytes):
+        f = os.fsdecode(f)
+    return f
 
 
 def _scene(scene: Union["Scene", str, os.PathLike, Mapping[str, Any]]) -> Scene:
@@ -125,7 +264,7 @@ def _scene(scene: Union["Scene", str, os.PathLike, Mapping[str, Any]]) -> Scene:
         return scene
     if isinstance(scene, Mapping):
         return Scene.from_dict(scene)
-    return Scene.from_file(scene)
+    return Scene.from_file(_fspath(scene, "scene"))
 
 
 @dataclass
@@ -231,6 +370,10 @@ def render(
     leaves from the command line); Ctrl-C stops it the same way and raises KeyboardInterrupt.
     """
     s = _scene(scene)
+    if out is not None:
+        out = _fspath(out, "out")
+    if not isinstance(overwrite, bool):
+        raise TypeError(f"overwrite must be a bool, got {type(overwrite).__name__}")
     if s.path is not None:
         scene_path = str(s.path)
         out_arg = out
@@ -241,7 +384,7 @@ def render(
                 f"out {directory} is not an existing directory: a scene from text or a dict "
                 "is written there as NAME.ron, next to its outputs"
             )
-        scene_path = s._write(directory)
+        scene_path = s._write(directory, overwrite=overwrite)
         out_arg = directory
     if out_arg is None:
         out_arg = tempfile.mkdtemp(prefix="candela-")
@@ -312,9 +455,11 @@ def _shard_spec(shard: Union[str, tuple, None]) -> Optional[str]:
         return shard
     try:
         index, count = shard
+        if isinstance(index, bool) or isinstance(count, bool):
+            raise TypeError
+        return f"{operator.index(index)}/{operator.index(count)}"
     except (TypeError, ValueError):
-        raise CandelaError(f"shard must be (index, count) or \"I/N\", got {shard!r}") from None
-    return f"{int(index)}/{int(count)}"
+        raise TypeError(f"shard must be (index, count) of integers or \"I/N\", got {shard!r:.80}") from None
 
 
 @dataclass
@@ -359,8 +504,11 @@ def merge(
     shards) or an existing directory (DIR/merged.*). ``partial`` merges the shards present
     even if some are missing or unfinished; without it such a merge raises
     :class:`CandelaError` naming them."""
+    if isinstance(states, (str, bytes, os.PathLike)) or not hasattr(states, "__iter__"):
+        raise TypeError(f"states must be a list of paths, got {type(states).__name__}")
     r = _candela.merge(
-        [os.fspath(p) for p in states], os.fspath(out), exposure_ev=exposure_ev, partial=partial
+        [_fspath(p, "states[]") for p in states], _fspath(out, "out"),
+        exposure_ev=exposure_ev, partial=partial,
     )
     path = lambda p: None if p is None else Path(p)  # noqa: E731
     return MergeResult(
@@ -383,7 +531,7 @@ def read_exr(path: Union[str, os.PathLike]) -> Dict[str, Any]:
     (height, width); for a candela render ``X``, ``Y``, ``Z``, ``stderr.Y`` in cd/m² and, with
     illuminance, ``E``, ``stderr.E`` in lx and ``mask.E``) and ``attributes`` (name → text:
     ``units``, ``scene``, ``spp``, ``projection``, …)."""
-    return _candela.read_exr(os.fspath(path))
+    return _candela.read_exr(_fspath(path, "path"))
 
 
 def read_state(path: Union[str, os.PathLike]) -> Dict[str, Any]:
@@ -392,4 +540,4 @@ def read_state(path: Union[str, os.PathLike]) -> Dict[str, Any]:
     ``height``, ``adaptive``, ``total_samples``, ``samples_per_pixel``, ``shard`` ((index,
     count, spp) or None), ``pixel_batches`` (independent sample batches per pixel), and
     ``channels``: the estimate it holds, as its EXR would have it."""
-    return _candela.read_state(os.fspath(path))
+    return _candela.read_state(_fspath(path, "path"))

@@ -13,6 +13,10 @@ class CandelaError(ValueError):
 class Cancelled(CandelaError):
     """A render stopped before it finished; the message says what was written."""
 
+class FileError(OSError, CandelaError):
+    """A file that cannot be read or written; errno is the system's, or None for a file candela
+    refuses itself (FIFO, device, directory, over its size limit)."""
+
 def render(
     scene: str,
     out: str,
@@ -38,7 +42,7 @@ def render(
     shard: Optional[str] = None,
     alpha_opic: bool = False,
     mesopic: bool = False,
-    spectral_bands: int = 0,
+    spectral_bands: Optional[int] = None,
     progress: Optional[Callable[[int, int, float], Optional[bool]]] = None,
     cancel: Any = None,
 ) -> Dict[str, Any]: ...
@@ -48,6 +52,7 @@ def merge(
 def scene_dict_to_ron(json: str) -> str: ...
 def check_scene_text(text: str, name: str) -> None: ...
 def check_scene_file(path: str) -> Tuple[int, int]: ...
+def read_scene_file(path: str) -> str: ...
 def sd_to_xyz(
     wavelengths_nm: npt.NDArray[np.float64],
     values: npt.NDArray[np.float64],

@@ -29,11 +29,41 @@ ALPHA_OPIC = ("s-cone-opic", "m-cone-opic", "l-cone-opic", "rhodopic", "melanopi
 """The order of the five α-opic columns (CIE S 026)."""
 
 
+def _floats(x, name: str) -> np.ndarray:
+    """``x`` as a float64 array, or TypeError / ValueError naming the argument."""
+    if isinstance(x, (str, bytes)):
+        raise TypeError(f"{name} must be an array of numbers, got {type(x).__name__}")
+    try:
+        a = np.asarray(x)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{name} must be an array of numbers: {e}") from None
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must be an array of real numbers, got dtype {a.dtype}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _text(v, name: str) -> str:
+    if not isinstance(v, str):
+        raise TypeError(f"{name} must be a str, got {type(v).__name__}")
+    return v
+
+
 def _spectra(wavelengths_nm, values) -> Tuple[np.ndarray, np.ndarray, bool]:
-    w = np.ascontiguousarray(wavelengths_nm, dtype=np.float64)
-    v = np.asarray(values, dtype=np.float64)
+    w = _floats(wavelengths_nm, "wavelengths_nm")
+    if w.ndim != 1:
+        raise ValueError(f"wavelengths_nm must be a 1-D array (W,), got shape {w.shape}")
+    v = _floats(values, "values")
+    if v.ndim not in (1, 2):
+        raise ValueError(f"values must be (W,) or (N, W), got shape {v.shape}")
     single = v.ndim == 1
     return w, np.ascontiguousarray(np.atleast_2d(v)), single
+
+
+def _xyz(xyz) -> np.ndarray:
+    a = _floats(xyz, "xyz")
+    if a.ndim == 0 or a.shape[-1] != 3:
+        raise ValueError(f"xyz must be an array of shape (..., 3), got shape {a.shape}")
+    return a
 
 
 def _squeeze(a, single: bool):
@@ -62,16 +92,21 @@ def sd_to_xyz(
     colour-science's default for 1 nm data).
     """
     w, v, single = _spectra(wavelengths_nm, values)
+    kind, observer, method = _text(kind, "kind"), _text(observer, "observer"), _text(method, "method")
     ill = None
     if illuminant is not None:
-        ill = (np.ascontiguousarray(illuminant[0], dtype=np.float64),
-               np.ascontiguousarray(illuminant[1], dtype=np.float64))
+        if isinstance(illuminant, (str, bytes)) or not hasattr(illuminant, "__len__") \
+                or len(illuminant) != 2:
+            raise TypeError("illuminant must be (wavelengths_nm, values)")
+        ill = (_floats(illuminant[0], "illuminant[0]"), _floats(illuminant[1], "illuminant[1]"))
+        if ill[0].ndim != 1 or ill[1].ndim != 1:
+            raise ValueError("illuminant must be two 1-D arrays (wavelengths_nm, values)")
     return _squeeze(_candela.sd_to_xyz(w, v, kind, ill, observer, method), single)
 
 
 def xyz_to_xy(xyz) -> np.ndarray:
     """CIE 1931 chromaticity coordinates (x, y) of XYZ (..., 3) → (..., 2)."""
-    a = np.asarray(xyz, dtype=np.float64)
+    a = _xyz(xyz)
     r = _candela.xyz_to_xy_array(np.ascontiguousarray(a.reshape(-1, 3)))
     return r.reshape(a.shape[:-1] + (2,))
 
@@ -80,8 +115,8 @@ def xyz_to_cct_duv(xyz, method: str = "ohno2013") -> np.ndarray:
     """Correlated colour temperature (K) and Duv of XYZ (..., 3) → (..., 2), by Ohno (2013)
     (colour-science ``XYZ_to_CCT_Ohno2013``; within 0.5 K and 5e-5 Duv of it) or
     ``"robertson1968"``."""
-    a = np.asarray(xyz, dtype=np.float64)
-    r = _candela.xyz_to_cct_duv(np.ascontiguousarray(a.reshape(-1, 3)), method)
+    a = _xyz(xyz)
+    r = _candela.xyz_to_cct_duv(np.ascontiguousarray(a.reshape(-1, 3)), _text(method, "method"))
     return r.reshape(a.shape[:-1] + (2,))
 
 
@@ -112,4 +147,4 @@ def tm30(wavelengths_nm, values) -> Dict[str, np.ndarray]:
 def named_spectrum(name: str) -> Tuple[np.ndarray, np.ndarray]:
     """A spectrum of candela's tables (``"D65"``, ``"A"``, ``"FL2"``, ``"LED-B3"``,
     ``"TCS01"``, …) at its own wavelengths: (wavelengths_nm, values)."""
-    return _candela.named_spectrum(name)
+    return _candela.named_spectrum(_text(name, "name"))

@@ -20,17 +20,19 @@ use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// The rows of `values` as 1 nm tables (360–830 nm); each row is checked as a spectrum file
-/// is (finite, increasing wavelengths, finite values).
-fn tables(
+/// `f` of each row of `values` as a 1 nm table (360–830 nm); each row is checked as a spectrum
+/// file is (finite, increasing wavelengths, finite values). One table at a time: the memory
+/// taken is that of the results, whatever the number of rows.
+fn per_row<T>(
     wavelengths_nm: PyReadonlyArray1<'_, f64>,
     values: PyReadonlyArray2<'_, f64>,
-) -> PyResult<Vec<[f64; LEN]>> {
+    f: impl Fn(&[f64; LEN]) -> T,
+) -> PyResult<Vec<T>> {
     let wl = wavelengths_nm.as_array().to_vec();
     let v = values.as_array();
     if v.ncols() != wl.len() {
         return Err(error_msg(format!(
-            "values has {} columns but there are {} wavelengths; give spectra as an (N, W) array with one row per spectrum",
+            "values has {} columns but wavelengths_nm has {} wavelengths; give spectra as an (N, W) array with one row per spectrum",
             v.ncols(),
             wl.len()
         )));
@@ -40,8 +42,8 @@ fn tables(
         .enumerate()
         .map(|(i, row)| {
             SpectralDistribution::new(wl.clone(), row.to_vec())
-                .map(|sd| sd.to_table())
-                .map_err(|e| error_msg(format!("spectrum {i}: {e}")))
+                .map(|sd| f(&sd.to_table()))
+                .map_err(|e| error_msg(format!("values: spectrum {i}: {e}")))
         })
         .collect()
 }
@@ -87,16 +89,13 @@ fn sd_to_xyz<'py>(
     method: &str,
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
     let (obs, m) = (self::observer(observer)?, self::method(method)?);
-    let t = tables(wavelengths_nm, values)?;
     let xyz: Vec<[f64; 3]> = match kind {
-        "absolute" => t
-            .iter()
-            .map(|s| sd_to_xyz_absolute_with(s, obs, m))
-            .collect(),
-        "emissive" => t
-            .iter()
-            .map(|s| sd_to_xyz_emissive_with(s, obs, m))
-            .collect(),
+        "absolute" => per_row(wavelengths_nm, values, |s| {
+            sd_to_xyz_absolute_with(s, obs, m)
+        })?,
+        "emissive" => per_row(wavelengths_nm, values, |s| {
+            sd_to_xyz_emissive_with(s, obs, m)
+        })?,
         "relative" => {
             let (iw, iv) = illuminant.ok_or_else(|| {
                 error_msg("kind \"relative\" needs an illuminant (wavelengths_nm, values)")
@@ -104,9 +103,9 @@ fn sd_to_xyz<'py>(
             let ill = SpectralDistribution::new(iw.as_array().to_vec(), iv.as_array().to_vec())
                 .map_err(|e| error_msg(format!("illuminant: {e}")))?
                 .to_table();
-            t.iter()
-                .map(|s| sd_to_xyz_relative_with(s, &ill, obs, m))
-                .collect()
+            per_row(wavelengths_nm, values, |s| {
+                sd_to_xyz_relative_with(s, &ill, obs, m)
+            })?
         }
         k => {
             return Err(error_msg(format!(
@@ -169,10 +168,7 @@ fn cri<'py>(
     wavelengths_nm: PyReadonlyArray1<'py, f64>,
     values: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let c: Vec<_> = tables(wavelengths_nm, values)?
-        .iter()
-        .map(colour_rendering_index)
-        .collect();
+    let c: Vec<_> = per_row(wavelengths_nm, values, colour_rendering_index)?;
     let d = PyDict::new(py);
     let col = |f: &dyn Fn(&Cri) -> f64| Array1::from_iter(c.iter().map(f)).into_pyarray(py);
     d.set_item("Ra", col(&|c: &Cri| c.ra))?;
@@ -190,10 +186,7 @@ fn alpha_opic<'py>(
     wavelengths_nm: PyReadonlyArray1<'py, f64>,
     values: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let q: Vec<_> = tables(wavelengths_nm, values)?
-        .iter()
-        .map(alpha_opic_quantities)
-        .collect();
+    let q: Vec<_> = per_row(wavelengths_nm, values, alpha_opic_quantities)?;
     let d = PyDict::new(py);
     d.set_item(
         "irradiance_W_m2",
@@ -230,10 +223,7 @@ fn tm30<'py>(
     wavelengths_nm: PyReadonlyArray1<'py, f64>,
     values: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let r: Vec<_> = tables(wavelengths_nm, values)?
-        .iter()
-        .map(colour_rendition)
-        .collect();
+    let r: Vec<_> = per_row(wavelengths_nm, values, colour_rendition)?;
     let scalar = |f: &dyn Fn(&ColourRendition) -> f64| {
         Array1::from_iter(r.iter().map(|c| c.as_ref().map_or(f64::NAN, f))).into_pyarray(py)
     };

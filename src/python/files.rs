@@ -46,9 +46,18 @@ fn read_exr(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyDict>> {
 /// shard, samples, and the estimate it holds as the channels its EXR would have.
 #[pyfunction]
 fn read_state(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyDict>> {
-    let st = py
-        .detach(|| crate::state::RenderState::load(&path))
-        .map_err(error)?;
+    // Read here rather than by `RenderState::load`, so that a file problem reaches Python as
+    // a FileError with its errno.
+    let st = py.detach(|| {
+        let bytes =
+            crate::limits::read_file(&path, crate::state::MAX_STATE_BYTES).map_err(|e| {
+                super::file_error(
+                    e.raw_os_error(),
+                    format!("cannot read state file {}: {e}", path.display()),
+                )
+            })?;
+        crate::state::RenderState::decode(&bytes, &path).map_err(error)
+    })?;
     let d = PyDict::new(py);
     d.set_item("scene", &st.scene)?;
     d.set_item("scene_hash", st.scene_hash)?;

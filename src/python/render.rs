@@ -4,7 +4,7 @@
 //! lets Python see Ctrl-C. A stop request ends the pass in progress, as Ctrl-C does for the
 //! command line.
 
-use super::{error, error_msg, Cancelled};
+use super::{args, error, error_msg, Cancelled};
 use crate::job::{self, ImageDone, Outcome, Progress, RenderJob};
 use crate::render::{PassStatus, TargetError};
 use crate::report::units::UnitSystem;
@@ -48,8 +48,12 @@ const POLL: Duration = Duration::from_millis(50);
 
 fn seconds(what: &str, s: Option<f64>) -> PyResult<Option<Duration>> {
     s.map(|s| {
-        Duration::try_from_secs_f64(s)
-            .map_err(|_| error_msg(format!("{what} must be a duration ≥ 0 in seconds, got {s}")))
+        args::number(what, s, "a duration ≥ 0 in seconds", |s| s >= 0.0)?;
+        Duration::try_from_secs_f64(s).map_err(|_| {
+            error_msg(format!(
+                "{what} must be a duration ≥ 0 in seconds, got {s:e}"
+            ))
+        })
     })
     .transpose()
 }
@@ -61,17 +65,17 @@ fn seconds(what: &str, s: Option<f64>) -> PyResult<Option<Duration>> {
     illuminance=false, caustics=None, exposure_ev=None, units="si", target_error=None,
     target_fraction=1.0, target_floor_cd_m2=None, max_spp=None, max_time_s=None,
     checkpoint_interval_s=None, resume=false, overwrite=false, save_state=false,
-    falsecolour=false, shard=None, alpha_opic=false, mesopic=false, spectral_bands=0,
+    falsecolour=false, shard=None, alpha_opic=false, mesopic=false, spectral_bands=None,
     progress=None, cancel=None))]
 #[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
     scene: PathBuf,
     out: PathBuf,
-    spp: Option<u32>,
-    seed: Option<u64>,
-    max_depth: Option<u32>,
-    threads: Option<usize>,
+    spp: Option<Bound<'py, PyAny>>,
+    seed: Option<Bound<'py, PyAny>>,
+    max_depth: Option<Bound<'py, PyAny>>,
+    threads: Option<Bound<'py, PyAny>>,
     illuminance: bool,
     caustics: Option<&str>,
     exposure_ev: Option<f64>,
@@ -79,7 +83,7 @@ fn render<'py>(
     target_error: Option<f64>,
     target_fraction: f64,
     target_floor_cd_m2: Option<f64>,
-    max_spp: Option<u32>,
+    max_spp: Option<Bound<'py, PyAny>>,
     max_time_s: Option<f64>,
     checkpoint_interval_s: Option<f64>,
     resume: bool,
@@ -89,10 +93,49 @@ fn render<'py>(
     shard: Option<&str>,
     alpha_opic: bool,
     mesopic: bool,
-    spectral_bands: usize,
+    spectral_bands: Option<Bound<'py, PyAny>>,
     progress: Option<Bound<'py, PyAny>>,
     cancel: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    // The command line's checks, with the messages naming the arguments.
+    let spp = args::opt_int_in(&spp, "spp", 1, u32::MAX as u64)?.map(|n| n as u32);
+    let seed = args::opt_int_in(&seed, "seed", 0, u64::MAX)?;
+    let max_depth =
+        args::opt_int_in(&max_depth, "max_depth", 0, u32::MAX as u64)?.map(|n| n as u32);
+    let threads =
+        args::opt_int_in(&threads, "threads", 1, job::max_threads() as u64)?.map(|n| n as usize);
+    let max_spp = args::opt_int_in(&max_spp, "max_spp", 1, u32::MAX as u64)?.map(|n| n as u32);
+    let spectral_bands = args::opt_int_in(
+        &spectral_bands,
+        "spectral_bands",
+        0,
+        crate::film::MAX_SPECTRAL_BANDS as u64,
+    )?
+    .unwrap_or(0) as usize;
+    if let Some(ev) = exposure_ev {
+        let max = job::MAX_ABS_EXPOSURE_EV;
+        args::number(
+            "exposure_ev",
+            ev,
+            &format!("a finite number of EV between -{max} and {max}"),
+            |v| v.abs() <= max,
+        )?;
+    }
+    args::number(
+        "target_fraction",
+        target_fraction,
+        "a fraction in (0, 1]",
+        |f| f > 0.0 && f <= 1.0,
+    )?;
+    if let Some(f) = target_floor_cd_m2 {
+        args::number(
+            "target_floor_cd_m2",
+            f,
+            "a luminance ≥ 0 in cd/m²",
+            |f| f >= 0.0,
+        )?;
+    }
+    args::callbacks(&progress, &cancel)?;
     let caustics = match caustics {
         None => None,
         Some("light-tracing") => Some(crate::world::Caustics::LightTracing),
@@ -113,11 +156,12 @@ fn render<'py>(
         }
     };
     if let Some(t) = target_error {
-        if !(t > 0.0 && t < 1.0) {
-            return Err(error_msg(format!(
-                "target_error must lie strictly between 0 and 1 (a fraction: 0.01 = 1 %), got {t}"
-            )));
-        }
+        args::number(
+            "target_error",
+            t,
+            "strictly between 0 and 1 (a fraction: 0.01 = 1 %)",
+            |t| t > 0.0 && t < 1.0,
+        )?;
     }
     let job = RenderJob {
         scene,
@@ -208,7 +252,18 @@ fn render<'py>(
     });
     let outputs = match result {
         Ok(r) => r.map_err(error)?,
-        Err(panic) => std::panic::resume_unwind(panic),
+        // A panic is a bug in candela; Python gets an exception it can catch, not a
+        // PanicException (a BaseException).
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            return Err(error_msg(format!(
+                "internal error in candela (please report it): the render failed: {what}"
+            )));
+        }
     };
     if let Some(e) = raised {
         return Err(e);
@@ -279,8 +334,7 @@ fn result_dict<'py>(
     let channels = super::files::channel_dict(py, &layers)?;
     let d = PyDict::new(py);
     d.set_item("channels", channels)?;
-    let report = std::fs::read_to_string(&outputs.report_path)
-        .map_err(|e| error_msg(format!("{}: {e}", outputs.report_path.display())))?;
+    let report = read_report(&outputs.report_path)?;
     d.set_item("report_json", report)?;
     d.set_item("exr_path", &outputs.exr_path)?;
     d.set_item("png_path", &outputs.png_path)?;
@@ -294,6 +348,17 @@ fn result_dict<'py>(
     Ok(d)
 }
 
+/// The report a job just wrote, read as every input is (a file replaced meanwhile by a FIFO
+/// or something huge is refused).
+fn read_report(path: &std::path::Path) -> PyResult<String> {
+    crate::limits::read_text(path, crate::limits::MAX_TEXT_BYTES).map_err(|e| {
+        super::file_error(
+            e.raw_os_error(),
+            format!("cannot read the report {}: {e}", path.display()),
+        )
+    })
+}
+
 /// Merges render states or shards as `candela merge` does ([`job::merge_with`]); see
 /// `candela.merge` (python/candela) for the result.
 #[pyfunction]
@@ -305,6 +370,15 @@ fn merge<'py>(
     exposure_ev: Option<f64>,
     partial: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if let Some(ev) = exposure_ev {
+        let max = job::MAX_ABS_EXPOSURE_EV;
+        args::number(
+            "exposure_ev",
+            ev,
+            &format!("a finite number of EV between -{max} and {max}"),
+            |v| v.abs() <= max,
+        )?;
+    }
     let options = job::MergeOptions {
         exposure_ev,
         partial,
@@ -339,12 +413,7 @@ fn merge<'py>(
         }
     };
     d.set_item("shards", shards)?;
-    let report = match &m.report_path {
-        Some(p) => Some(
-            std::fs::read_to_string(p).map_err(|e| error_msg(format!("{}: {e}", p.display())))?,
-        ),
-        None => None,
-    };
+    let report = m.report_path.as_deref().map(read_report).transpose()?;
     d.set_item("report_json", report)?;
     Ok(d)
 }

@@ -3,7 +3,7 @@
 //! tuples and vectors are lists) is written as the RON text of the same scene, guided by the
 //! scene's own types, so the render reads exactly what a scene file would give it.
 
-use super::error_msg;
+use super::{error, error_msg};
 use crate::description::schema::SceneFile;
 use pyo3::prelude::*;
 use serde::de::{self, DeserializeSeed, IntoDeserializer, Visitor};
@@ -481,14 +481,30 @@ fn check_scene_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<(usize
     py.detach(|| {
         crate::scene::load_world(&path, &crate::scene::Overrides::default())
             .map(|world| (world.camera.width, world.camera.height))
-            .map_err(|e| e.to_string())
+            .map_err(|e| error(e.into()))
     })
-    .map_err(error_msg)
+}
+
+/// The text of a scene file, read as the command line reads it (at most
+/// [`crate::limits::MAX_TEXT_BYTES`] of UTF-8; never a FIFO, device or directory) and parsed
+/// (syntax, types, unknown fields).
+#[pyfunction]
+fn read_scene_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<String> {
+    py.detach(|| {
+        let text = crate::limits::read_text(&path, crate::limits::MAX_TEXT_BYTES)
+            .map_err(|e| {
+                anyhow::Error::new(e).context(format!("cannot read scene file {}", path.display()))
+            })
+            .map_err(error)?;
+        crate::scene::parse(&text, &path).map_err(|e| error_msg(e.to_string()))?;
+        Ok(text)
+    })
 }
 
 pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene_dict_to_ron, m)?)?;
     m.add_function(wrap_pyfunction!(check_scene_text, m)?)?;
     m.add_function(wrap_pyfunction!(check_scene_file, m)?)?;
+    m.add_function(wrap_pyfunction!(read_scene_file, m)?)?;
     Ok(())
 }

@@ -129,7 +129,7 @@ def test_alpha_opic_of_d65_meets_the_definition():
 
 
 def test_bad_spectra_raise_candela_error():
-    with pytest.raises(candela.CandelaError, match="3 columns but there are 4 wavelengths"):
+    with pytest.raises(candela.CandelaError, match="values has 3 columns but wavelengths_nm has 4 wavelengths"):
         cc.sd_to_xyz([400, 500, 600, 700], np.ones((2, 3)))
     with pytest.raises(candela.CandelaError, match="spectrum 1: .*non-finite"):
         cc.sd_to_xyz([400, 500, 600], np.array([[1, 1, 1], [1, np.nan, 1]]))
