@@ -67,6 +67,24 @@ _MARK = "\n// candela: written by the Python module for a scene from text or a d
 """The last lines of a scene file the module writes: such a file may be replaced, no other."""
 
 
+MAX_TEXT_BYTES = 256 << 20
+"""Largest scene text in bytes: what a render reads of a scene file (``candela::limits``)."""
+
+
+def _check_text(text: Any) -> str:
+    """Scene text that a render can read back from its file, or TypeError / CandelaError."""
+    if not isinstance(text, str):
+        raise TypeError(f"text must be a str, got {type(text).__name__}")
+    try:
+        n = len(text.encode("utf-8"))
+    except UnicodeEncodeError:
+        raise CandelaError("text must be valid Unicode (no lone surrogates)") from None
+    if n + len(_MARK) > MAX_TEXT_BYTES:
+        raise CandelaError(f"text is {n} bytes, more than the limit of {MAX_TEXT_BYTES} bytes "
+                           "of a scene file")
+    return text
+
+
 def _check_name(name: Any) -> str:
     """``name`` as a plain file-name stem, or TypeError / CandelaError naming it."""
     if not isinstance(name, str):
@@ -111,8 +129,11 @@ class Scene:
 
     def __init__(self, *, path: Optional[Path] = None, text: Optional[str] = None,
                  name: str = "scene") -> None:
-        self.path = path
-        self.text = text
+        if (path is None) == (text is None):
+            raise TypeError("Scene needs exactly one of path= and text= (or use from_file, "
+                            "from_ron, from_dict)")
+        self.path = None if path is None else Path(_fspath(path, "path"))
+        self.text = None if text is None else _check_text(text)
         self.name = _check_name(name)
 
     @classmethod
@@ -128,9 +149,7 @@ class Scene:
         """RON text of a scene; ``name`` names the outputs (``NAME.exr``, …) and the scene
         file written beside them (``NAME.ron``)."""
         name = _check_name(name)
-        if not isinstance(text, str):
-            raise TypeError(f"text must be a str, got {type(text).__name__}")
-        _candela.check_scene_text(text, f"{name}.ron")
+        _candela.check_scene_text(_check_text(text), f"{name}.ron")
         return cls(text=text, name=name)
 
     @classmethod
@@ -147,8 +166,11 @@ class Scene:
             raise CandelaError(f"scene dict: {e}") from None
         except TypeError as e:
             raise TypeError(f"scene dict: {e}") from None
+        if len(dumped) > MAX_TEXT_BYTES:
+            raise CandelaError(f"scene dict: {len(dumped)} bytes as JSON, more than the limit of "
+                               f"{MAX_TEXT_BYTES} bytes of a scene file")
         text = _candela.scene_dict_to_ron(dumped)
-        return cls(text=text, name=name)
+        return cls(text=_check_text(text), name=name)
 
     @property
     def ron(self) -> str:
@@ -197,13 +219,21 @@ class Scene:
                     f"name={self.name!r}: {target} holds another scene, rendered into "
                     f"{os.path.basename(states[0])}: continue that render with the same scene, or "
                     "replace both with overwrite=True (or choose another name or out)")
+        try:
+            return self._write_new(directory, target, data, replace=st is not None)
+        except FileError:
+            raise
+        except OSError as e:
+            raise FileError(e.errno, f"cannot write the scene file {target}: {e.strerror or e}") from None
+
+    def _write_new(self, directory: Path, target: Path, data: bytes, replace: bool) -> str:
         fd, tmp = tempfile.mkstemp(prefix=f".{self.name}.", suffix=".tmp", dir=directory)
         try:
             with os.fdopen(fd, "wb") as f:
                 f.write(data)
                 f.flush()
                 os.fsync(f.fileno())
-            if st is None:
+            if not replace:
                 try:
                     # A link never replaces: a file made meanwhile by another process stays.
                     os.link(tmp, target)
@@ -213,6 +243,15 @@ class Scene:
                     raise CandelaError(
                         f"name={self.name!r}: {target} was created by someone else meanwhile; "
                         "render again") from None
+                except OSError:
+                    # A file system without hard links: create the file, never replacing one.
+                    fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+                    try:
+                        with os.fdopen(fd, "wb") as f:
+                            f.write(data)
+                    except OSError:
+                        os.unlink(target)
+                        raise
             else:
                 os.replace(tmp, target)
         finally:

@@ -193,6 +193,11 @@ def test_scene_text_mutations(tmp_path):
         r = call(f"render #{k}", candela.render, s, out=d, spp=1, max_time_s=1.0)
         rendered_ok += not isinstance(r, BaseException)
     assert rendered_ok > 0  # the mutations leave some scenes that render
+    # Nesting far past any parser's recursion limit.
+    for deep in ["Scene(objects: " + "[" * 100000,
+                 'Scene(materials: {"a": ' + "NormalMapped(material: " * 100000,
+                 "Scene(objects: [(material: \"a\", shape: " + "Instances(transforms: [], mesh: " * 50000]:
+        call("deep text", candela.Scene.from_ron, deep)
 
 
 def test_dict_scene_mutations(scene_dict):

@@ -200,3 +200,24 @@ def test_colour_arguments_name_them():
     assert np.array_equal(colour.sd_to_xyz(wl, np.asfortranarray(v)), a)
     assert np.array_equal(colour.sd_to_xyz(wl, np.repeat(v, 2, axis=1)[:, ::2]), a)
     assert colour.sd_to_xyz(wl, np.zeros((0, 95))).shape == (0, 3)
+
+
+def test_scene_constructor_and_text_are_checked(tmp_path):
+    with pytest.raises(TypeError, match="exactly one of path= and text="):
+        candela.Scene()
+    with pytest.raises(TypeError, match="^text must be a str"):
+        candela.Scene.from_ron(b"Scene()")
+    with pytest.raises(candela.CandelaError, match="^text must be valid Unicode"):
+        candela.Scene.from_ron("\ud800")
+
+
+def test_unwritable_directory_is_a_file_error(tmp_path):
+    if os.geteuid() == 0:
+        pytest.skip("root writes into read-only directories")
+    os.chmod(tmp_path, 0o500)
+    try:
+        with pytest.raises(candela.FileError) as e:
+            candela.render(candela.Scene.from_ron(tiny_text(), name="room"), out=tmp_path, spp=1)
+        assert e.value.errno == errno.EACCES
+    finally:
+        os.chmod(tmp_path, 0o700)
