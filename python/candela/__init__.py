@@ -134,7 +134,11 @@ class Scene:
                             "from_ron, from_dict)")
         self.path = None if path is None else Path(_fspath(path, "path"))
         self.text = None if text is None else _check_text(text)
-        self.name = _check_name(name)
+        if not isinstance(name, str):
+            raise TypeError(f"name must be a str, got {type(name).__name__}")
+        # A scene file's outputs are named after it by the render, which checks them; only a
+        # scene from text is written under this name.
+        self.name = name if text is None else _check_name(name)
 
     @classmethod
     def from_file(cls, path: Union[str, os.PathLike]) -> "Scene":
@@ -142,7 +146,7 @@ class Scene:
         if it cannot be read."""
         p = Path(_fspath(path, "path"))
         _candela.read_scene_file(str(p))
-        return cls(path=p, name=p.stem if p.stem not in ("", ".", "..") else "scene")
+        return cls(path=p, name=p.stem)
 
     @classmethod
     def from_ron(cls, text: str, name: str = "scene") -> "Scene":

@@ -221,3 +221,14 @@ def test_unwritable_directory_is_a_file_error(tmp_path):
         assert e.value.errno == errno.EACCES
     finally:
         os.chmod(tmp_path, 0o700)
+
+
+def test_a_scene_file_of_any_name_renders(tmp_path):
+    # Only a scene from text is written under its name: a file's own name is the render's
+    # business (its outputs are checked by the command line's rules).
+    odd = tmp_path / "a\x1bb.ron"
+    odd.write_text(tiny_text())
+    s = candela.Scene.from_file(odd)
+    assert s.name == "a\x1bb"
+    r = candela.render(s, out=tmp_path, spp=1)
+    assert r.exr_path == tmp_path / "a\x1bb.exr"
