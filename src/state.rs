@@ -315,6 +315,53 @@ fn take_pixels<T: serde::de::DeserializeOwned>(
     Ok(pixels)
 }
 
+/// Feeds the bytes of the regular file `path` to `eat` as one slice would be, reading it in
+/// blocks (a mesh of gigabytes is not held twice), and returns its length. What is not a
+/// regular file (a FIFO or device put in a model's place) is an error, found without blocking.
+fn hash_file(
+    h: &mut u64,
+    path: &std::path::Path,
+    eat: impl Fn(&mut u64, &[u8]),
+) -> std::io::Result<u64> {
+    use std::io::Read;
+    let not_regular =
+        || std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a regular file");
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(not_regular());
+    }
+    let mut open = std::fs::OpenOptions::new();
+    open.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // A file swapped for a FIFO since the check opens at once instead of waiting.
+        open.custom_flags(libc::O_NONBLOCK);
+    }
+    let mut file = open.open(path)?;
+    if !file.metadata()?.is_file() {
+        return Err(not_regular());
+    }
+    // Whole blocks are a multiple of 8 bytes, so `eat`'s 8-byte words fall as over one slice.
+    let mut block = vec![0u8; 1 << 16];
+    let mut len = 0u64;
+    loop {
+        let mut filled = 0;
+        while filled < block.len() {
+            match file.read(&mut block[filled..]) {
+                Ok(0) => break,
+                Ok(n) => filled += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(e),
+            }
+        }
+        eat(h, &block[..filled]);
+        len += filled as u64;
+        if filled < block.len() {
+            return Ok(len);
+        }
+    }
+}
+
 /// Hash of the scene text, the contents of every file it refers to ([`World::sources`]) and the
 /// estimator's settings (seed excluded: merging combines seeds). A referenced file that can no
 /// longer be read hashes as its path alone, so the state then no longer matches.
@@ -331,11 +378,8 @@ pub fn scene_hash(scene_text: &[u8], world: &World) -> u64 {
     // (A scene without referenced files hashes as before they were included.)
     for source in &world.sources {
         eat(&mut h, source.to_string_lossy().as_bytes());
-        match std::fs::read(source) {
-            Ok(bytes) => {
-                eat(&mut h, &bytes);
-                h = mix64(h ^ bytes.len() as u64);
-            }
+        match hash_file(&mut h, source, eat) {
+            Ok(len) => h = mix64(h ^ len),
             Err(_) => h = mix64(h ^ 0xdead),
         }
     }
@@ -616,6 +660,36 @@ impl RenderState {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A file hashed in blocks gives what hashing its bytes as one slice gave, at lengths
+    /// around the word and block sizes; a FIFO is refused without blocking.
+    #[test]
+    fn file_hash_in_blocks_equals_one_slice() {
+        let eat = |h: &mut u64, bytes: &[u8]| {
+            for chunk in bytes.chunks(8) {
+                let mut b = [0u8; 8];
+                b[..chunk.len()].copy_from_slice(chunk);
+                *h = mix64(*h ^ u64::from_le_bytes(b));
+            }
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.bin");
+        for len in [0usize, 1, 7, 8, 9, 65_535, 65_536, 65_537, 200_003] {
+            let bytes: Vec<u8> = (0..len).map(|i| (i * 31 % 251) as u8).collect();
+            std::fs::write(&path, &bytes).unwrap();
+            let (mut a, mut b) = (7u64, 7u64);
+            eat(&mut a, &bytes);
+            assert_eq!(hash_file(&mut b, &path, eat).unwrap(), len as u64);
+            assert_eq!(a, b, "length {len}");
+        }
+        #[cfg(unix)]
+        {
+            let fifo = dir.path().join("fifo");
+            let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+            assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+            assert!(hash_file(&mut 0, &fifo, eat).is_err());
+        }
+    }
 
     /// A 3 × 2 film with one sample per pixel and melanopic and 4-band sums, as a state.
     fn health_state() -> RenderState {

@@ -33,11 +33,36 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     ron::Options::default()
         .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+        .with_recursion_limit(RECURSION_LIMIT)
         .from_str::<SceneFile>(text)
         .map_err(|e| SceneError::Parse {
             path: path.to_path_buf(),
             line: e.span.start.line,
             col: e.span.start.col,
-            message: e.code.to_string(),
+            message: match e.code {
+                // ron's own text names its Rust option, which a scene's author cannot set.
+                ron::error::Error::ExceededRecursionLimit => format!(
+                    "brackets nested more than {} deep; a scene needs far fewer",
+                    RECURSION_LIMIT
+                ),
+                code => code.to_string(),
+            },
         })
+}
+
+/// How deep brackets may nest in a scene file (ron's default; named in the message).
+const RECURSION_LIMIT: usize = 128;
+
+#[cfg(test)]
+mod tests {
+    /// Deep nesting is refused with a message a scene's author can act on, naming the place.
+    #[test]
+    fn deep_nesting_names_the_limit_not_ron_options() {
+        let text = format!("(objects: [{}])", "(".repeat(10_000));
+        let e = super::parse(&text, std::path::Path::new("deep.ron")).unwrap_err();
+        let m = e.to_string();
+        assert!(m.contains("nested more than 128 deep"), "{m}");
+        assert!(m.contains("deep.ron:1:"), "{m}");
+        assert!(!m.contains("recursion_limit"), "{m}");
+    }
 }
