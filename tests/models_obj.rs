@@ -371,7 +371,7 @@ fn bad_models_and_textures_are_clear_errors() {
         (
             "/dev/zero as MTL",
             Box::new(|| write("m.obj", obj("/dev/zero").as_bytes())),
-            vec!["/dev/zero", "m.obj", "device"],
+            vec!["/dev/zero", "m.obj", "outside the model's folder"],
         ),
         (
             "malformed MTL statement",

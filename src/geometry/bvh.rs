@@ -228,6 +228,20 @@ impl SceneGeometry {
                             format!("vertex {i} has a non-finite position {}", m.positions[i]),
                         ));
                     }
+                    // Checked per vertex, before small triangles far out collapse in f32 to
+                    // zero area and would be dropped unseen.
+                    if let Some(i) =
+                        (m.positions.iter()).position(|p| p.abs().max_element() > MAX_COORDINATE)
+                    {
+                        return Err(invalid(
+                            shape,
+                            object,
+                            format!(
+                                "vertex {i} is at {} m; geometry must lie within ±{MAX_COORDINATE:e} m",
+                                m.positions[i]
+                            ),
+                        ));
+                    }
                     let nbase = normals.len() as u32;
                     let has_n = match &m.normals {
                         Some(ns) => {

@@ -199,6 +199,44 @@ fn locate_bad_face(text: &str) -> Option<String> {
     None
 }
 
+/// The first `v` line whose position (divided by its optional weight w, as tobj does) is not
+/// finite or lies beyond [`super::bvh::MAX_COORDINATE`], described with its line and number.
+fn far_vertex(text: &str) -> Option<String> {
+    let mut k = 0usize;
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("v") {
+            continue;
+        }
+        k += 1;
+        let x: Vec<f32> = words.map_while(|w| w.parse().ok()).collect();
+        if x.len() < 3 {
+            continue;
+        }
+        // A fourth value alone is the weight; six are a position and a colour.
+        let w = if x.len() == 4 { x[3] } else { 1.0 };
+        let p = [x[0] / w, x[1] / w, x[2] / w];
+        if p.iter()
+            .any(|c| !c.is_finite() || c.abs() > super::bvh::MAX_COORDINATE)
+        {
+            return Some(format!(
+                "line {}: vertex {k} is at ({}, {}, {}) m, {}; geometry must lie within ±{:e} m",
+                n + 1,
+                p[0],
+                p[1],
+                p[2],
+                if p.iter().all(|c| c.is_finite()) {
+                    "too far from the origin"
+                } else {
+                    "not a finite position"
+                },
+                super::bvh::MAX_COORDINATE
+            ));
+        }
+    }
+    None
+}
+
 /// How an OBJ file's material libraries are read.
 #[derive(Clone, Copy, PartialEq)]
 enum Mtl {
@@ -208,7 +246,92 @@ enum Mtl {
     Use,
 }
 
-type Models = (Vec<tobj::Model>, Vec<MtlMaterial>);
+/// The objects, the materials and the material libraries read.
+type Models = (Vec<tobj::Model>, Vec<MtlMaterial>, Vec<std::path::PathBuf>);
+
+#[cfg(test)]
+thread_local! {
+    /// Material libraries read on this thread (tests count them).
+    static MTL_READS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+/// The file names of one `mtllib` statement (`rest` follows the keyword): OBJ allows several,
+/// separated by spaces, and exporters write names with spaces. As Blender's importer does, the
+/// text is cut after each `.mtl` (any case) that ends a word, so `a.mtl b c.mtl` names `a.mtl`
+/// and `b c.mtl`; text after the last `.mtl` is one more name.
+fn mtllib_names(rest: &str) -> Vec<String> {
+    let lower = rest.to_ascii_lowercase();
+    let b = lower.as_bytes();
+    let mut names = Vec::new();
+    let mut start = 0;
+    let mut i = 0;
+    while let Some(k) = lower[i..].find(".mtl") {
+        let end = i + k + 4;
+        if end == b.len() || b[end].is_ascii_whitespace() {
+            names.push(rest[start..end].trim().to_string());
+            start = end;
+        }
+        i = end;
+    }
+    names.push(rest[start..].trim().to_string());
+    names.retain(|n| !n.is_empty());
+    names
+}
+
+/// Lexically normalised absolute form of `p` (`.` dropped, `..` taking off the component
+/// before it), without asking the file system.
+fn lexical(p: &Path) -> std::path::PathBuf {
+    use std::path::Component;
+    let abs = if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        std::env::current_dir().unwrap_or_default().join(p)
+    };
+    let mut out = std::path::PathBuf::new();
+    for c in abs.components() {
+        match c {
+            Component::ParentDir => {
+                out.pop();
+            }
+            Component::CurDir => {}
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The file a model file `model` names as `name` (`what` in messages), relative to `base`
+/// (the model's directory, or a material library's inside it): it must lie beside the model
+/// or below its folder, both as written (`..` resolved) and, when it exists, once symbolic
+/// links are resolved, so a model cannot make candela read (or show bytes of) files elsewhere.
+/// The file is not opened here.
+pub fn model_file(
+    model: &Path,
+    base: &Path,
+    name: &str,
+    what: &str,
+) -> Result<std::path::PathBuf, GeometryError> {
+    let folder = match model.parent() {
+        Some(f) if !f.as_os_str().is_empty() => f,
+        _ => Path::new("."),
+    };
+    let file = base.join(name);
+    let outside = || GeometryError::Outside {
+        path: model.to_path_buf(),
+        what: what.to_string(),
+        name: name.to_string(),
+        folder: folder.to_path_buf(),
+    };
+    if !lexical(&file).starts_with(lexical(folder)) {
+        return Err(outside());
+    }
+    if let (Ok(f), Ok(root)) = (file.canonicalize(), folder.canonicalize()) {
+        if !f.starts_with(root) {
+            return Err(outside());
+        }
+    }
+    Ok(file)
+}
 
 /// Reads and parses an OBJ file (and, with [`Mtl::Use`], its material libraries).
 fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
@@ -233,57 +356,83 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
     };
     let mtl_error = std::cell::RefCell::new(None);
     let mtls = std::cell::RefCell::new(Vec::<MtlMaterial>::new());
-    let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
-        let mtl = path.parent().unwrap_or(Path::new("")).join(name);
+    // Libraries already read: each is read once however often `mtllib` names it.
+    let read = std::cell::RefCell::new(Vec::<std::path::PathBuf>::new());
+    let seen = std::cell::RefCell::new(Vec::<std::path::PathBuf>::new());
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let load_mtl = |line: &Path| -> tobj::MTLLoadResult {
         let fail = |e: GeometryError| {
             mtl_error.borrow_mut().get_or_insert(e);
             Ok(Default::default())
         };
-        let bytes = match limits::read_file(&mtl, MAX_MTL_FILE_BYTES) {
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound && mtl_mode == Mtl::Ignore => {
-                return Ok(Default::default())
-            }
-            Err(source) => {
-                return fail(GeometryError::Material {
-                    path: path.to_path_buf(),
-                    mtl,
-                    source,
-                })
-            }
-            Ok(b) => b,
-        };
-        if mtl_mode == Mtl::Ignore {
-            return Ok(Default::default());
-        }
-        let parsed = match super::mtl::parse_mtl(&mtl, &bytes) {
-            Ok(p) => p,
-            Err(e) => return fail(e),
-        };
-        let mut all = mtls.borrow_mut();
         // tobj's own map type (it is not named in tobj's API).
         let empty: tobj::MTLLoadResult = Ok(Default::default());
         let Ok((mut mats, mut map)) = empty else {
             unreachable!()
         };
-        for m in parsed {
-            if let Some(prev) = all.iter().find(|p| p.name == m.name) {
-                return fail(GeometryError::MaterialSyntax {
-                    mtl: m.file.clone(),
-                    line: m.line,
-                    message: format!(
-                        "material {:?} is defined again (first in '{}', line {})",
-                        m.name,
-                        prev.file.display(),
-                        prev.line
-                    ),
-                });
+        for name in mtllib_names(&line.to_string_lossy()) {
+            let mtl = match model_file(path, dir, &name, "the material library") {
+                Ok(f) => f,
+                // An unused library outside the folder is not read; one that is not there is
+                // ignored, as missing libraries are.
+                Err(_)
+                    if mtl_mode == Mtl::Ignore
+                        && std::fs::symlink_metadata(dir.join(&name)).is_err() =>
+                {
+                    continue
+                }
+                Err(e) => return fail(e),
+            };
+            // The same file by another spelling (`./a.mtl`, `sub/../a.mtl`) is the same library.
+            let key = mtl.canonicalize().unwrap_or_else(|_| mtl.clone());
+            if seen.borrow().contains(&key) {
+                continue;
             }
-            map.insert(m.name.clone(), mats.len());
-            mats.push(tobj::Material {
-                name: m.name.clone(),
-                ..Default::default()
-            });
-            all.push(m);
+            seen.borrow_mut().push(key);
+            read.borrow_mut().push(mtl.clone());
+            #[cfg(test)]
+            MTL_READS.with(|n| n.set(n.get() + 1));
+            let bytes = match limits::read_file(&mtl, MAX_MTL_FILE_BYTES) {
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound && mtl_mode == Mtl::Ignore => {
+                    continue
+                }
+                Err(source) => {
+                    return fail(GeometryError::Material {
+                        path: path.to_path_buf(),
+                        mtl,
+                        source,
+                    })
+                }
+                Ok(b) => b,
+            };
+            if mtl_mode == Mtl::Ignore {
+                continue;
+            }
+            let parsed = match super::mtl::parse_mtl(&mtl, &bytes) {
+                Ok(p) => p,
+                Err(e) => return fail(e),
+            };
+            let mut all = mtls.borrow_mut();
+            for m in parsed {
+                if let Some(prev) = all.iter().find(|p| p.name == m.name) {
+                    return fail(GeometryError::MaterialSyntax {
+                        mtl: m.file.clone(),
+                        line: m.line,
+                        message: format!(
+                            "material {:?} is defined again (first in '{}', line {})",
+                            m.name,
+                            prev.file.display(),
+                            prev.line
+                        ),
+                    });
+                }
+                map.insert(m.name.clone(), mats.len());
+                mats.push(tobj::Material {
+                    name: m.name.clone(),
+                    ..Default::default()
+                });
+                all.push(m);
+            }
         }
         Ok((mats, map))
     };
@@ -317,7 +466,18 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
         }
         e => parse(e.to_string()),
     })?;
+    let far =
+        |p: &[f32]| (p.iter()).any(|c| !c.is_finite() || c.abs() > super::bvh::MAX_COORDINATE);
+    if models.iter().any(|m| far(&m.mesh.positions)) {
+        return Err(parse(far_vertex(text).unwrap_or_else(|| {
+            format!(
+                "a vertex lies beyond ±{:e} m from the origin (or is not finite)",
+                super::bvh::MAX_COORDINATE
+            )
+        })));
+    }
     let mtls = mtls.into_inner();
+    let libraries = read.into_inner();
     if mtl_mode == Mtl::Use {
         // A `usemtl` naming no material of the libraries would silently lose its faces'
         // material: say where it is.
@@ -344,7 +504,7 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
             }
         }
     }
-    Ok((models, mtls))
+    Ok((models, mtls, libraries))
 }
 
 /// Appends the triangles of `models` to `mesh` (and their normals to `normals` when
@@ -427,7 +587,7 @@ fn all_have_normals(models: &[&tobj::Model]) -> bool {
 /// Material libraries (`mtllib`) are not used, so one that does not exist is ignored; one that
 /// is a FIFO, a device, a directory or over 16 MiB is refused, naming it.
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
-    let (models, _) = parse_obj(path, Mtl::Ignore)?;
+    let (models, _, _) = parse_obj(path, Mtl::Ignore)?;
     let models: Vec<&tobj::Model> = models.iter().collect();
     let mut mesh = TriangleMesh::default();
     let with_normals = all_have_normals(&models);
@@ -463,6 +623,8 @@ pub struct ObjGroup {
 pub struct ObjModel {
     pub groups: Vec<ObjGroup>,
     pub materials: Vec<MtlMaterial>,
+    /// The material libraries read, each once.
+    pub libraries: Vec<std::path::PathBuf>,
 }
 
 /// Loads an OBJ file keeping its materials: the faces are grouped by the material their
@@ -473,7 +635,7 @@ pub struct ObjModel {
 /// naming the file and line. Groups with no triangles are left out; a file with none at all is
 /// an error.
 pub fn load_obj_model(path: &Path) -> Result<ObjModel, GeometryError> {
-    let (models, materials) = parse_obj(path, Mtl::Use)?;
+    let (models, materials, libraries) = parse_obj(path, Mtl::Use)?;
     let mut ids: Vec<Option<usize>> = Vec::new();
     for m in &models {
         if !ids.contains(&m.mesh.material_id) {
@@ -515,7 +677,11 @@ pub fn load_obj_model(path: &Path) -> Result<ObjModel, GeometryError> {
             detail: "no faces with 3 or more vertices were found".into(),
         });
     }
-    Ok(ObjModel { groups, materials })
+    Ok(ObjModel {
+        groups,
+        materials,
+        libraries,
+    })
 }
 
 /// Loads a PLY file (ascii, binary little- or big-endian): element `vertex` with float
@@ -661,4 +827,43 @@ pub fn load_ply(path: &Path) -> Result<TriangleMesh, GeometryError> {
     }
     validate(path, &mesh)?;
     Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mtllib_names_split_after_each_mtl() {
+        assert_eq!(mtllib_names("a.mtl"), ["a.mtl"]);
+        assert_eq!(mtllib_names(" a.mtl  b.MTL "), ["a.mtl", "b.MTL"]);
+        assert_eq!(mtllib_names("my lib.mtl b.mtl"), ["my lib.mtl", "b.mtl"]);
+        assert_eq!(mtllib_names("a.mtlx.mtl c"), ["a.mtlx.mtl", "c"]);
+        assert_eq!(mtllib_names("materials"), ["materials"]);
+        assert!(mtllib_names("  ").is_empty());
+    }
+
+    #[test]
+    fn each_library_is_read_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("a.mtl"), "newmtl a\nKd 0.5 0.5 0.5\n").unwrap();
+        std::fs::write(d.join("b.mtl"), "newmtl b\nKd 0.5 0.5 0.5\n").unwrap();
+        std::fs::create_dir(d.join("x")).unwrap();
+        let mut obj = "mtllib a.mtl\nmtllib ./a.mtl b.mtl\nmtllib x/../a.mtl\n".repeat(5000);
+        obj.push_str("v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\n");
+        std::fs::write(d.join("m.obj"), obj).unwrap();
+        for use_them in [true, false] {
+            MTL_READS.with(|n| n.set(0));
+            if use_them {
+                let m = load_obj_model(&d.join("m.obj")).unwrap();
+                assert_eq!(m.materials.len(), 2);
+            } else {
+                load_obj(&d.join("m.obj")).unwrap();
+            }
+            // `./a.mtl` and `x/../a.mtl` are the same file by other spellings: read again, it
+            // would define material a twice.
+            assert_eq!(MTL_READS.with(|n| n.get()), 2, "use {use_them}");
+        }
+    }
 }

@@ -52,7 +52,7 @@ mod wide;
 pub use bvh::BUILD_PEAK_BYTES_PER_PRIM;
 pub(crate) use desc::mesh_err;
 pub use instance::{InstanceGroup, NO_INSTANCE};
-pub use io::{load_obj, load_obj_model, load_ply, ObjGroup, ObjModel};
+pub use io::{load_obj, load_obj_model, load_ply, model_file, ObjGroup, ObjModel};
 pub use prim::flat_point;
 pub use query::RayHit;
 pub use robust::{
@@ -115,6 +115,14 @@ pub enum GeometryError {
         path: PathBuf,
         vertex: usize,
         what: &'static str,
+    },
+    /// A model names a file outside its folder (see [`io::model_file`]).
+    #[error("model file '{}' names {what} {name:?}, which is outside the model's folder '{}'; a model may read only files beside it or below its folder (after resolving `..` and symbolic links), or data: URIs.", path.display(), folder.display())]
+    Outside {
+        path: PathBuf,
+        what: String,
+        name: String,
+        folder: PathBuf,
     },
     /// The file parsed fine but contains no usable triangles.
     #[error("mesh file '{}' contains no triangles: {detail}.", path.display())]

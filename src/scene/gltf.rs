@@ -604,6 +604,15 @@ pub fn model_parts(
     }
     let model = crate::geometry::gltf::load_gltf(&ctx.resolve(file))
         .map_err(|e| crate::geometry::mesh_err(ctx, field, file, e))?;
+    {
+        // A render refuses to overwrite them, and its state's hash covers them.
+        let mut sources = ctx.sources.borrow_mut();
+        for f in &model.files {
+            if !sources.contains(f) {
+                sources.push(f.clone());
+            }
+        }
+    }
     let mut lights = Vec::new();
     if with_lights {
         for (k, l) in model.lights.iter().enumerate() {

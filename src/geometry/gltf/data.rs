@@ -96,11 +96,21 @@ pub(super) fn resource(path: &Path, uri: &str, what: &str) -> Result<Resource, G
             ),
         ));
     }
-    Ok(Resource::File(
-        path.parent()
-            .unwrap_or(Path::new(""))
-            .join(percent_decode(uri)),
-    ))
+    let dir = path.parent().unwrap_or(Path::new(""));
+    super::super::model_file(path, dir, &percent_decode(uri), what)
+        .map(Resource::File)
+        .map_err(|e| match e {
+            // Named as the file writes it.
+            GeometryError::Outside {
+                path, what, folder, ..
+            } => GeometryError::Outside {
+                path,
+                what,
+                name: uri.to_string(),
+                folder,
+            },
+            e => e,
+        })
 }
 
 /// Reads a file a model names, through [`limits::read_file`].
@@ -117,11 +127,13 @@ pub(super) fn read_resource(
     })
 }
 
-/// The data of every buffer of `doc`, each at least as long as the buffer declares.
+/// The data of every buffer of `doc`, each at least as long as the buffer declares; the files
+/// read are appended to `files`.
 pub(super) fn buffers(
     path: &Path,
     doc: &gltf::Document,
     mut blob: Option<Vec<u8>>,
+    files: &mut Vec<PathBuf>,
 ) -> Result<Vec<Vec<u8>>, GeometryError> {
     let mut out = Vec::new();
     for b in doc.buffers() {
@@ -135,7 +147,10 @@ pub(super) fn buffers(
             })?,
             gltf::buffer::Source::Uri(uri) => match resource(path, uri, &what)? {
                 Resource::Data(d) => d,
-                Resource::File(f) => read_resource(path, &f, &what)?,
+                Resource::File(f) => {
+                    files.push(f.clone());
+                    read_resource(path, &f, &what)?
+                }
             },
         };
         if data.len() < b.length() {

@@ -165,6 +165,8 @@ pub struct GltfModel {
     pub cameras: Vec<GltfCamera>,
     /// Primitives left out because they are points or lines.
     pub skipped_primitives: usize,
+    /// The files the model names (buffers and images), each checked to lie in its folder.
+    pub files: Vec<PathBuf>,
 }
 
 impl GltfModel {
@@ -215,7 +217,8 @@ pub fn load_gltf(path: &Path) -> Result<GltfModel, GeometryError> {
             ));
         }
     }
-    let buffers = data::buffers(path, &document, blob)?;
+    let mut files = Vec::new();
+    let buffers = data::buffers(path, &document, blob, &mut files)?;
     let instances = instances(path, &document)?;
     check_mesh_memory(path, &document, &instances)?;
     let mut skipped = 0;
@@ -249,14 +252,20 @@ pub fn load_gltf(path: &Path) -> Result<GltfModel, GeometryError> {
             ),
         });
     }
+    check_world_positions(path, &document, &meshes, &instances)?;
     let materials = document
         .materials()
         .map(|m| material(path, &m))
         .collect::<Result<_, _>>()?;
-    let images = document
+    let images: Vec<GltfImage> = document
         .images()
         .map(|im| image(path, &im, &buffers))
         .collect::<Result<_, _>>()?;
+    for im in &images {
+        if let GltfImage::File(f) = im {
+            files.push(f.clone());
+        }
+    }
     let lights = lights(path, &document)?;
     let cameras = cameras(path, &document)?;
     Ok(GltfModel {
@@ -268,6 +277,7 @@ pub fn load_gltf(path: &Path) -> Result<GltfModel, GeometryError> {
         lights,
         cameras,
         skipped_primitives: skipped,
+        files,
     })
 }
 
@@ -412,6 +422,68 @@ fn check_mesh_memory(
             message,
         }
     })
+}
+
+/// Refuses a vertex that a node's transform puts at a non-finite position or beyond
+/// [`super::bvh::MAX_COORDINATE`] (a valid vertex can be scaled out of range), naming the node,
+/// mesh, primitive, vertex and accessor. Each primitive's bounding box is transformed first;
+/// only when it reaches out are its vertices searched.
+fn check_world_positions(
+    path: &Path,
+    doc: &gltf::Document,
+    meshes: &[GltfMesh],
+    instances: &[GltfInstance],
+) -> Result<(), GeometryError> {
+    let max = super::bvh::MAX_COORDINATE;
+    let far = |p: Vec3| !p.is_finite() || p.abs().max_element() > max;
+    for inst in instances {
+        for (k, prim) in meshes[inst.mesh].primitives.iter().enumerate() {
+            let ps = &prim.mesh.positions;
+            let (lo, hi) = ps
+                .iter()
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+                    (a.min(*p), b.max(*p))
+                });
+            if ps.is_empty() {
+                continue;
+            }
+            let corners = (0..8).map(|c| {
+                let pick = |bit: u32, l: f32, h: f32| if c & bit == 0 { l } else { h };
+                inst.world.transform_point3(Vec3::new(
+                    pick(1, lo.x, hi.x),
+                    pick(2, lo.y, hi.y),
+                    pick(4, lo.z, hi.z),
+                ))
+            });
+            if !corners.into_iter().any(far) {
+                continue;
+            }
+            let Some((v, w)) = (ps.iter().enumerate())
+                .map(|(v, p)| (v, inst.world.transform_point3(*p)))
+                .find(|(_, w)| far(*w))
+            else {
+                continue;
+            };
+            // The k-th triangle primitive kept, by its index in the file.
+            let gp = doc.meshes().nth(inst.mesh).and_then(|m| {
+                m.primitives()
+                    .filter(|p| p.mode() == gltf::mesh::Mode::Triangles)
+                    .nth(k)
+            });
+            let index = gp.as_ref().map_or(k, |p| p.index());
+            let accessor = (gp.as_ref())
+                .and_then(|p| p.get(&gltf::Semantic::Positions))
+                .map_or(String::new(), |a| format!(" (accessor {})", a.index()));
+            return Err(parse_err(
+                path,
+                format!(
+                    "node {} places vertex {v} of mesh {} primitive {index}{accessor} at ({}, {}, {}) m; geometry must lie within ±{max:e} m of the origin",
+                    inst.node, inst.mesh, w.x, w.y, w.z
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn primitive(

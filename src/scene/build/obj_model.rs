@@ -31,8 +31,12 @@ pub(super) fn model_parts(
     materials: &mut Vec<Material>,
 ) -> Result<Vec<Part>, SceneError> {
     let shape_field = format!("{field}.shape");
-    let model = geometry::load_obj_model(&ctx.resolve(file))
+    let obj = ctx.resolve(file);
+    let model = geometry::load_obj_model(&obj)
         .map_err(|e| geometry::mesh_err(ctx, &shape_field, file, e))?;
+    for lib in &model.libraries {
+        record(ctx, lib);
+    }
     let names = || {
         let mut n: Vec<&str> = model.materials.iter().map(|m| m.name.as_str()).collect();
         n.sort_unstable();
@@ -91,6 +95,11 @@ pub(super) fn model_parts(
                 materials.len() as u32 - 1
             }
             None => {
+                for (stmt, map) in [("map_Kd", &mtl.map_kd), ("norm", &mtl.norm)] {
+                    if let Some(map) = map {
+                        map_file(ctx, &shape_field, &obj, mtl, stmt, map)?;
+                    }
+                }
                 materials.push(Material::from_mtl(ctx, &shape_field, mtl)?);
                 materials.len() as u32 - 1
             }
@@ -114,6 +123,7 @@ pub(super) fn model_parts(
                     Some(map) => Some(match emissive_maps.get(&name) {
                         Some(t) => t.clone(),
                         None => {
+                            map_file(ctx, &shape_field, &obj, mtl, "map_Ke", map)?;
                             let t =
                                 std::sync::Arc::new(emission_map(ctx, &shape_field, mtl, map, ke)?);
                             emissive_maps.insert(name.clone(), t.clone());
@@ -183,4 +193,36 @@ fn emission_map(
         crate::texture::Wrap::Repeat
     };
     Ok(t)
+}
+
+/// Records `file` among the scene's sources: a render refuses to overwrite it and its state's
+/// hash covers it.
+pub(super) fn record(ctx: &Context, file: &std::path::Path) {
+    let mut sources = ctx.sources.borrow_mut();
+    if !sources.iter().any(|s| s == file) {
+        sources.push(file.to_path_buf());
+    }
+}
+
+/// The image of material `mtl`'s map `stmt` (relative to its MTL file), checked to lie inside
+/// the OBJ file `obj`'s folder and recorded among the scene's sources.
+fn map_file(
+    ctx: &Context,
+    shape_field: &str,
+    obj: &std::path::Path,
+    mtl: &geometry::mtl::MtlMaterial,
+    stmt: &str,
+    map: &geometry::mtl::MtlMap,
+) -> Result<(), SceneError> {
+    let dir = mtl.file.parent().unwrap_or(std::path::Path::new(""));
+    let what = format!(
+        "the `{stmt}` image of material {:?} ('{}' line {})",
+        mtl.name,
+        mtl.file.display(),
+        mtl.line
+    );
+    let file = geometry::model_file(obj, dir, &map.file, &what)
+        .map_err(|e| ctx.err(shape_field, e.to_string()))?;
+    record(ctx, &file);
+    Ok(())
 }
