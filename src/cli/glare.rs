@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use candela::glare::file::read_glare_image;
 use candela::glare::{
-    evaluate_uncertain, GlareOptions, Interval, Task, Threshold, UncertainGlare, UncertainOptions,
+    evaluate_uncertain, Background, GlareOptions, Interval, PositionIndexUp, Task, Threshold,
+    UncertainGlare, UncertainOptions,
 };
 
 /// Arguments of `candela glare`.
@@ -22,8 +23,22 @@ pub struct GlareArgs {
     #[arg(long, default_value_t = 0.2)]
     pub search_angle: f64,
     /// Do not split sources' peaks above 50 000 cd/m² into sources of their own (evalglare `-x`).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "peak_limit")]
     pub no_peaks: bool,
+    /// Peak extraction limit in cd/m² (evalglare `-Y`): the pixels of a source at or above it
+    /// become sources of their own when any glare pixel exceeds it (default 50 000).
+    #[arg(long, value_name = "CD_M2")]
+    pub peak_limit: Option<f64>,
+    /// Background luminance of UGR and DGI (evalglare `-q`): `cie` (E_v − E_dir)/π (`-q 0`,
+    /// default), `mean` the mean luminance outside the sources (`-q 1`), `ev-over-pi` E_v/π
+    /// (`-q 2`).
+    #[arg(long, default_value = "cie", value_parser = ["cie", "mean", "ev-over-pi"])]
+    pub background: String,
+    /// The up vector of the position index: `as-given` the view's up (Radiance `-vu`) as
+    /// given, as evalglare takes it (default); `perpendicular` made perpendicular to the line
+    /// of sight, the image's vertical.
+    #[arg(long, default_value = "as-given", value_parser = ["as-given", "perpendicular"])]
+    pub position_index_up: String,
     /// Apply DGP's low-light correction below 1000 lx (evalglare `-C l+`).
     #[arg(long)]
     pub low_light: bool,
@@ -49,6 +64,9 @@ impl GlareArgs {
             threshold: None,
             search_angle: 0.2,
             no_peaks: false,
+            peak_limit: None,
+            background: "cie".into(),
+            position_index_up: "as-given".into(),
             low_light: false,
             task: None,
             draws: 64,
@@ -96,6 +114,23 @@ fn evaluate(args: &GlareArgs) -> anyhow::Result<(UncertainGlare, bool)> {
     if args.no_peaks {
         opt.detect.peak_limit_cd_m2 = None;
     }
+    if let Some(y) = args.peak_limit {
+        if !(y.is_finite() && y > 0.0) {
+            return Err(super::usage(format!(
+                "--peak-limit must be a positive luminance in cd/m², got {y}"
+            )));
+        }
+        opt.detect.peak_limit_cd_m2 = Some(y);
+    }
+    opt.background = match args.background.as_str() {
+        "mean" => Background::Mean,
+        "ev-over-pi" => Background::EvOverPi,
+        _ => Background::Cie,
+    };
+    opt.position_index_up = match args.position_index_up.as_str() {
+        "perpendicular" => PositionIndexUp::Perpendicular,
+        _ => PositionIndexUp::AsGiven,
+    };
     opt.low_light_correction = args.low_light;
     let task = args.task.as_deref().map(parse_task).transpose()?;
     let img = read_glare_image(&args.image)?;

@@ -25,7 +25,9 @@ pub struct GlareImage {
     pub inside: Vec<bool>,
     /// Unit line of sight.
     pub view_dir: [f64; 3],
-    /// Up vector (need not be perpendicular to `view_dir`; only its component across it is used).
+    /// Up vector (need not be perpendicular to `view_dir`: the image's vertical is its
+    /// component across it; the position index takes it as given or made perpendicular,
+    /// [`super::PositionIndexUp`]).
     pub up: [f64; 3],
 }
 
@@ -166,6 +168,14 @@ impl GlareImage {
         let right = normalize(cross(v, self.up)).expect("validated");
         (v, cross(right, v))
     }
+
+    /// The unit up vector the position index measures from.
+    pub(crate) fn position_up(&self, convention: super::PositionIndexUp) -> [f64; 3] {
+        match convention {
+            super::PositionIndexUp::AsGiven => normalize(self.up).expect("validated"),
+            super::PositionIndexUp::Perpendicular => self.frame().1,
+        }
+    }
 }
 
 /// Per-pixel directions, solid angles (sr) and inside mask of a Radiance angular fisheye view
@@ -182,22 +192,85 @@ pub fn angular_fisheye(
     h_deg: f64,
     v_deg: f64,
 ) -> (Vec<[f64; 3]>, Vec<f64>, Vec<bool>) {
-    let ray = |lx: f64, ly: f64| -> Option<[f64; 3]> {
-        let x = (lx - 0.5) * h_deg / 180.0;
-        let y = (ly - 0.5) * v_deg / 180.0;
-        let d2 = x * x + y * y;
-        if d2 > 1.0 {
-            return None;
+    radiance_view_pixels('a', width, height, h_deg, v_deg, (0.0, 0.0))
+}
+
+/// Radiance's `viewray` for view type `kind` (`a` angular fisheye, `h` hemispherical, `s`
+/// stereographic, `v` perspective) at image location (`lx`, `ly`) in [0, 1]² (y up), for the
+/// full angles `h_deg`, `v_deg` and the view shift and lift `offset`; `None` outside the view.
+fn radiance_ray(
+    kind: char,
+    h_deg: f64,
+    v_deg: f64,
+    offset: (f64, f64),
+    lx: f64,
+    ly: f64,
+) -> Option<[f64; 3]> {
+    use std::f64::consts::PI;
+    let (x, y) = (lx + offset.0 - 0.5, ly + offset.1 - 0.5);
+    let half = |deg: f64| 0.5 * deg.to_radians();
+    match kind {
+        'v' => normalize([
+            2.0 * x * half(h_deg).tan(),
+            2.0 * y * half(v_deg).tan(),
+            1.0,
+        ]),
+        'h' => {
+            let (x, y) = (2.0 * x * half(h_deg).sin(), 2.0 * y * half(v_deg).sin());
+            let d2 = x * x + y * y;
+            (d2 <= 1.0).then(|| [x, y, (1.0 - d2).sqrt()])
         }
-        let d = d2.sqrt();
-        let z = (std::f64::consts::PI * d).cos();
-        let s = if d <= 1e-6 {
-            std::f64::consts::PI
-        } else {
-            (1.0 - z * z).max(0.0).sqrt() / d
-        };
-        Some([x * s, y * s, z])
-    };
+        's' => {
+            // r = tan(θ/2): the image edge at half the view angle.
+            let (x, y) = (
+                2.0 * x * (0.5 * half(h_deg)).tan(),
+                2.0 * y * (0.5 * half(v_deg)).tan(),
+            );
+            let d2 = x * x + y * y;
+            let z = (1.0 - d2) / (1.0 + d2);
+            let s = if d2 <= 1e-12 {
+                1.0
+            } else {
+                ((1.0 - z * z).max(0.0) / d2).sqrt()
+            };
+            Some([x * s, y * s, z])
+        }
+        _ => {
+            let (x, y) = (x * h_deg / 180.0, y * v_deg / 180.0);
+            let d2 = x * x + y * y;
+            if d2 > 1.0 {
+                return None;
+            }
+            let d = d2.sqrt();
+            let z = (PI * d).cos();
+            let s = if d <= 1e-6 {
+                PI
+            } else {
+                (1.0 - z * z).max(0.0).sqrt() / d
+            };
+            Some([x * s, y * s, z])
+        }
+    }
+}
+
+/// Per-pixel directions, solid angles (sr) and inside mask of a Radiance view of type `kind`
+/// (`a`, `h`, `s` or `v`, as in `-vta`) with full angles `h_deg` × `v_deg` and view shift and
+/// lift `offset` (`-vs`, `-vl`), as evalglare takes them: the direction through each pixel's
+/// centre, the solid angle of the spherical quadrilateral through its corners' directions (0
+/// if a corner is outside the view), inside when that is positive and, for `-vta`, the centre
+/// is not behind the eye. Row 0 at the top; view direction +z, up +y.
+///
+/// A stereographic view wider than 180° sees behind the eye in its corners; evalglare counts
+/// those pixels (with cos θ < 0 in E_v), candela leaves them out as for `-vta`.
+pub fn radiance_view_pixels(
+    kind: char,
+    width: usize,
+    height: usize,
+    h_deg: f64,
+    v_deg: f64,
+    offset: (f64, f64),
+) -> (Vec<[f64; 3]>, Vec<f64>, Vec<bool>) {
+    let ray = |lx: f64, ly: f64| radiance_ray(kind, h_deg, v_deg, offset, lx, ly);
     let n = width * height;
     let (mut dirs, mut omega, mut inside) = (vec![[0.0; 3]; n], vec![0.0; n], vec![false; n]);
     for row in 0..height {
@@ -217,7 +290,8 @@ pub fn angular_fisheye(
             if let [Some(a), Some(b), Some(c), Some(e)] = corners {
                 omega[i] = spherical_quad_area(a, b, c, e);
             }
-            inside[i] = d[2] >= 0.0 && omega[i] > 0.0;
+            let behind = matches!(kind, 'a' | 's') && d[2] < 0.0;
+            inside[i] = !behind && omega[i] > 0.0 && omega[i].is_finite();
         }
     }
     (dirs, omega, inside)

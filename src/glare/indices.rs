@@ -18,6 +18,22 @@ pub enum Background {
     EvOverPi,
 }
 
+/// Which up vector the position index measures the angle τ from.
+///
+/// A Radiance view's `-vu` need not be perpendicular to `-vd` (`-vu 0 0 1` with a tilted
+/// line of sight is the usual way to write it); the image's vertical is `-vu` made
+/// perpendicular. evalglare takes τ from `-vu` as given, so in a tilted view its τ never
+/// reaches 0° or 180°; above or below the line of sight is decided by the perpendicular up.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PositionIndexUp {
+    /// The image's `up` as given (evalglare's convention; the default).
+    #[default]
+    AsGiven,
+    /// `up` made perpendicular to the line of sight: the image's vertical, the direction
+    /// Guth's table measures from.
+    Perpendicular,
+}
+
 /// Coefficients of DGP = c1·E_v^a5 + c2·log10(1 + Σ L^a1 ω^a2 / (E_v^a3 P^a4)) + c3
 /// (evalglare `-w a1 a2 a3 a4 a5 c1 c2 c3`; defaults from Wienold & Christoffersen 2006 as
 /// evalglare rounds them).
@@ -57,6 +73,8 @@ pub struct GlareOptions {
     /// DGP low-light correction (evalglare `-C l+`; off by default since evalglare 2.14):
     /// below 1000 lx DGP is multiplied by e^(0.024 E_v − 4)/(1 + e^(0.024 E_v − 4)).
     pub low_light_correction: bool,
+    /// The up vector of the position index (default evalglare's, `up` as given).
+    pub position_index_up: PositionIndexUp,
 }
 
 /// One glare source as reported.
@@ -106,17 +124,26 @@ pub struct GlareResult {
     pub sources: Vec<SourceReport>,
 }
 
-/// Guth position index of direction `dir` for line of sight `view` and up vector `up` (unit,
-/// perpendicular), as evalglare computes it: above the line of sight the IES handbook's fit of
+/// Guth position index of direction `dir` for unit line of sight `view` and up vector `up`, as
+/// evalglare computes it: above the line of sight the IES handbook's fit of
 /// Guth's data,
 ///   P = exp((35.2 − 0.31889 τ − 1.22 e^(−2τ/9))·10⁻³ σ + (21 + 0.26667 τ − 0.002963 τ²)·10⁻⁵ σ²),
 /// below it Iwata & Osterhaus (CIE 2010) in Kikuchi's coordinates,
 ///   β = atan(tan σ · √(1 + 0.3225 cos²τ)), P = exp(6.49·10⁻³ β + 21·10⁻⁵ β²),
-/// σ the angle from the line of sight and τ the angle from up of the direction's projection
-/// across the line of sight, both in degrees; capped at 16.
+/// σ the angle from the line of sight and τ the angle from `up` of the direction's projection
+/// across the line of sight, both in degrees; capped at 16. `up` is used as given (it need not
+/// be perpendicular to `view`; see [`PositionIndexUp`]); above or below the line of sight is
+/// decided by its component across `view`.
 pub fn position_index(dir: [f64; 3], view: [f64; 3], up: [f64; 3]) -> f64 {
     let deg = 180.0 / std::f64::consts::PI;
     let d = normalize(dir).unwrap_or(view);
+    let up = normalize(up).unwrap_or([0.0, 1.0, 0.0]);
+    let k = dot(up, view);
+    let up_across = [
+        up[0] - k * view[0],
+        up[1] - k * view[1],
+        up[2] - k * view[2],
+    ];
     let cos_s = dot(view, d).clamp(-1.0, 1.0);
     let sigma_rad = cos_s.acos();
     let sigma = sigma_rad * deg;
@@ -131,7 +158,7 @@ pub fn position_index(dir: [f64; 3], view: [f64; 3], up: [f64; 3]) -> f64 {
         .map(|h| dot(up, h).clamp(-1.0, 1.0).acos())
         .unwrap_or(std::f64::consts::FRAC_PI_2)
         * deg;
-    let above = dot(up, d) >= 0.0;
+    let above = dot(up_across, d) >= 0.0;
     let p = if above {
         ((35.2 - 0.31889 * tau - 1.22 * (-2.0 * tau / 9.0).exp()) / 1000.0 * sigma
             + (21.0 + 0.26667 * tau - 0.002963 * tau * tau) / 100_000.0 * sigma * sigma)
@@ -276,7 +303,8 @@ pub(crate) fn evaluate_detected(
     lum: &[f64],
     opt: &GlareOptions,
 ) -> (GlareResult, Detection) {
-    let (view, up) = img.frame();
+    let (view, _) = img.frame();
+    let up = img.position_up(opt.position_index_up);
     let det: Detection = detect(img, lum, &opt.detect);
     let ev = vertical_illuminance(img, lum);
     let ev_direct: f64 = det.sources.iter().map(|s| s.illuminance_lx).sum();

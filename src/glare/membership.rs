@@ -120,7 +120,8 @@ pub(crate) fn membership(
     opt: &GlareOptions,
 ) -> Membership {
     let t = det.threshold_cd_m2;
-    let (view, up) = img.frame();
+    let (view, _) = img.frame();
+    let up = img.position_up(opt.position_index_up);
     let near: Vec<usize> = (0..img.len())
         .filter(|&i| img.valid(i) && se[i] > 0.0 && (lum[i] - t).abs() < BAND * se[i])
         .collect();

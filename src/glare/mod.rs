@@ -22,7 +22,7 @@ pub mod sources;
 pub use image::{angular_fisheye, GlareImage, ImageError};
 pub use indices::{
     evaluate, evaluate_luminance, position_index, Background, DgpCoefficients, GlareOptions,
-    GlareResult, SourceReport, SourceTerm,
+    GlareResult, PositionIndexUp, SourceReport, SourceTerm,
 };
 pub use interval::{
     evaluate_uncertain, significant_sources, Interval, UncertainGlare, UncertainOptions,
