@@ -260,9 +260,9 @@ fn epw_reader_against_ladybug() {
     assert_eq!(w.site.elevation_m, lb["elevation"].as_f64().unwrap());
     type Get = fn(&candela::daylight::epw::Record) -> Option<f64>;
     let summed: [(&str, Get); 4] = [
-        ("direct_normal_radiation", |r| r.direct_normal_w_m2),
+        ("direct_normal_radiation", |r| Some(r.direct_normal_w_m2)),
         ("diffuse_horizontal_radiation", |r| {
-            r.diffuse_horizontal_w_m2
+            Some(r.diffuse_horizontal_w_m2)
         }),
         ("direct_normal_illuminance", |r| r.direct_normal_lx),
         ("diffuse_horizontal_illuminance", |r| {

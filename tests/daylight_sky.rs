@@ -406,11 +406,14 @@ fn daylight_factor_in_report_files() {
 }
 
 /// `Weather(file, time)`: the Perez sky and sun of one hour of tests/data/lyon-excerpt.epw (a
-/// synthetic excerpt in EPW format). An unobstructed horizontal meter reads the record's
-/// diffuse-horizontal illuminance plus its direct-normal illuminance times the sine of the
-/// sun's altitude at that time (local standard time UTC+1, the file's site).
+/// synthetic excerpt in EPW format). An unobstructed horizontal meter reads the diffuse-
+/// horizontal illuminance plus the direct-normal illuminance times the sine of the sun's
+/// altitude at that time (local standard time UTC+1, the file's site), the illuminances those
+/// of the record's irradiances under the Perez efficacy model (the file's own illuminance
+/// fields, 77 000 and 11 160 lx, are not used).
 #[test]
 fn weather_file_hour() {
+    use candela::daylight::perez::{eccentricity, SkyCondition};
     use candela::daylight::sun::{sun_position, Atmosphere, CivilTime};
     let file = "tests/data/lyon-excerpt.epw";
     let alt = |iso: &str| {
@@ -420,14 +423,27 @@ fn weather_file_hour() {
             .altitude_deg
             .to_radians()
     };
-    // 10:30 is in the record of hour 11: 77 000 lx direct normal, 11 160 lx diffuse.
+    // 10:30 is in the record of hour 11: 770 W/m² direct normal, 93 W/m² diffuse, dew point
+    // 12.3 °C; 21 June is day 172.
+    let a = alt("2003-06-21T10:30:00+01:00");
+    let (_, e_vn, e_vd) = SkyCondition::illuminance_from_irradiance(
+        93.0,
+        770.0,
+        std::f64::consts::FRAC_PI_2 - a,
+        eccentricity(172.0),
+        12.3,
+    )
+    .unwrap();
+    // The efficacies are those of a clear sky.
+    assert!((90.0..110.0).contains(&(e_vn / 770.0)), "{e_vn}");
+    assert!((100.0..140.0).contains(&(e_vd / 93.0)), "{e_vd}");
     let r = measure(
         &format!(r#"Weather(file: "{file}", time: "06-21 10:30")"#),
         "",
         UP_METER,
         4096,
     );
-    let expected = 11_160.0 + 77_000.0 * alt("2003-06-21T10:30:00+01:00").sin();
+    let expected = e_vd + e_vn * a.sin();
     assert_estimate_near(r[0].0, r[0].1, expected, 0.01, "weather 06-21 10:30");
     // Without its sun's disk: the diffuse part alone.
     let r = measure(
@@ -436,7 +452,7 @@ fn weather_file_hour() {
         UP_METER,
         4096,
     );
-    assert_estimate_near(r[0].0, r[0].1, 11_160.0, 0.01, "weather, no disk");
+    assert_estimate_near(r[0].0, r[0].1, e_vd, 0.01, "weather, no disk");
     // 22 June has irradiances only: the efficacy model turns them into illuminances, so the
     // sky's diffuse part lies between 100 and 140 lm/W times its 260 sin(…) W/m².
     let w = common::world(&format!(
@@ -586,4 +602,154 @@ fn perez_from_irradiance() {
     let r = measure(&sky, "", UP_METER, 4096);
     let expected = dh + dn * 40f64.to_radians().sin();
     assert_estimate_near(r[0].0, r[0].1, expected, 0.01, "Perez from irradiance");
+}
+
+/// A year of physically possible weather at Lyon (45.73° N, 4.94° E, UTC+1) in EPW format:
+/// direct light while the sun is up at the end of the hour (so the hour of sunrise has some
+/// with the sun still down at its middle), diffuse light growing with the sun's height.
+fn lyon_year(path: &std::path::Path) {
+    use candela::daylight::sun::{sun_position, Atmosphere, CivilTime};
+    let mut out = String::from(
+        "LOCATION,Lyon-Bron,ARA,FRA,candela synthetic,074800,45.73,4.94,1.0,201.0\n\
+         DESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\n\
+         HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\nCOMMENTS 1,synthetic\nCOMMENTS 2,synthetic\n\
+         DATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n",
+    );
+    let days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+    let sin_alt = |m: u32, d: u32, s: f64| {
+        let t = CivilTime {
+            year: 2003,
+            month: m,
+            day: d,
+            seconds: s,
+            offset_s: 3600.0,
+        };
+        let p = sun_position(45.73, 4.94, 201.0, &t, Atmosphere::default(), None).unwrap();
+        p.altitude_deg.to_radians().sin()
+    };
+    for (m, &n) in (1u32..).zip(days.iter()) {
+        for d in 1..=n {
+            let k = [0.1, 0.5, 1.0][(d % 3) as usize];
+            for h in 1..=24u32 {
+                let (mid, end) = (
+                    sin_alt(m, d, (h as f64 - 0.5) * 3600.0),
+                    sin_alt(m, d, h as f64 * 3600.0),
+                );
+                let dn = if end > 0.005 { 800.0 * k } else { 0.0 };
+                let dh = if mid > -0.1 || end > 0.0 {
+                    10.0 + 200.0 * mid.max(0.0)
+                } else {
+                    0.0
+                };
+                out += &format!(
+                    "2003,{m},{d},{h},60,A7A7E8E8*0?9?9?9?9?9?9?9A7A7A7A7A7*0*0E8E8*0*0,10.0,12.0,60,\
+                     98600,1310,1367,350,9999,{dn:.0},{dh:.0},999999,999999,999999,9999,180,\
+                     3.0,5,3,20.0,77777,9,999999999,0,0.2,0,88,0.0,0.0,0.0\n"
+                );
+            }
+        }
+    }
+    std::fs::write(path, out).unwrap();
+}
+
+/// A `Weather` light at the middle of a record's hour and `candela annual`'s sky of that hour
+/// are one sky: the same diffuse-horizontal and direct-normal illuminances (to 10⁻⁸: annual keeps
+/// the model's sun 10⁻⁹ rad off the horizon), and the
+/// same luminance on each of Reinhart's 577 patches (by annual's 4 × 4 quadrature) and on the ground (to 2·10⁻⁴: the two
+/// normalise the distribution on grids of 512 × 1024 and 128 × 256 cells), for a morning, a
+/// noon, a winter afternoon and the hour of sunrise, whose direct light both drop because the
+/// sun is still down at its middle. A render of the noon hour's unobstructed horizontal
+/// illuminance with the light agrees with annual's E_vd + E_vn sin(altitude) within its
+/// Monte Carlo error.
+#[test]
+fn weather_light_and_annual_see_the_same_sky() {
+    use candela::annual::year::hourly_skies;
+    use candela::daylight::epw::Weather;
+    use candela::daylight::patches::SkyPatches;
+    use candela::light::Light;
+    use candela::photometry::luminous_integral;
+    use glam::DVec3;
+    let dir = tempfile::tempdir().unwrap();
+    let epw = dir.path().join("year.epw");
+    lyon_year(&epw);
+    let weather = Weather::read(&epw).unwrap();
+    assert!(weather.is_full_year());
+    let patches = SkyPatches::new(2).unwrap();
+    let year = hourly_skies(&weather, &patches, 0.2).unwrap();
+    let file = epw.to_str().unwrap();
+    let mut sunrise_checked = false;
+    for (m, d, h) in [(3, 21, 9), (6, 21, 14), (12, 21, 15), (6, 21, 5)] {
+        let hs = year
+            .iter()
+            .find(|s| (s.month, s.day, s.hour) == (m, d, h))
+            .unwrap();
+        let time = format!("{m:02}-{d:02} {:02}:30", h - 1);
+        let w = world(&format!(
+            "({CAMERA}, lights: [Weather(file: \"{file}\", time: \"{time}\")])"
+        ));
+        let Light::Sky(sky) = &w.lights[0] else {
+            panic!("a sky first")
+        };
+        let sun_lx = w
+            .lights
+            .iter()
+            .find_map(|l| match l {
+                Light::Sun(s) => Some(s.normal_illuminance_lx),
+                _ => None,
+            })
+            .unwrap_or(0.0);
+        let label = format!(
+            "{time}: annual {:?}",
+            (hs.sky.diffuse_horizontal_lx, hs.sky.direct_normal_lx)
+        );
+        assert!(hs.sky.diffuse_horizontal_lx > 0.0, "{label}");
+        assert!(
+            (sky.horizontal_illuminance_lx / hs.sky.diffuse_horizontal_lx - 1.0).abs() < 1e-8,
+            "{label}: the light's {}",
+            sky.horizontal_illuminance_lx
+        );
+        assert!(
+            (sun_lx - hs.sky.direct_normal_lx).abs() <= 1e-8 * sun_lx.max(1.0),
+            "{label}: the light's sun {sun_lx}"
+        );
+        if h == 5 {
+            // 04:30 on 21 June: the sun is below the horizon, the record has direct light.
+            let r = weather.at(6, 21, 4, 30).unwrap();
+            assert!(r.direct_normal_w_m2 > 0.0 && hs.sun_altitude_deg < 0.0);
+            assert_eq!(sun_lx, 0.0);
+            sunrise_checked = true;
+        }
+        let k = luminous_integral(&sky.radiance);
+        let mut worst = 0.0f64;
+        for i in 1..patches.len() {
+            let p = patches.patch(i).unwrap();
+            let mean = k * patches.integrate(i, 4, |v| {
+                sky.distribution.relative(DVec3::from_array(v), sky.sun)
+            }) / p.solid_angle_sr;
+            let a = hs.sky.luminance_cd_m2[i];
+            worst = worst.max((mean - a).abs() / a);
+        }
+        assert!(
+            worst < 2e-4,
+            "{label}: patch luminance differs by {worst:e}"
+        );
+        let ground = luminous_integral(&sky.ground);
+        assert!(
+            (ground / hs.sky.luminance_cd_m2[0] - 1.0).abs() < 2e-4,
+            "{label}: ground {ground} against {}",
+            hs.sky.luminance_cd_m2[0]
+        );
+        if h == 14 {
+            let r = measure(
+                &format!(r#"Weather(file: "{file}", time: "{time}")"#),
+                "",
+                UP_METER,
+                4096,
+            );
+            let e = hs.sky.diffuse_horizontal_lx
+                + hs.sky.direct_normal_lx * hs.sun_altitude_deg.to_radians().sin();
+            assert_estimate_near(r[0].0, r[0].1, e, 0.01, &label);
+        }
+    }
+    assert!(sunrise_checked);
 }

@@ -120,17 +120,27 @@ fn view_json(v: &super::run::ViewRun) -> Value {
 /// direct_stderr`: the illuminance per lx of direct-normal illuminance, in total and of the
 /// direct sun alone).
 pub fn write_coefficients(sky: &Path, sun: &Path, run: &AnnualRun) -> Result<(), OutputError> {
-    let Some((c, sc)) = &run.coefficients else {
-        return Ok(());
-    };
-    let points: Vec<(String, usize, usize)> = run
-        .grids
+    write_sky_coefficients(sky, run)?;
+    write_sun_coefficients(sun, run)
+}
+
+/// Each grid point as (grid name made CSV-safe, i, j).
+fn coefficient_points(run: &AnnualRun) -> Vec<(String, usize, usize)> {
+    run.grids
         .iter()
         .flat_map(|g| {
             let name = g.name.replace([',', '"', '\n', '\r'], "_");
             (0..g.points.len()).map(move |k| (name.clone(), k % g.nx as usize, k / g.nx as usize))
         })
-        .collect();
+        .collect()
+}
+
+/// The sky half of [`write_coefficients`].
+pub fn write_sky_coefficients(sky: &Path, run: &AnnualRun) -> Result<(), OutputError> {
+    let Some((c, _)) = &run.coefficients else {
+        return Ok(());
+    };
+    let points = coefficient_points(run);
     crate::output::write_atomic(sky, |w| {
         writeln!(
             w,
@@ -156,7 +166,15 @@ pub fn write_coefficients(sky: &Path, sun: &Path, run: &AnnualRun) -> Result<(),
             }
         }
         Ok(())
-    })?;
+    })
+}
+
+/// The sun half of [`write_coefficients`].
+pub fn write_sun_coefficients(sun: &Path, run: &AnnualRun) -> Result<(), OutputError> {
+    let Some((_, sc)) = &run.coefficients else {
+        return Ok(());
+    };
+    let points = coefficient_points(run);
     crate::output::write_atomic(sun, |w| {
         writeln!(
             w,
@@ -387,12 +405,12 @@ pub fn output_paths(
 
 /// The heat maps of each grid: daylight autonomy and useful daylight illuminance (%, on a
 /// fixed 0–100 scale) and hours of direct sun above the ASE threshold (h, 0 to the largest),
-/// as NAME.annual.grid-SLUG.da.png, .udi.png and .sun-hours.png. Returns the paths written.
-pub fn write_heatmaps(stem: &Path, run: &AnnualRun) -> Result<Vec<PathBuf>, OutputError> {
+/// as NAME.annual.grid-SLUG.da.png, .udi.png and .sun-hours.png, each attempted whether or
+/// not an earlier one failed.
+pub fn write_heatmaps(stem: &Path, run: &AnnualRun, writes: &mut crate::job::Writes) {
     use crate::report::falsecolour::FalsecolourSettings;
     use crate::report::heatmap::{render_metric_heatmap, GridMetric, GridValues};
     let t = &run.settings.thresholds;
-    let mut written = Vec::new();
     for (g, r) in run.grids.iter().zip(&run.results) {
         let (nx, ny) = (g.nx as usize, g.ny as usize);
         // (file key, title, unit, values, scale maximum)
@@ -458,11 +476,108 @@ pub fn write_heatmaps(stem: &Path, run: &AnnualRun) -> Result<Vec<PathBuf>, Outp
                 name,
                 unit: unit.to_string(),
             };
-            let (img, _) = render_metric_heatmap(&grid, &metric, &settings)
-                .map_err(|e| OutputError::invalid(&path, e))?;
-            crate::output::write_rgb_png(&path, &img)?;
-            written.push(path);
+            writes.attempt(&path, || {
+                let (img, _) = render_metric_heatmap(&grid, &metric, &settings)
+                    .map_err(|e| OutputError::invalid(&path, e))?;
+                crate::output::write_rgb_png(&path, &img)?;
+                Ok(())
+            });
         }
     }
+}
+
+/// Every file of a run with output stem `stem`: the JSON report, the hourly CSV, the glare CSV
+/// (with a view), the coefficient CSVs (when kept) and the heat maps. Each is attempted
+/// whether or not an earlier one failed; the error lists every file that could not be
+/// written. Returns the files written.
+pub fn write_all(stem: &Path, run: &AnnualRun) -> anyhow::Result<Vec<String>> {
+    let mut writes = crate::job::Writes::default();
+    let named = |suffix: &str| crate::output::with_suffix(stem, suffix);
+    let json = named(".annual.json");
+    writes.attempt(&json, || Ok(write_json(&json, run)?));
+    let csv = named(".annual.csv");
+    writes.attempt(&csv, || Ok(write_csv(&csv, run)?));
+    if run.view.is_some() {
+        let glare = named(".annual-glare.csv");
+        writes.attempt(&glare, || Ok(write_glare_csv(&glare, run)?));
+    }
+    if run.coefficients.is_some() {
+        let (sky, sun) = (named(".annual-sky-dc.csv"), named(".annual-sun-dc.csv"));
+        writes.attempt(&sky, || Ok(write_sky_coefficients(&sky, run)?));
+        writes.attempt(&sun, || Ok(write_sun_coefficients(&sun, run)?));
+    }
+    write_heatmaps(stem, run, &mut writes);
+    let written = std::mem::take(&mut writes.written);
+    writes.finish()?;
     Ok(written)
+}
+
+/// What a run will write, for [`check_room`].
+#[derive(Clone, Copy, Debug)]
+pub struct Planned {
+    pub points: usize,
+    pub hours: usize,
+    pub sunny_hours: usize,
+    pub patches: usize,
+    pub grids: usize,
+    pub glare: bool,
+    pub coefficients: bool,
+}
+
+impl Planned {
+    /// The fewest bytes the CSV files take: every value is written with 6 decimals, so
+    /// ",0.000000" (9 bytes) at the least. The JSON report and the heat maps come on top.
+    pub fn minimum_bytes(&self) -> u64 {
+        let (p, h) = (self.points as u64, self.hours as u64);
+        // NAME.annual.csv: "m,d,h" and three values per point, each hour.
+        let mut n = h * (6 + 27 * p);
+        if self.glare {
+            n += h * (6 + 5 * 9);
+        }
+        if self.coefficients {
+            n += p * self.patches as u64 * 30 + self.sunny_hours as u64 * p * 40;
+        }
+        n
+    }
+}
+
+/// Checks, before the computation, that the directory of `stem` takes the run's files: their
+/// names fit, none is a directory, a file can be created there, and the file system has at
+/// least [`Planned::minimum_bytes`] free.
+pub fn check_room(stem: &Path, planned: &Planned) -> anyhow::Result<()> {
+    use crate::job::files::{bytes_text, check_outputs, free_bytes, Planned as File};
+    let named = |suffix: &str, what: &str| File {
+        path: crate::output::with_suffix(stem, suffix),
+        what: what.to_string(),
+    };
+    let mut files = vec![
+        named(".annual.json", "the report"),
+        named(".annual.csv", "the hourly illuminances"),
+    ];
+    if planned.glare {
+        files.push(named(".annual-glare.csv", "the hourly glare"));
+    }
+    if planned.coefficients {
+        files.push(named(".annual-sky-dc.csv", "the sky coefficients"));
+        files.push(named(".annual-sun-dc.csv", "the sun coefficients"));
+    }
+    check_outputs(&files, &[], 0)?;
+    let dir = match stem.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let need = planned.minimum_bytes();
+    if let Some(free) = free_bytes(dir) {
+        if free < need {
+            anyhow::bail!(
+                "not enough free disk space in {}: the annual results of {} points over {} hours need at least {}, {} are free; free some space or choose another --out",
+                crate::limits::printable(&dir.display().to_string(), 300),
+                planned.points,
+                planned.hours,
+                bytes_text(need),
+                bytes_text(free)
+            );
+        }
+    }
+    Ok(())
 }

@@ -52,6 +52,10 @@ pub struct AnnualSettings {
     pub glare: GlareOptions,
     /// Keep the grid points' sky and sun coefficients in [`AnnualRun::coefficients`].
     pub keep_coefficients: bool,
+    /// The output stem the caller will write to (NAME of NAME.annual.json): when given, its
+    /// directory is checked to take the files and to have room for them before the
+    /// computation ([`super::output::check_room`]).
+    pub out: Option<PathBuf>,
 }
 
 impl Default for AnnualSettings {
@@ -69,6 +73,7 @@ impl Default for AnnualSettings {
             view: None,
             glare: GlareOptions::default(),
             keep_coefficients: false,
+            out: None,
         }
     }
 }
@@ -226,7 +231,7 @@ pub fn run(
         )));
     }
     let patches = SkyPatches::new(settings.mf).map_err(|e| anyhow!(e))?;
-    let (year, year_notes) = hourly_skies(&weather, &patches, sky.ground_reflectance)
+    let year = hourly_skies(&weather, &patches, sky.ground_reflectance)
         .map_err(|e| anyhow!("{}: {e}", weather_path.display()))?;
 
     // The geometry lit by the unit sky.
@@ -300,6 +305,20 @@ pub fn run(
         "the annual calculation's coefficients and hourly illuminances",
     )
     .map_err(|m| anyhow!("{}: {m}", scene_path.display()))?;
+    if let Some(stem) = &settings.out {
+        super::output::check_room(
+            stem,
+            &super::output::Planned {
+                points: receivers.len(),
+                hours: year.len(),
+                sunny_hours: sunny.len(),
+                patches: patches.len(),
+                grids: grids.len(),
+                glare: settings.view.is_some(),
+                coefficients: settings.keep_coefficients,
+            },
+        )?;
+    }
 
     let t0 = std::time::Instant::now();
     progress(Stage::Sky, 0, 1);
@@ -415,12 +434,6 @@ pub fn run(
     if electric > 0 {
         notes.push(format!(
             "{electric} electric light(s) of the scene are left out: annual results are daylight alone"
-        ));
-    }
-    if year_notes.missing_records > 0 {
-        notes.push(format!(
-            "{} record(s) of the weather file lack irradiances and count as dark",
-            year_notes.missing_records
         ));
     }
     Ok(AnnualRun {

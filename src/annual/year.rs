@@ -1,12 +1,11 @@
 //! A year of skies from a weather file: for each hourly record, the sun's position at the
 //! middle of its hour and the Perez sky over the sky patches ([`SkyVector`]), as `gendaymtx`
 //! builds them from the file (through `epw2wea`, which also places each record at the middle
-//! of its hour).
+//! of its hour), by the rule a `Weather` light follows too ([`crate::daylight::weather`]).
 
 use crate::daylight::epw::Weather;
 use crate::daylight::patches::{SkyPatches, SkyVector};
-use crate::daylight::perez::{eccentricity, DEFAULT_DEW_POINT_C};
-use crate::daylight::sun::{sun_position, Atmosphere, CivilTime};
+use crate::daylight::weather::{middle_of_hour, weather_hour};
 
 /// One hour of the year.
 #[derive(Clone, Debug)]
@@ -34,70 +33,40 @@ impl HourSky {
     }
 }
 
-/// What the year's skies report beyond the skies.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct YearNotes {
-    /// Records whose irradiances are missing (the format's missing-value codes), taken as dark.
-    pub missing_records: usize,
-}
-
-/// The skies of every record of an hourly weather file (8760 or 8784 records) over `patches`,
-/// above a ground of reflectance `ground_reflectance`.
+/// The skies of every record of an hourly weather file over `patches`, above a ground of
+/// reflectance `ground_reflectance`. The file must hold one whole calendar year (8760
+/// consecutive hours from 1 January hour 1 to 31 December hour 24, or 8784 with 29
+/// February): the metrics count hours of a year. Each record is read by the rule of
+/// [`crate::daylight::weather`], at the middle of its hour.
 pub fn hourly_skies(
     weather: &Weather,
     patches: &SkyPatches,
     ground_reflectance: f64,
-) -> Result<(Vec<HourSky>, YearNotes), String> {
+) -> Result<Vec<HourSky>, String> {
     let n = weather.records.len();
-    if n != 8760 && n != 8784 {
+    if !weather.is_full_year() {
+        let (a, b) = (&weather.records[0], &weather.records[n - 1]);
         return Err(format!(
-            "annual daylight needs a year of hourly records (8760 or 8784), the file has {n}"
+            "annual daylight needs one whole calendar year of hourly records (8760, or 8784 with 29 February, from 01-01 hour 1 to 12-31 hour 24); the file has {n}, from {:02}-{:02} hour {} (line {}) to {:02}-{:02} hour {} (line {})",
+            a.month, a.day, a.hour, a.line, b.month, b.day, b.hour, b.line
         ));
     }
     let site = &weather.site;
-    let missing = std::sync::atomic::AtomicUsize::new(0);
-    let hour = |(i, r): (usize, &crate::daylight::epw::Record)| -> Result<HourSky, String> {
+    let hour = |r: &crate::daylight::epw::Record| -> Result<HourSky, String> {
         let at = |e: &dyn std::fmt::Display| {
             format!(
-                "record {} ({:02}-{:02} hour {}): {e}",
-                i + 1,
-                r.month,
-                r.day,
-                r.hour
+                "line {} (record {:02}-{:02} hour {}): {e}",
+                r.line, r.month, r.day, r.hour
             )
         };
-        let t = CivilTime {
-            year: r.year.clamp(1, 9999),
-            month: r.month,
-            day: r.day,
-            seconds: (r.hour as f64 - 0.5) * 3600.0,
-            offset_s: site.time_zone_h * 3600.0,
-        };
-        let pos = sun_position(
-            site.latitude_deg,
-            site.longitude_deg,
-            site.elevation_m,
-            &t,
-            Atmosphere::default(),
-            None,
-        )
-        .map_err(|e| at(&e))?;
-        let (alt, az) = (pos.altitude_deg.to_radians(), pos.azimuth_deg.to_radians());
-        let to_sun = [alt.cos() * az.sin(), alt.cos() * az.cos(), alt.sin()];
-        let (dn, dh) = match (r.direct_normal_w_m2, r.diffuse_horizontal_w_m2) {
-            (Some(dn), Some(dh)) => (dn, dh),
-            _ => {
-                missing.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                (0.0, 0.0)
-            }
-        };
+        let wh = weather_hour(site, r, middle_of_hour(r)).map_err(|e| at(&e))?;
         let sky = SkyVector::perez(
             patches,
-            dh,
-            dn,
-            to_sun,
-            eccentricity(t.day_of_year() as f64),
-            r.dew_point_c.unwrap_or(DEFAULT_DEW_POINT_C),
+            wh.diffuse_horizontal_w_m2,
+            wh.direct_normal_w_m2,
+            wh.to_sun_enu,
+            wh.eccentricity,
+            wh.dew_point_c,
             ground_reflectance,
         )
         .map_err(|e| at(&e))?;
@@ -105,20 +74,11 @@ pub fn hourly_skies(
             month: r.month,
             day: r.day,
             hour: r.hour,
-            sun_altitude_deg: pos.altitude_deg,
-            to_sun_enu: to_sun,
+            sun_altitude_deg: wh.sun.altitude_deg,
+            to_sun_enu: wh.to_sun_enu,
             sky,
         })
     };
     use rayon::prelude::*;
-    let hours = weather
-        .records
-        .par_iter()
-        .enumerate()
-        .map(hour)
-        .collect::<Result<Vec<_>, _>>()?;
-    let notes = YearNotes {
-        missing_records: missing.into_inner(),
-    };
-    Ok((hours, notes))
+    weather.records.par_iter().map(hour).collect()
 }

@@ -176,17 +176,19 @@ pub fn settings(a: &AnnualArgs) -> Result<AnnualSettings> {
         }),
         glare: Default::default(),
         keep_coefficients: a.coefficients,
+        out: None,
     })
 }
 
 /// Runs the command: the summary to print.
 pub fn run(a: &AnnualArgs) -> Result<String> {
-    let s = settings(a)?;
+    let mut s = settings(a)?;
     if let Some(n) = a.threads {
         candela::job::check_threads("--threads", n)?;
     }
     let (stem, json, csv) =
         candela::annual::output::output_paths(a.out.as_deref(), &a.scene, a.weather.as_deref())?;
+    s.out = Some(stem.clone());
     let bar = if a.quiet {
         ProgressBar::hidden()
     } else {
@@ -219,20 +221,13 @@ pub fn run(a: &AnnualArgs) -> Result<String> {
     let out = pool.install(|| candela::annual::run::run(&a.scene, &s, &mut progress));
     bar.finish_and_clear();
     let out = out?;
-    candela::annual::output::write_json(&json, &out)?;
-    candela::annual::output::write_csv(&csv, &out)?;
+    let written = candela::annual::output::write_all(&stem, &out)?;
     let glare_csv = PathBuf::from(format!("{}.annual-glare.csv", stem.display()));
-    if out.view.is_some() {
-        candela::annual::output::write_glare_csv(&glare_csv, &out)?;
-    }
     let dc = [
         PathBuf::from(format!("{}.annual-sky-dc.csv", stem.display())),
         PathBuf::from(format!("{}.annual-sun-dc.csv", stem.display())),
     ];
-    if out.coefficients.is_some() {
-        candela::annual::output::write_coefficients(&dc[0], &dc[1], &out)?;
-    }
-    let maps = candela::annual::output::write_heatmaps(&stem, &out)?;
+    let maps = written.iter().filter(|w| w.ends_with(".png")).count();
     let view = match &out.view {
         Some(v) => format!(
             "wrote {} ({:.1} s view coefficients, {:.1} s hourly glare)\n",
@@ -251,7 +246,7 @@ pub fn run(a: &AnnualArgs) -> Result<String> {
         candela::annual::output::summary(&out),
         json.display(),
         csv.display(),
-        maps.len(),
+        maps,
         out.seconds.0,
         out.seconds.1,
         out.seconds.2

@@ -11,6 +11,7 @@ pub mod patches;
 pub mod perez;
 pub mod sky_map;
 pub mod sun;
+pub mod weather;
 
 pub use cie::CieSky;
 pub use perez::{PerezSky, SkyCondition};

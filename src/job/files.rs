@@ -36,37 +36,8 @@ pub fn state_bytes_at_least(width: usize, height: usize, adaptive: bool) -> u64 
     (pixel * width * height * (1 + adaptive as usize)) as u64
 }
 
-/// The directory of outputs at `path` ("." for a bare file name).
-fn dir_of(path: &Path) -> &Path {
-    match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    }
-}
-
-/// The directory entry `path` names: its directory resolved (links, `..`) and its file name.
-fn entry(path: &Path) -> Option<PathBuf> {
-    Some(dir_of(path).canonicalize().ok()?.join(path.file_name()?))
-}
-
-/// Whether writing `output` (a new file renamed over the entry, see
-/// [`crate::output::write_atomic`]) would replace or change `input`: the same directory entry,
-/// the entry a link at `input` resolves to, or the same file by another name (inode).
-pub fn would_replace(output: &Path, input: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        if let (Ok(a), Ok(b)) = (std::fs::metadata(output), std::fs::metadata(input)) {
-            if a.dev() == b.dev() && a.ino() == b.ino() {
-                return true;
-            }
-        }
-    }
-    let Some(out) = entry(output) else {
-        return output == input;
-    };
-    entry(input).is_some_and(|e| e == out) || input.canonicalize().is_ok_and(|c| c == out)
-}
+pub use crate::output::would_replace;
+use crate::output::{dir_of, entry};
 
 /// One file a job may write, and what it is for messages ("the EXR image", "the CSV of grid
 /// \"desk\"").
@@ -92,7 +63,7 @@ fn name_max(dir: &Path) -> usize {
 }
 
 /// Bytes free for this user on the file system holding `dir`, where the system says.
-fn free_bytes(dir: &Path) -> Option<u64> {
+pub fn free_bytes(dir: &Path) -> Option<u64> {
     #[cfg(unix)]
     {
         use std::os::unix::ffi::OsStrExt;
@@ -113,7 +84,7 @@ fn free_bytes(dir: &Path) -> Option<u64> {
 }
 
 /// A size in bytes for messages: "304 kB", "12.5 MB", "3.2 GB".
-fn bytes_text(n: u64) -> String {
+pub fn bytes_text(n: u64) -> String {
     let n = n as f64;
     if n < 1e6 {
         format!("{:.0} kB", (n / 1e3).ceil())

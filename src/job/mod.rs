@@ -68,6 +68,9 @@ pub struct RenderJob {
     pub save_state: bool,
     /// Also write false-colour maps of luminance (and illuminance).
     pub falsecolour: bool,
+    /// NAME.html, the HTML report, is written after the job (by its caller, as `candela
+    /// render --report-html` does): it is checked with the job's own outputs before rendering.
+    pub report_html: bool,
     /// Render only this shard of the render (see [`shard`]): samples I·spp … (I+1)·spp − 1 of
     /// every pixel, outputs named NAME.shard-I-of-N.*, the state always written, and an existing
     /// state of the shard continued (a requeued job picks up where it stopped).
@@ -96,6 +99,7 @@ impl RenderJob {
             overwrite: false,
             save_state: false,
             falsecolour: false,
+            report_html: false,
             shard: None,
             health: Default::default(),
         }
@@ -417,6 +421,9 @@ fn planned_outputs(job: &RenderJob, world: &World, stem: &Path) -> Vec<Planned> 
     if job.health.spectral_bands > 0 {
         planned.push(plan(".spectral.exr", "the spectral EXR image"));
     }
+    if job.report_html {
+        planned.push(plan(".html", "the HTML report"));
+    }
     planned
 }
 
@@ -698,17 +705,18 @@ pub fn run(
     Ok(outputs)
 }
 
-/// The outputs of the end of a job, each attempted whether or not an earlier one failed.
+/// The outputs of the end of a job, each attempted whether or not an earlier one failed
+/// (also used by `annual` and `merge`).
 #[derive(Default)]
-struct Writes {
+pub struct Writes {
     /// Files written, in order.
-    written: Vec<String>,
+    pub written: Vec<String>,
     /// One line per file that could not be written, naming it.
-    failed: Vec<String>,
+    pub failed: Vec<String>,
 }
 
 impl Writes {
-    fn attempt(&mut self, path: &Path, write: impl FnOnce() -> Result<()>) {
+    pub fn attempt(&mut self, path: &Path, write: impl FnOnce() -> Result<()>) {
         let shown = path.display().to_string();
         match write() {
             Ok(()) => self.written.push(shown),
@@ -724,7 +732,7 @@ impl Writes {
     }
 
     /// One error listing every file that could not be written, if any.
-    fn finish(self) -> Result<()> {
+    pub fn finish(self) -> Result<()> {
         match self.failed.len() {
             0 => Ok(()),
             1 => bail!("{}", self.failed[0]),

@@ -338,7 +338,9 @@ impl SkyLight {
                         format!("a Perez sky's amount is its {hfield}; remove `amount`"),
                     ));
                 }
-                let zenith = s.z.clamp(-1.0, 1.0).acos();
+                // A sun below the horizon (its direct light then absent) shapes the sky from
+                // the horizon, as in gendaymtx and `candela annual`.
+                let zenith = s.z.clamp(-1.0, 1.0).acos().min(std::f64::consts::FRAC_PI_2);
                 let (cond, dn, dh) = if by_irradiance {
                     SkyCondition::illuminance_from_irradiance(
                         diffuse,
@@ -399,7 +401,13 @@ impl SkyLight {
             }
         };
         // The sun's direction only shapes sun-dependent skies; any will do for the others.
-        let sun = sun_local.unwrap_or(DVec3::Z);
+        let sun = match (sun_local, &distribution) {
+            (Some(s), SkyDistribution::Perez(_)) if s.z < 0.0 => DVec3::new(s.x, s.y, 0.0)
+                .try_normalize()
+                .unwrap_or(DVec3::X),
+            (Some(s), _) => s,
+            (None, _) => DVec3::Z,
+        };
         let integral = distribution.horizontal_integral(sun);
         let k = match (d.amount, sky_lx) {
             (None, Some(lx)) => lx / integral,
@@ -472,9 +480,9 @@ impl SkyLight {
 
 /// The sky model and sun of `Weather(file, time)` (`field` is `lights[i]`): the record of
 /// `file` covering `time` ("MM-DD hh:mm", the file's local standard time; record hour h covers
-/// (h − 1):00 to h:00), as a Perez sky from its illuminances (or, where the file lacks them,
-/// its irradiances through the Perez efficacy model) and its dew point, the sun placed by the
-/// file's site at that time.
+/// (h − 1):00 to h:00), read by the rule `candela annual` follows too
+/// ([`crate::daylight::weather`]): a Perez sky from the record's irradiances and dew point, the
+/// sun placed by the file's site at `time`.
 pub fn weather_sky(
     ctx: &crate::description::context::Context,
     field: &str,
@@ -488,7 +496,7 @@ pub fn weather_sky(
     crate::description::context::SceneError,
 > {
     use crate::daylight::epw::Weather;
-    use crate::daylight::perez::{eccentricity, SkyCondition, DEFAULT_DEW_POINT_C};
+    use crate::daylight::weather::weather_hour;
     use crate::description::schema::{SkyModelDesc, SunDesc};
     let tfield = format!("{field}.time");
     let bad_time = || {
@@ -515,69 +523,46 @@ pub fn weather_sky(
             format!("{} has no record for {time}", path.display()),
         )
     })?;
-    let tz = w.site.time_zone_h;
-    let offset_min = (tz * 60.0).round() as i64;
+    let line = format!(
+        "{}: line {} (record {month:02}-{day:02} hour {})",
+        path.display(),
+        r.line,
+        r.hour
+    );
+    // The offset is written to the minute in the sun's time, so the hour is read with that
+    // same offset.
+    let offset_min = (w.site.time_zone_h * 60.0).round() as i64;
+    let site = crate::daylight::epw::Site {
+        time_zone_h: offset_min as f64 / 60.0,
+        ..w.site.clone()
+    };
+    let wh = weather_hour(&site, r, (hour * 3600 + minute * 60) as f64)
+        .map_err(|e| ctx.err(&tfield, format!("{line}: {e}")))?;
+    if wh.is_dark() {
+        return Err(ctx.err(
+            &tfield,
+            format!("{line}: no daylight at that time (no diffuse light, and no direct light with the sun up)"),
+        ));
+    }
     let sign = if offset_min < 0 { '-' } else { '+' };
     let iso = format!(
         "{:04}-{month:02}-{day:02}T{hour:02}:{minute:02}:00{sign}{:02}:{:02}",
-        r.year.clamp(1, 9999),
+        wh.time.year,
         offset_min.abs() / 60,
         offset_min.abs() % 60
     );
     let sun = SunDesc {
-        latitude_deg: Some(w.site.latitude_deg),
-        longitude_deg: Some(w.site.longitude_deg),
-        elevation_m: Some(w.site.elevation_m),
+        latitude_deg: Some(site.latitude_deg),
+        longitude_deg: Some(site.longitude_deg),
+        elevation_m: Some(site.elevation_m),
         time: Some(iso),
         ..Default::default()
     };
-    let dew = r.dew_point_c.unwrap_or(DEFAULT_DEW_POINT_C);
-    let line = format!(
-        "{} record {month:02}-{day:02} hour {}",
-        path.display(),
-        r.hour
-    );
-    let (dn, dh) = match (r.direct_normal_lx, r.diffuse_horizontal_lx) {
-        (Some(dn), Some(dh)) => (dn, dh),
-        _ => {
-            let (Some(en), Some(ed)) = (r.direct_normal_w_m2, r.diffuse_horizontal_w_m2) else {
-                return Err(ctx.err(
-                    &tfield,
-                    format!("{line}: neither the illuminances nor the irradiances are given"),
-                ));
-            };
-            let place = super::sun::place_sun(ctx, &tfield, &sun)?;
-            let zenith = (90.0 - place.altitude_deg).to_radians();
-            let day_of_year =
-                crate::daylight::sun::CivilTime::parse(sun.time.as_deref().unwrap_or(""))
-                    .map(|t| t.day_of_year() as f64)
-                    .unwrap_or(1.0);
-            if ed + en == 0.0 {
-                (0.0, 0.0)
-            } else {
-                let (_, dn, dh) = SkyCondition::illuminance_from_irradiance(
-                    ed,
-                    en,
-                    zenith.min(std::f64::consts::FRAC_PI_2),
-                    eccentricity(day_of_year),
-                    dew,
-                )
-                .map_err(|e| ctx.err(&tfield, format!("{line}: {e}")))?;
-                (dn, dh)
-            }
-        }
-    };
-    if dn + dh == 0.0 {
-        return Err(ctx.err(
-            &tfield,
-            format!("{line}: no daylight at that hour (zero direct and diffuse light)"),
-        ));
-    }
     Ok((
-        SkyModelDesc::Perez {
-            direct_normal_lx: dn,
-            diffuse_horizontal_lx: dh,
-            dew_point_c: r.dew_point_c,
+        SkyModelDesc::PerezIrradiance {
+            direct_normal_w_m2: wh.direct_normal_w_m2,
+            diffuse_horizontal_w_m2: wh.diffuse_horizontal_w_m2,
+            dew_point_c: Some(wh.dew_point_c),
         },
         sun,
     ))
