@@ -357,6 +357,87 @@ pub fn render_progressive(
     on_pass: &mut dyn FnMut(&PassStatus),
     on_checkpoint: &mut dyn FnMut(&Film) -> anyhow::Result<()>,
 ) -> anyhow::Result<(RenderResult, StopReason)> {
+    check_film(world, film)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()?;
+    // The light-and-health channels weight the spectrum their own way: with them the sun in
+    // view is left to the camera rays, which every channel sees alike.
+    let sun = if film.health.is_some() {
+        None
+    } else {
+        SunInView::new(world)
+    };
+    let tiling = Tiling::new(world.camera.width, world.camera.height);
+    let start = Instant::now();
+    let mut last_checkpoint = start;
+    let mut stats = RayStats::default();
+    let mut status = PassStatus {
+        max_samples: world.camera.inside_pixels() as u64 * prog.max_spp as u64,
+        ..Default::default()
+    };
+    // Each tile's results, kept from pass to pass: the memory is reused instead of allocated
+    // (and its pages faulted in afresh) for every pass.
+    let mut tiles: Vec<TileResult> = (0..tiling.count()).map(|_| TileResult::default()).collect();
+    // The image sums after the pass: a second film buffer that the tiles write in place and
+    // that replaces the film's when the pass completes (an interrupted pass leaves the film
+    // as it was). Gathering them per tile and copying them back took 5–15 % of the render's
+    // time on a small scene: memory a long pass leaves untouched is slow to walk again.
+    let mut next_pixels = vec![PixelSums::default(); tiling.w * tiling.h];
+    let reason = loop {
+        let (plan, frac) = plan_pass(world, film, prog);
+        status.converged_fraction = frac;
+        status.samples = film_samples(film);
+        if let Some(reason) = stop_before_pass(prog, &plan, frac, stop, start) {
+            break reason;
+        }
+        let pass = Pass {
+            world,
+            prog,
+            plan: &plan,
+            sun: sun.as_ref(),
+            tiling: &tiling,
+            stop,
+        };
+        if !pool.install(|| pass.render_tiles(film, &mut tiles, &mut next_pixels)) {
+            break StopReason::Interrupted;
+        }
+        let Some(light) = pool.install(|| pass.trace_caustics(film, &mut stats)) else {
+            break StopReason::Interrupted;
+        };
+        std::mem::swap(&mut film.pixels, &mut next_pixels);
+        pass.gather_tiles(film, &tiles, &mut stats);
+        add_light_paths(film, light);
+        status.passes += 1;
+        status.samples = film_samples(film);
+        on_pass(&status);
+        if let Some(iv) = prog.checkpoint_interval {
+            if last_checkpoint.elapsed() >= iv {
+                on_checkpoint(film)?;
+                last_checkpoint = Instant::now();
+            }
+        }
+    };
+    // The status the stop decision saw (the last pass's report predates it).
+    on_pass(&status);
+    // The pass buffers go before the film is copied: the render's peak holds two copies of
+    // the sums (see `crate::scene::build::bytes_per_pixel`).
+    drop(tiles);
+    drop(next_pixels);
+    Ok((
+        RenderResult {
+            film: film.clone(),
+            stats,
+            elapsed: start.elapsed(),
+            threads: pool.current_num_threads(),
+        },
+        reason,
+    ))
+}
+
+/// Refuse a film that does not fit the world's render (its batches, size, illuminance and
+/// light-and-health sums); a fresh film is given illuminance sums when the render needs them.
+fn check_film(world: &World, film: &mut Film) -> anyhow::Result<()> {
     // The samples are drawn in the world's batches and their errors taken in the film's: one
     // number, or the standard errors would be wrong.
     anyhow::ensure!(
@@ -365,9 +446,6 @@ pub fn render_progressive(
         film.pixel_batches,
         world.settings.pixel_batches
     );
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()?;
     let (w, h) = (world.camera.width, world.camera.height);
     anyhow::ensure!(
         film.width == w && film.height == h,
@@ -399,182 +477,191 @@ pub fn render_progressive(
             "the film's light-and-health sums do not match its pixels"
         );
     }
-    // The light-and-health channels weight the spectrum their own way: with them the sun in
-    // view is left to the camera rays, which every channel sees alike.
-    let sun = if film.health.is_some() {
-        None
-    } else {
-        SunInView::new(world)
-    };
-    let tiles_x = w.div_ceil(TILE);
-    let n_tiles = tiles_x * h.div_ceil(TILE);
-    let start = Instant::now();
-    let mut last_checkpoint = start;
-    let mut stats = RayStats::default();
-    let mut status = PassStatus {
-        max_samples: world.camera.inside_pixels() as u64 * prog.max_spp as u64,
-        ..Default::default()
-    };
-    // Each tile's results, kept from pass to pass: the memory is reused instead of allocated
-    // (and its pages faulted in afresh) for every pass.
-    let mut tiles: Vec<TileResult> = (0..n_tiles).map(|_| TileResult::default()).collect();
-    // Tile t's pixel indices, row by row: the order in which a tile renders its pixels and
-    // keeps their other sums, and in which they are put back into the film.
-    let tile_pixels = |t: usize| {
-        let (x0, y0) = ((t % tiles_x) * TILE, (t / tiles_x) * TILE);
+    Ok(())
+}
+
+/// The samples the film holds, all pixels together.
+fn film_samples(film: &Film) -> u64 {
+    (0..film.width * film.height)
+        .map(|i| film.samples_taken(i))
+        .sum()
+}
+
+/// Why the render ends before the pass `plan` (`frac`: the fraction of pixels that meet the
+/// target), if it does.
+fn stop_before_pass(
+    prog: &Progressive,
+    plan: &[u64],
+    frac: Option<f64>,
+    stop: &AtomicBool,
+    start: Instant,
+) -> Option<StopReason> {
+    if let (Some(t), Some(f)) = (&prog.target, frac) {
+        if f >= t.fraction {
+            return Some(StopReason::TargetReached);
+        }
+    }
+    if plan.iter().all(|&n| n == 0) {
+        return Some(StopReason::Done);
+    }
+    if stop.load(Ordering::Relaxed) {
+        return Some(StopReason::Interrupted);
+    }
+    if prog.max_time.is_some_and(|t| start.elapsed() >= t) {
+        return Some(StopReason::MaxTime);
+    }
+    None
+}
+
+/// The image in square tiles of [`TILE`] pixels, row by row.
+struct Tiling {
+    w: usize,
+    h: usize,
+    tiles_x: usize,
+}
+
+impl Tiling {
+    fn new(w: usize, h: usize) -> Self {
+        Self {
+            w,
+            h,
+            tiles_x: w.div_ceil(TILE),
+        }
+    }
+    fn count(&self) -> usize {
+        self.tiles_x * self.h.div_ceil(TILE)
+    }
+    /// Tile t's pixel indices, row by row: the order in which a tile renders its pixels and
+    /// keeps their other sums, and in which they are put back into the film.
+    fn pixels(&self, t: usize) -> impl Iterator<Item = usize> {
+        let (w, h) = (self.w, self.h);
+        let (x0, y0) = ((t % self.tiles_x) * TILE, (t / self.tiles_x) * TILE);
         let xs = x0..(x0 + TILE).min(w);
         (y0..(y0 + TILE).min(h)).flat_map(move |y| xs.clone().map(move |x| y * w + x))
-    };
-    // The image sums after the pass: a second film buffer that the tiles write in place and
-    // that replaces the film's when the pass completes (an interrupted pass leaves the film
-    // as it was). Gathering them per tile and copying them back took 5–15 % of the render's
-    // time on a small scene: memory a long pass leaves untouched is slow to walk again.
-    let mut next_pixels = vec![PixelSums::default(); w * h];
-    let reason = 'passes: loop {
-        let (plan, frac) = plan_pass(world, film, prog);
-        status.converged_fraction = frac;
-        status.samples = (0..w * h).map(|i| film.samples_taken(i)).sum();
-        if let (Some(t), Some(f)) = (&prog.target, frac) {
-            if f >= t.fraction {
-                break 'passes StopReason::TargetReached;
+    }
+}
+
+/// One pass of a progressive render: `plan` holds the samples each pixel gets.
+struct Pass<'a> {
+    world: &'a World,
+    prog: &'a Progressive,
+    plan: &'a [u64],
+    sun: Option<&'a SunInView>,
+    tiling: &'a Tiling,
+    stop: &'a AtomicBool,
+}
+
+/// Light paths a pass traced into one buffer (0 the image, 1 the decision buffer): their XYZ
+/// and illuminance sums per pixel, and their number.
+type LightPass = (usize, Vec<[f64; 6]>, u64);
+
+impl Pass<'_> {
+    /// Render every tile (in the calling thread pool): the image sums into `next`, the other
+    /// sums into `tiles`. False when `stop` interrupted it.
+    fn render_tiles(&self, film: &Film, tiles: &mut [TileResult], next: &mut [PixelSums]) -> bool {
+        let next = DisjointSlice::new(next);
+        let completed: Vec<bool> = tiles
+            .par_iter_mut()
+            .enumerate()
+            .map(|(t, r)| {
+                if self.stop.load(Ordering::Relaxed) {
+                    return false;
+                }
+                r.clear();
+                for i in self.tiling.pixels(t) {
+                    let est = self.render_plan_pixel(film, i, r);
+                    // SAFETY: pixel i belongs to this tile alone, and the buffer is read only
+                    // after the pass.
+                    unsafe { next.write(i, est) };
+                }
+                true
+            })
+            .collect();
+        !completed.contains(&false)
+    }
+
+    /// Pixel i's samples of this pass, continuing the film's sums: the image sums returned,
+    /// the others appended to the tile's `r`.
+    fn render_plan_pixel(&self, film: &Film, i: usize, r: &mut TileResult) -> PixelSums {
+        let (world, prog, sun) = (self.world, self.prog, self.sun);
+        let (x, y) = (i % self.tiling.w, i / self.tiling.w);
+        let mut est = film.pixels[i];
+        let mut dec = film.decision.as_ref().map(|d| d[i]);
+        let mut est_e = film.e.as_ref().map(|e| e[i]);
+        let mut dec_e = film.decision_e.as_ref().map(|e| e[i]);
+        let mut hp = film.health.as_ref().map(|h| h.pixel(i).to_vec());
+        let hv = film
+            .health
+            .as_ref()
+            .zip(hp.as_deref_mut())
+            .map(|(h, s)| h.view(s));
+        let seed = world.settings.seed;
+        match dec.as_mut() {
+            // Independent streams: the image's samples continue its own sequence, the decision
+            // buffer draws from another scramble.
+            Some(d) => {
+                let half = self.plan[i] / 2;
+                let first = prog.first_sample + est.count;
+                let (e, stats) = (est_e.as_mut(), &mut r.stats);
+                render_pixel(world, seed, x, y, first, half, &mut est, e, hv, stats, sun);
+                let first = prog.first_sample + d.count;
+                let (e, stats) = (dec_e.as_mut(), &mut r.stats);
+                let seed = seed ^ DECISION_STREAM;
+                render_pixel(world, seed, x, y, first, half, d, e, None, stats, sun);
+            }
+            None => {
+                let first = prog.first_sample + est.count;
+                let (n, e, stats) = (self.plan[i], est_e.as_mut(), &mut r.stats);
+                render_pixel(world, seed, x, y, first, n, &mut est, e, hv, stats, sun);
             }
         }
-        if plan.iter().all(|&n| n == 0) {
-            break 'passes StopReason::Done;
-        }
-        if stop.load(Ordering::Relaxed) {
-            break 'passes StopReason::Interrupted;
-        }
-        if prog.max_time.is_some_and(|t| start.elapsed() >= t) {
-            break 'passes StopReason::MaxTime;
-        }
-        let adaptive = film.decision.is_some();
-        let film_ref: &Film = film;
-        let next = DisjointSlice::new(&mut next_pixels);
-        let completed: Vec<bool> = pool.install(|| {
-            tiles
-                .par_iter_mut()
-                .enumerate()
-                .map(|(t, r)| {
-                    if stop.load(Ordering::Relaxed) {
-                        return false;
-                    }
-                    r.clear();
-                    for i in tile_pixels(t) {
-                        let (x, y) = (i % w, i / w);
-                        let mut est = film_ref.pixels[i];
-                        let mut dec = film_ref.decision.as_ref().map(|d| d[i]);
-                        let mut est_e = film_ref.e.as_ref().map(|e| e[i]);
-                        let mut dec_e = film_ref.decision_e.as_ref().map(|e| e[i]);
-                        let mut hp = film_ref.health.as_ref().map(|h| h.pixel(i).to_vec());
-                        let hv = film_ref
-                            .health
-                            .as_ref()
-                            .zip(hp.as_deref_mut())
-                            .map(|(h, s)| h.view(s));
-                        let seed = world.settings.seed;
-                        match dec.as_mut() {
-                            // Independent streams: the image's samples continue its own
-                            // sequence, the decision buffer draws from another scramble.
-                            Some(d) => {
-                                let half = plan[i] / 2;
-                                let first = prog.first_sample + est.count;
-                                render_pixel(
-                                    world,
-                                    seed,
-                                    x,
-                                    y,
-                                    first,
-                                    half,
-                                    &mut est,
-                                    est_e.as_mut(),
-                                    hv,
-                                    &mut r.stats,
-                                    sun.as_ref(),
-                                );
-                                let first = prog.first_sample + d.count;
-                                render_pixel(
-                                    world,
-                                    seed ^ DECISION_STREAM,
-                                    x,
-                                    y,
-                                    first,
-                                    half,
-                                    d,
-                                    dec_e.as_mut(),
-                                    None,
-                                    &mut r.stats,
-                                    sun.as_ref(),
-                                );
-                            }
-                            None => {
-                                let first = prog.first_sample + est.count;
-                                render_pixel(
-                                    world,
-                                    seed,
-                                    x,
-                                    y,
-                                    first,
-                                    plan[i],
-                                    &mut est,
-                                    est_e.as_mut(),
-                                    hv,
-                                    &mut r.stats,
-                                    sun.as_ref(),
-                                );
-                            }
-                        }
-                        // SAFETY: pixel i belongs to this tile alone, and the buffer is
-                        // read only after the pass.
-                        unsafe { next.write(i, est) };
-                        r.decision.extend(dec);
-                        r.e.extend(est_e);
-                        r.decision_e.extend(dec_e);
-                        r.health.extend(hp.into_iter().flatten());
-                    }
-                    true
-                })
-                .collect()
-        });
-        if completed.contains(&false) {
-            break 'passes StopReason::Interrupted;
-        }
-        // Caustic light paths: `light_paths_per_sample` per camera sample each buffer received
-        // in this pass (a pass interrupted here is discarded too).
+        r.decision.extend(dec);
+        r.e.extend(est_e);
+        r.decision_e.extend(dec_e);
+        r.health.extend(hp.into_iter().flatten());
+        est
+    }
+
+    /// Caustic light paths: `light_paths_per_sample` per camera sample each buffer received
+    /// in this pass. None when `stop` interrupted them (the pass is discarded too).
+    fn trace_caustics(&self, film: &Film, stats: &mut RayStats) -> Option<Vec<LightPass>> {
+        let world = self.world;
         let mut light = Vec::new();
-        if let Some(caustics) = &world.caustics {
-            let samples: u64 = if adaptive {
-                plan.iter().map(|n| n / 2).sum()
-            } else {
-                plan.iter().sum()
-            };
-            let per_buffer =
-                (samples as f64 * world.settings.light_paths_per_sample as f64).ceil() as u64;
-            let streams: &[u64] = if adaptive {
-                &[CAUSTIC_STREAM, CAUSTIC_STREAM ^ DECISION_STREAM]
-            } else {
-                &[CAUSTIC_STREAM]
-            };
-            for (b, &stream) in streams.iter().enumerate() {
-                let first = prog.first_light_path + film.light_paths[b];
-                let seed = world.settings.seed ^ stream;
-                let mut sums = vec![[0.0f64; 6]; w * h];
-                let traced = pool.install(|| {
-                    crate::integrator::light_path::trace_light_paths(
-                        world, caustics, seed, first, per_buffer, stop, &mut sums,
-                    )
-                });
-                let Some(st) = traced else {
-                    break 'passes StopReason::Interrupted;
-                };
-                stats.merge(&st);
-                light.push((b, sums, per_buffer));
-            }
+        let Some(caustics) = &world.caustics else {
+            return Some(light);
+        };
+        let adaptive = film.decision.is_some();
+        let samples: u64 = if adaptive {
+            self.plan.iter().map(|n| n / 2).sum()
+        } else {
+            self.plan.iter().sum()
+        };
+        let per_buffer =
+            (samples as f64 * world.settings.light_paths_per_sample as f64).ceil() as u64;
+        let streams: &[u64] = if adaptive {
+            &[CAUSTIC_STREAM, CAUSTIC_STREAM ^ DECISION_STREAM]
+        } else {
+            &[CAUSTIC_STREAM]
+        };
+        for (b, &stream) in streams.iter().enumerate() {
+            let first = self.prog.first_light_path + film.light_paths[b];
+            let seed = world.settings.seed ^ stream;
+            let mut sums = vec![[0.0f64; 6]; self.tiling.w * self.tiling.h];
+            let st = crate::integrator::light_path::trace_light_paths(
+                world, caustics, seed, first, per_buffer, self.stop, &mut sums,
+            )?;
+            stats.merge(&st);
+            light.push((b, sums, per_buffer));
         }
-        std::mem::swap(&mut film.pixels, &mut next_pixels);
+        Some(light)
+    }
+
+    /// Put the tiles' other sums (decision buffer, illuminance, light and health) and ray
+    /// counts back into the film and `stats`.
+    fn gather_tiles(&self, film: &mut Film, tiles: &[TileResult], stats: &mut RayStats) {
         for (t, r) in tiles.iter().enumerate() {
             stats.merge(&r.stats);
-            for (k, i) in tile_pixels(t).enumerate() {
+            for (k, i) in self.tiling.pixels(t).enumerate() {
                 if let Some(d) = film.decision.as_mut() {
                     d[i] = r.decision[k];
                 }
@@ -590,49 +677,28 @@ pub fn render_progressive(
                 }
             }
         }
-        for (b, sums, paths) in light {
-            film.light_paths[b] += paths;
-            let (buf, e) = if b == 0 {
-                (&mut film.pixels, &mut film.e)
-            } else {
-                let d = film.decision.as_mut().expect("adaptive film");
-                (d, &mut film.decision_e)
-            };
-            for (p, s) in buf.iter_mut().zip(&sums) {
-                p.add_light_paths(&[s[0], s[1], s[2], s[3]], paths);
-            }
-            if let Some(e) = e.as_mut() {
-                for (p, s) in e.iter_mut().zip(&sums) {
-                    p.add_light_paths(s[4], s[5]);
-                }
+    }
+}
+
+/// Add a pass's light paths to the film's buffers.
+fn add_light_paths(film: &mut Film, light: Vec<LightPass>) {
+    for (b, sums, paths) in light {
+        film.light_paths[b] += paths;
+        let (buf, e) = if b == 0 {
+            (&mut film.pixels, &mut film.e)
+        } else {
+            let d = film.decision.as_mut().expect("adaptive film");
+            (d, &mut film.decision_e)
+        };
+        for (p, s) in buf.iter_mut().zip(&sums) {
+            p.add_light_paths(&[s[0], s[1], s[2], s[3]], paths);
+        }
+        if let Some(e) = e.as_mut() {
+            for (p, s) in e.iter_mut().zip(&sums) {
+                p.add_light_paths(s[4], s[5]);
             }
         }
-        debug_assert_eq!(adaptive, film.decision.is_some());
-        status.passes += 1;
-        status.samples = (0..w * h).map(|i| film.samples_taken(i)).sum();
-        on_pass(&status);
-        if let Some(iv) = prog.checkpoint_interval {
-            if last_checkpoint.elapsed() >= iv {
-                on_checkpoint(film)?;
-                last_checkpoint = Instant::now();
-            }
-        }
-    };
-    // The status the stop decision saw (the last pass's report predates it).
-    on_pass(&status);
-    // The pass buffers go before the film is copied: the render's peak holds two copies of
-    // the sums (see `crate::scene::build::bytes_per_pixel`).
-    drop(tiles);
-    drop(next_pixels);
-    Ok((
-        RenderResult {
-            film: film.clone(),
-            stats,
-            elapsed: start.elapsed(),
-            threads: pool.current_num_threads(),
-        },
-        reason,
-    ))
+    }
 }
 
 /// A slice that several threads write at distinct indices.

@@ -97,43 +97,101 @@ impl<'a> Tokens<'a> {
 /// Parse the text of an IES file; `file` is used in messages.
 pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
     let lines: Vec<&str> = text.lines().collect();
-    let err = |line: usize, field: &str, m: String| ParseError {
+    let version = version(&lines, file)?;
+    let start = usize::from(version != "LM-63-1986");
+    let (header, tilt_idx, tilt) = header_and_tilt(&lines, start, file)?;
+    let mut t = Tokens {
+        toks: tokens(&lines, tilt_idx + 1),
+        pos: 0,
+        file,
+        last_line: lines.len().max(1),
+    };
+    let tilt_factor = tilt_factor(&mut t, &tilt, tilt_idx)?;
+    let f = Fields::read(&mut t, &version)?;
+    let vert = t.angles(f.nv, "vertical")?;
+    let horiz = t.angles(f.nh, "horizontal")?;
+    let kind = match f.ptype {
+        1 => Kind::C,
+        2 => Kind::B,
+        _ => Kind::A,
+    };
+    let symmetry = symmetry(&t, kind, &vert, &horiz)?;
+    let scale = f.multiplier * f.ballast * f.blpf * tilt_factor;
+    let candela = candela_table(&mut t, &horiz, &vert, scale)?;
+    let stated_lumens = (f.lumens_per_lamp > 0.0 && f.lamps > 0.0)
+        .then_some(f.lamps * f.lumens_per_lamp * f.ballast * f.blpf * tilt_factor);
+    let to_m = if f.units == 1 { 0.3048 } else { 1.0 };
+    Ok(Photometry {
+        format: Format::Ies(version),
+        header,
+        kind,
+        symmetry,
+        planes: horiz.iter().map(|a| a.1).collect(),
+        angles: vert.iter().map(|a| a.1).collect(),
+        candela,
+        stated_lumens,
+        size_m: [
+            f.length.abs() * to_m,
+            f.width.abs() * to_m,
+            f.height.abs() * to_m,
+        ],
+    })
+}
+
+fn line_err(file: &Path, line: usize, field: &str, message: String) -> ParseError {
+    ParseError {
         file: file.to_path_buf(),
         line,
         field: field.to_string(),
-        message: m,
-    };
+        message,
+    }
+}
+
+/// The LM-63 version the first line names (`LM-63-1986` when it names none).
+fn version(lines: &[&str], file: &Path) -> Result<String, ParseError> {
     let first = lines.first().map(|l| l.trim()).unwrap_or("");
-    let version = if first.starts_with("IESNA") || first.starts_with("IES:") {
-        let v = if first == "IESNA91" {
-            "LM-63-1991".to_string()
-        } else {
-            first.split(':').nth(1).unwrap_or(first).trim().to_string()
-        };
-        let known = ["LM-63-1991", "LM-63-1995", "LM-63-2002", "LM-63-2019"];
-        if !known.contains(&v.as_str()) {
-            return Err(err(
-                1,
-                "format line",
-                format!("unknown IES version {first:?} (known: IESNA91, IESNA:LM-63-1995, IESNA:LM-63-2002, IES:LM-63-2019, or none for 1986)"),
-            ));
-        }
-        v
+    if !(first.starts_with("IESNA") || first.starts_with("IES:")) {
+        return Ok("LM-63-1986".to_string());
+    }
+    let v = if first == "IESNA91" {
+        "LM-63-1991".to_string()
     } else {
-        "LM-63-1986".to_string()
+        first.split(':').nth(1).unwrap_or(first).trim().to_string()
     };
-    let start = usize::from(version != "LM-63-1986");
+    let known = ["LM-63-1991", "LM-63-1995", "LM-63-2002", "LM-63-2019"];
+    if !known.contains(&v.as_str()) {
+        return Err(line_err(
+            file,
+            1,
+            "format line",
+            format!("unknown IES version {first:?} (known: IESNA91, IESNA:LM-63-1995, IESNA:LM-63-2002, IES:LM-63-2019, or none for 1986)"),
+        ));
+    }
+    Ok(v)
+}
+
+/// The header's keyword lines (`[MORE]` joined to the one before) and free text from line
+/// `start`, then the index of the `TILT=` line and its value.
+#[allow(clippy::type_complexity)]
+fn header_and_tilt(
+    lines: &[&str],
+    start: usize,
+    file: &Path,
+) -> Result<(Vec<(String, String)>, usize, String), ParseError> {
     let mut header: Vec<(String, String)> = Vec::new();
-    let mut tilt_line = None;
     for (k, raw) in lines.iter().enumerate().skip(start) {
         let l = raw.trim();
         if let Some(rest) = l.strip_prefix("TILT") {
             let rest = rest.trim_start();
             let Some(v) = rest.strip_prefix('=') else {
-                return Err(err(k + 1, "TILT", format!("expected TILT=…, got {l:?}")));
+                return Err(line_err(
+                    file,
+                    k + 1,
+                    "TILT",
+                    format!("expected TILT=…, got {l:?}"),
+                ));
             };
-            tilt_line = Some((k, v.trim().to_string()));
-            break;
+            return Ok((header, k, v.trim().to_string()));
         }
         if let Some(rest) = l.strip_prefix('[') {
             if let Some(end) = rest.find(']') {
@@ -154,32 +212,33 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
             header.push((String::new(), l.to_string()));
         }
     }
-    let Some((tilt_idx, tilt)) = tilt_line else {
-        return Err(err(
-            lines.len().max(1),
-            "TILT",
-            "no TILT= line: the file ends before the photometric data".into(),
-        ));
-    };
-    let toks: Vec<(usize, &str)> = lines
+    Err(line_err(
+        file,
+        lines.len().max(1),
+        "TILT",
+        "no TILT= line: the file ends before the photometric data".into(),
+    ))
+}
+
+/// The numbers from line index `from` on, each with its 1-based line (whitespace or commas
+/// separate them).
+fn tokens<'a>(lines: &[&'a str], from: usize) -> Vec<(usize, &'a str)> {
+    lines
         .iter()
         .enumerate()
-        .skip(tilt_idx + 1)
+        .skip(from)
         .flat_map(|(k, l)| {
             l.split(|c: char| c.is_whitespace() || c == ',')
                 .filter(|s| !s.is_empty())
                 .map(move |s| (k + 1, s))
         })
-        .collect();
-    let mut t = Tokens {
-        toks,
-        pos: 0,
-        file,
-        last_line: lines.len().max(1),
-    };
-    let mut tilt_factor = 1.0;
+        .collect()
+}
+
+/// The tilt factor at 0° of `TILT=tilt` (line index `tilt_idx`): 1 without a table.
+fn tilt_factor(t: &mut Tokens, tilt: &str, tilt_idx: usize) -> Result<f64, ParseError> {
     match tilt.to_ascii_uppercase().as_str() {
-        "NONE" => {}
+        "NONE" => Ok(1.0),
         "INCLUDE" => {
             t.int_in("lamp-to-luminaire geometry", &[1, 2, 3])?;
             let (_, n) = t.count("number of tilt angles")?;
@@ -194,104 +253,128 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
                 factors.push(v);
             }
             let xs: Vec<f64> = angles.iter().map(|a| a.1).collect();
-            tilt_factor = match super::bracket(&xs, 0.0) {
-                Some((i, s)) if i + 1 < n => factors[i] * (1.0 - s) + factors[i + 1] * s,
-                Some((i, _)) => factors[i],
-                None => {
-                    return Err(t.err(
-                        angles[0].0,
-                        "tilt angle 1",
-                        "the tilt table does not cover 0° (the luminaire as photometered)",
-                    ))
-                }
-            };
+            match super::bracket(&xs, 0.0) {
+                Some((i, s)) if i + 1 < n => Ok(factors[i] * (1.0 - s) + factors[i + 1] * s),
+                Some((i, _)) => Ok(factors[i]),
+                None => Err(t.err(
+                    angles[0].0,
+                    "tilt angle 1",
+                    "the tilt table does not cover 0° (the luminaire as photometered)",
+                )),
+            }
         }
-        other => {
-            return Err(err(
-                tilt_idx + 1,
-                "TILT",
-                format!("TILT={other}: tilt data in a separate file is not supported; use TILT=NONE or TILT=INCLUDE"),
-            ))
-        }
+        other => Err(t.err(
+            tilt_idx + 1,
+            "TILT",
+            format!("TILT={other}: tilt data in a separate file is not supported; use TILT=NONE or TILT=INCLUDE"),
+        )),
     }
-    let (_, lamps) = t.num("number of lamps")?;
-    let (llm_line, lumens_per_lamp) = t.num("lumens per lamp")?;
-    let (mline, multiplier) = t.num("candela multiplier")?;
-    if multiplier < 0.0 {
-        return Err(t.err(
-            mline,
-            "candela multiplier",
-            format!("{multiplier} is negative"),
-        ));
-    }
-    let (_, nv) = t.count("number of vertical angles")?;
-    let (nhl, nh) = t.count("number of horizontal angles")?;
-    if nv.saturating_mul(nh) > MAX_VALUES {
-        return Err(t.err(
-            nhl,
-            "number of horizontal angles",
-            format!("{nh} × {nv} values exceed the limit of {MAX_VALUES}"),
-        ));
-    }
-    let (_, ptype) = t.int_in("photometric type", &[1, 2, 3])?;
-    let (_, units) = t.int_in("units type", &[1, 2])?;
-    let to_m = if units == 1 { 0.3048 } else { 1.0 };
-    let (_, width) = t.num("width")?;
-    let (_, length) = t.num("length")?;
-    let (_, height) = t.num("height")?;
-    let (bline, ballast) = t.num("ballast factor")?;
-    if ballast < 0.0 {
-        return Err(t.err(bline, "ballast factor", format!("{ballast} is negative")));
-    }
-    let (fline, future) = t.num(if version == "LM-63-2019" {
-        "file generation type"
-    } else {
-        "ballast-lamp photometric factor"
-    })?;
-    let blpf = if version == "LM-63-1991" || version == "LM-63-1995" || version == "LM-63-1986" {
-        if future < 0.0 {
+}
+
+/// The numbers between the tilt data and the angles.
+struct Fields {
+    lamps: f64,
+    lumens_per_lamp: f64,
+    multiplier: f64,
+    nv: usize,
+    nh: usize,
+    ptype: i64,
+    units: i64,
+    width: f64,
+    length: f64,
+    height: f64,
+    ballast: f64,
+    /// The ballast-lamp photometric factor (1 where the version gives the field another use).
+    blpf: f64,
+}
+
+impl Fields {
+    fn read(t: &mut Tokens, version: &str) -> Result<Self, ParseError> {
+        let non_negative = |t: &Tokens, (line, v): (usize, f64), field: &str| {
+            if v < 0.0 {
+                return Err(t.err(line, field, format!("{v} is negative")));
+            }
+            Ok(v)
+        };
+        let (_, lamps) = t.num("number of lamps")?;
+        let (_, lumens_per_lamp) = t.num("lumens per lamp")?;
+        let m = t.num("candela multiplier")?;
+        let multiplier = non_negative(t, m, "candela multiplier")?;
+        let (_, nv) = t.count("number of vertical angles")?;
+        let (nhl, nh) = t.count("number of horizontal angles")?;
+        if nv.saturating_mul(nh) > MAX_VALUES {
             return Err(t.err(
-                fline,
-                "ballast-lamp photometric factor",
-                format!("{future} is negative"),
+                nhl,
+                "number of horizontal angles",
+                format!("{nh} × {nv} values exceed the limit of {MAX_VALUES}"),
             ));
         }
-        future
-    } else {
-        1.0
-    };
-    let (_, _watts) = t.num("input watts")?;
-    let vert = t.angles(nv, "vertical")?;
-    let horiz = t.angles(nh, "horizontal")?;
-    let kind = match ptype {
-        1 => Kind::C,
-        2 => Kind::B,
-        _ => Kind::A,
-    };
-    let (v0, v1) = (vert[0].1, vert[nv - 1].1);
+        let (_, ptype) = t.int_in("photometric type", &[1, 2, 3])?;
+        let (_, units) = t.int_in("units type", &[1, 2])?;
+        let (_, width) = t.num("width")?;
+        let (_, length) = t.num("length")?;
+        let (_, height) = t.num("height")?;
+        let b = t.num("ballast factor")?;
+        let ballast = non_negative(t, b, "ballast factor")?;
+        let future = t.num(if version == "LM-63-2019" {
+            "file generation type"
+        } else {
+            "ballast-lamp photometric factor"
+        })?;
+        let blpf = if ["LM-63-1991", "LM-63-1995", "LM-63-1986"].contains(&version) {
+            non_negative(t, future, "ballast-lamp photometric factor")?
+        } else {
+            1.0
+        };
+        let (_, _watts) = t.num("input watts")?;
+        Ok(Self {
+            lamps,
+            lumens_per_lamp,
+            multiplier,
+            nv,
+            nh,
+            ptype,
+            units,
+            width,
+            length,
+            height,
+            ballast,
+            blpf,
+        })
+    }
+}
+
+/// The symmetry the angles' ranges give a photometry of `kind`.
+fn symmetry(
+    t: &Tokens,
+    kind: Kind,
+    vert: &[(usize, f64)],
+    horiz: &[(usize, f64)],
+) -> Result<Symmetry, ParseError> {
+    let (nh, v0, v1) = (horiz.len(), vert[0].1, vert[vert.len() - 1].1);
     let (h0, h1) = (horiz[0].1, horiz[nh - 1].1);
-    let bad_v = |msg: &str| Err(err(vert[0].0, "vertical angle 1", msg.to_string()));
-    let bad_h = |msg: String| Err(err(horiz[0].0, "horizontal angle 1", msg));
-    let symmetry = match kind {
+    let bad_v = |msg: &str| Err(t.err(vert[0].0, "vertical angle 1", msg));
+    let bad_h = |msg: String| Err(t.err(horiz[0].0, "horizontal angle 1", msg));
+    match kind {
         Kind::C => {
             if v0 < -ANGLE_TOL || v1 > 180.0 + ANGLE_TOL {
                 return bad_v("type C vertical angles must lie in 0…180°");
             }
             let near = |a: f64, b: f64| (a - b).abs() < ANGLE_TOL;
             if nh == 1 {
-                Symmetry::Rotational
+                Ok(Symmetry::Rotational)
             } else if near(h0, 0.0) && near(h1, 90.0) {
-                Symmetry::Quadrant
+                Ok(Symmetry::Quadrant)
             } else if near(h0, 0.0) && near(h1, 180.0) {
-                Symmetry::C0C180
+                Ok(Symmetry::C0C180)
             } else if near(h0, 90.0) && near(h1, 270.0) {
-                Symmetry::C90C270
+                Ok(Symmetry::C90C270)
             } else if near(h0, 0.0) && h1 > 180.0 && h1 <= 360.0 + ANGLE_TOL {
-                Symmetry::None
+                Ok(Symmetry::None)
             } else {
-                return bad_h(format!(
+                bad_h(format!(
                     "type C horizontal angles {h0}…{h1}° are not one of 0 (rotational), 0…90, 0…180, 90…270 or 0…360"
-                ));
+                ))
             }
         }
         Kind::A | Kind::B => {
@@ -302,16 +385,25 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
                 return bad_h("type A/B horizontal angles must lie in −90…90°".into());
             }
             if h0.abs() < ANGLE_TOL && nh > 1 {
-                Symmetry::Lateral
+                Ok(Symmetry::Lateral)
             } else if nh == 1 {
-                return bad_h("type A/B photometry needs at least two horizontal angles".into());
+                bad_h("type A/B photometry needs at least two horizontal angles".into())
             } else {
-                Symmetry::None
+                Ok(Symmetry::None)
             }
         }
-    };
-    let scale = multiplier * ballast * blpf * tilt_factor;
-    let mut candela = Vec::with_capacity(nh);
+    }
+}
+
+/// The candela table, a row per horizontal angle, times `scale`; nothing may follow it.
+fn candela_table(
+    t: &mut Tokens,
+    horiz: &[(usize, f64)],
+    vert: &[(usize, f64)],
+    scale: f64,
+) -> Result<Vec<Vec<f64>>, ParseError> {
+    let nv = vert.len();
+    let mut candela = Vec::with_capacity(horiz.len());
     for (i, &(_, h)) in horiz.iter().enumerate() {
         let mut row = Vec::with_capacity(t.capacity(nv));
         for (j, &(_, v)) in vert.iter().enumerate() {
@@ -334,24 +426,11 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
             "end of candela table",
             format!(
                 "unexpected extra value {s:?} after the {} candela values (wrong count of angles?)",
-                nh * nv
+                horiz.len() * nv
             ),
         ));
     }
-    let _ = llm_line;
-    let stated_lumens = (lumens_per_lamp > 0.0 && lamps > 0.0)
-        .then_some(lamps * lumens_per_lamp * ballast * blpf * tilt_factor);
-    Ok(Photometry {
-        format: Format::Ies(version),
-        header,
-        kind,
-        symmetry,
-        planes: horiz.iter().map(|a| a.1).collect(),
-        angles: vert.iter().map(|a| a.1).collect(),
-        candela,
-        stated_lumens,
-        size_m: [length.abs() * to_m, width.abs() * to_m, height.abs() * to_m],
-    })
+    Ok(candela)
 }
 
 const ANGLE_TOL: f64 = 1e-6;

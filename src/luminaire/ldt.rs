@@ -70,42 +70,101 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
         file,
     };
     let mut header = Vec::new();
-    let (_, company) = l.text("company identification")?;
-    header.push(("company".to_string(), company.to_string()));
-    let (_, ityp) = l.int("type indicator Ityp", 0, 3)?;
-    let (isym_line, isym) = l.int("symmetry indicator Isym", 0, 4)?;
-    let (mc_line, mc) = l.int("number of C planes Mc", 1, MAX_PLANES as i64)?;
-    let _ = l.num("distance between C planes Dc")?;
-    let (_, ng) = l.int("number of intensities per plane Ng", 1, MAX_ANGLES as i64)?;
-    let _ = l.num("distance between angles Dg")?;
-    for name in [
-        "measurement report number",
-        "luminaire name",
-        "luminaire number",
-        "file name",
-        "date/user",
-    ] {
-        let (_, v) = l.text(name)?;
-        header.push((name.to_string(), v.to_string()));
+    let h = Head::read(&mut l, &mut header)?;
+    let (lamp_flux, lor, conversion) = read_lamps(&mut l, &mut header)?;
+    let (mc, ng) = (h.mc as usize, h.ng as usize);
+    let c_angles = read_angles(&mut l, mc, "C angle")?;
+    let g_angles = read_angles(&mut l, ng, "gamma angle")?;
+    if c_angles[0] < 0.0 || c_angles[mc - 1] >= 360.0 {
+        return Err(l.err(h.mc_line, "C angles", "C angles must lie in 0…<360°"));
     }
-    header.push(("type indicator".into(), ityp.to_string()));
-    let mut dims = [0.0; 9];
-    for (k, name) in [
-        "length/diameter of luminaire (mm)",
-        "width of luminaire (mm)",
-        "height of luminaire (mm)",
-        "length/diameter of luminous area (mm)",
-        "width of luminous area (mm)",
-        "height of luminous area C0 (mm)",
-        "height of luminous area C90 (mm)",
-        "height of luminous area C180 (mm)",
-        "height of luminous area C270 (mm)",
-    ]
-    .iter()
-    .enumerate()
-    {
-        dims[k] = l.num(name)?.1;
+    if g_angles[0] < 0.0 || g_angles[ng - 1] > 180.0 {
+        return Err(l.err(h.mc_line, "gamma angles", "gamma angles must lie in 0…180°"));
     }
+    let (symmetry, planes) = tabulated_planes(&l, &h, &c_angles)?;
+    let scale = lamp_flux / 1000.0 * conversion;
+    let candela = read_intensities(&mut l, &planes, &g_angles, scale)?;
+    let stated = (lamp_flux > 0.0).then_some(lamp_flux * lor / 100.0 * conversion);
+    Ok(Photometry {
+        format: Format::Eulumdat,
+        header,
+        kind: Kind::C,
+        symmetry,
+        planes,
+        angles: g_angles,
+        candela,
+        stated_lumens: stated,
+        size_m: [h.dims[0] / 1000.0, h.dims[1] / 1000.0, h.dims[2] / 1000.0],
+    })
+}
+
+/// The lines before the lamp sets: identification, symmetry, counts of planes and angles,
+/// dimensions.
+struct Head {
+    isym_line: usize,
+    isym: i64,
+    mc_line: usize,
+    mc: i64,
+    ng: i64,
+    /// Luminaire length, width, height, then the luminous area's, mm.
+    dims: [f64; 9],
+}
+
+impl Head {
+    fn read(l: &mut Lines, header: &mut Vec<(String, String)>) -> Result<Self, ParseError> {
+        let (_, company) = l.text("company identification")?;
+        header.push(("company".to_string(), company.to_string()));
+        let (_, ityp) = l.int("type indicator Ityp", 0, 3)?;
+        let (isym_line, isym) = l.int("symmetry indicator Isym", 0, 4)?;
+        let (mc_line, mc) = l.int("number of C planes Mc", 1, MAX_PLANES as i64)?;
+        let _ = l.num("distance between C planes Dc")?;
+        let (_, ng) = l.int("number of intensities per plane Ng", 1, MAX_ANGLES as i64)?;
+        let _ = l.num("distance between angles Dg")?;
+        for name in [
+            "measurement report number",
+            "luminaire name",
+            "luminaire number",
+            "file name",
+            "date/user",
+        ] {
+            let (_, v) = l.text(name)?;
+            header.push((name.to_string(), v.to_string()));
+        }
+        header.push(("type indicator".into(), ityp.to_string()));
+        let mut dims = [0.0; 9];
+        for (k, name) in [
+            "length/diameter of luminaire (mm)",
+            "width of luminaire (mm)",
+            "height of luminaire (mm)",
+            "length/diameter of luminous area (mm)",
+            "width of luminous area (mm)",
+            "height of luminous area C0 (mm)",
+            "height of luminous area C90 (mm)",
+            "height of luminous area C180 (mm)",
+            "height of luminous area C270 (mm)",
+        ]
+        .iter()
+        .enumerate()
+        {
+            dims[k] = l.num(name)?.1;
+        }
+        Ok(Self {
+            isym_line,
+            isym,
+            mc_line,
+            mc,
+            ng,
+            dims,
+        })
+    }
+}
+
+/// From the downward flux fraction to the direct ratios: the lamps' total flux (lm), the light
+/// output ratio (%) and the conversion factor of the intensities.
+fn read_lamps(
+    l: &mut Lines,
+    header: &mut Vec<(String, String)>,
+) -> Result<(f64, f64, f64), ParseError> {
     let _ = l.num("downward flux fraction DFF (%)")?;
     let (lor_line, lor) = l.num("light output ratio LORL (%)")?;
     if lor < 0.0 {
@@ -144,33 +203,38 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
     for k in 1..=10 {
         let _ = l.num(&format!("direct ratio {k}"))?;
     }
-    let read_angles = |l: &mut Lines, n: usize, what: &str| -> Result<Vec<f64>, ParseError> {
-        let mut out: Vec<f64> = Vec::with_capacity(n);
-        for k in 0..n {
-            let field = format!("{what} {}", k + 1);
-            let (line, v) = l.num(&field)?;
-            if let Some(&prev) = out.last() {
-                if v <= prev {
-                    return Err(l.err(
-                        line,
-                        &field,
-                        format!("angles out of order: {v}° does not follow {prev}° (angles must increase)"),
-                    ));
-                }
+    Ok((lamp_flux, lor, conversion))
+}
+
+/// `n` strictly increasing angles, one a line, named `what` and their number in messages.
+fn read_angles(l: &mut Lines, n: usize, what: &str) -> Result<Vec<f64>, ParseError> {
+    let mut out: Vec<f64> = Vec::with_capacity(n);
+    for k in 0..n {
+        let field = format!("{what} {}", k + 1);
+        let (line, v) = l.num(&field)?;
+        if let Some(&prev) = out.last() {
+            if v <= prev {
+                return Err(l.err(
+                    line,
+                    &field,
+                    format!(
+                        "angles out of order: {v}° does not follow {prev}° (angles must increase)"
+                    ),
+                ));
             }
-            out.push(v);
         }
-        Ok(out)
-    };
-    let (mc, ng) = (mc as usize, ng as usize);
-    let c_angles = read_angles(&mut l, mc, "C angle")?;
-    let g_angles = read_angles(&mut l, ng, "gamma angle")?;
-    if c_angles[0] < 0.0 || c_angles[mc - 1] >= 360.0 {
-        return Err(l.err(mc_line, "C angles", "C angles must lie in 0…<360°"));
+        out.push(v);
     }
-    if g_angles[0] < 0.0 || g_angles[ng - 1] > 180.0 {
-        return Err(l.err(mc_line, "gamma angles", "gamma angles must lie in 0…180°"));
-    }
+    Ok(out)
+}
+
+/// The symmetry of Isym and the C planes whose intensities the file holds, which must include
+/// the planes that symmetry needs.
+fn tabulated_planes(
+    l: &Lines,
+    h: &Head,
+    c_angles: &[f64],
+) -> Result<(Symmetry, Vec<f64>), ParseError> {
     let pick = |lo: f64, hi: f64| -> Vec<f64> {
         c_angles
             .iter()
@@ -178,8 +242,8 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
             .filter(|&c| c >= lo - 1e-6 && c <= hi + 1e-6)
             .collect()
     };
-    let (symmetry, planes) = match isym {
-        0 => (Symmetry::None, c_angles.clone()),
+    let (symmetry, planes) = match h.isym {
+        0 => (Symmetry::None, c_angles.to_vec()),
         1 => (Symmetry::Rotational, vec![0.0]),
         2 => (Symmetry::C0C180, pick(0.0, 180.0)),
         3 => (Symmetry::C90C270, pick(90.0, 270.0)),
@@ -198,16 +262,27 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
     };
     if !ok {
         return Err(l.err(
-            isym_line,
+            h.isym_line,
             "symmetry indicator Isym",
             format!(
-                "the C angles {}…{}° do not contain the planes Isym {isym} needs",
+                "the C angles {}…{}° do not contain the planes Isym {} needs",
                 c_angles[0],
-                c_angles[mc - 1]
+                c_angles[c_angles.len() - 1],
+                h.isym
             ),
         ));
     }
-    let scale = lamp_flux / 1000.0 * conversion;
+    Ok((symmetry, planes))
+}
+
+/// The intensities of `planes` × `g_angles`, times `scale`; nothing but blank lines may follow.
+fn read_intensities(
+    l: &mut Lines,
+    planes: &[f64],
+    g_angles: &[f64],
+    scale: f64,
+) -> Result<Vec<Vec<f64>>, ParseError> {
+    let ng = g_angles.len();
     let mut candela = Vec::with_capacity(planes.len());
     for (i, &c) in planes.iter().enumerate() {
         let mut row = Vec::with_capacity(ng);
@@ -235,18 +310,7 @@ pub fn parse(text: &str, file: &Path) -> Result<Photometry, ParseError> {
             ),
         ));
     }
-    let stated = (lamp_flux > 0.0).then_some(lamp_flux * lor / 100.0 * conversion);
-    Ok(Photometry {
-        format: Format::Eulumdat,
-        header,
-        kind: Kind::C,
-        symmetry,
-        planes,
-        angles: g_angles,
-        candela,
-        stated_lumens: stated,
-        size_m: [dims[0] / 1000.0, dims[1] / 1000.0, dims[2] / 1000.0],
-    })
+    Ok(candela)
 }
 
 /// Write a type C photometry as EULUMDAT: one lamp set whose flux is the stated flux (or the

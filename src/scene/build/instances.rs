@@ -1,7 +1,7 @@
 //! `Instances` objects: their parts and transforms for the two-level BVH, or their copies when
 //! they emit (light sampling needs each emitter's triangles in world space).
 
-use super::Part;
+use super::obj_model::Part;
 use crate::bxdf::{Material, MaterialFlags};
 use crate::description::context::{Context, SceneError};
 use crate::geometry::{self, Shape, Transform};
