@@ -157,50 +157,14 @@ pub fn trace_light_path(
     }
     let light = &world.lights[caustics.lights[k] as usize];
     let mut wl = SampledWavelengths::sample_visible(u_wl);
-    let (origin, dir, mut beta) = if let Light::Distant(crate::light::DistantLight {
-        to_light,
-        irradiance,
-    }) = light
-    {
-        // Parallel light: flux per path = irradiance normal to the beam / density per area.
-        let dir = -*to_light;
-        let Some((origin, pdf_area)) = caustics.sample_parallel(dir, u_dir, Vec2::new(dx, dy))
-        else {
-            return;
-        };
-        let e = irradiance.sample(&wl);
-        if e.is_black() || pdf_area.is_nan() || pdf_area <= 0.0 {
-            return;
-        }
-        (origin, dir, e * (1.0 / (pdf_area * p_select)))
-    } else {
-        let Some(at) = light.sample_emission_point(&world.geometry, u_prim, Vec2::new(px, py))
-        else {
-            return;
-        };
-        let Some((dir, pdf_dir)) = caustics.sample_direction(at.p, u_dir, Vec2::new(dx, dy)) else {
-            return;
-        };
-        let le = light.emission_toward(&at, dir, &wl);
-        if le.is_black() || pdf_dir.is_nan() || pdf_dir <= 0.0 {
-            return;
-        }
-        let origin = match at.n {
-            Some(n) => crate::geometry::offset_ray_origin(
-                at.p,
-                crate::geometry::point_error_bound(at.p),
-                n,
-                dir,
-            ),
-            None => at.p,
-        };
-        (origin, dir, le * (at.inv_pdf / (pdf_dir * p_select)))
+    let u = (u_prim, u_dir, Vec2::new(px, py), Vec2::new(dx, dy));
+    let Some((origin, dir, mut beta)) = leave_light(world, caustics, light, p_select, u, &wl)
+    else {
+        return;
     };
     // The BSDF factors alone, for Russian roulette.
     let mut throughput = 1.0f32;
     let (mut ray_o, mut ray_d) = (origin, dir);
-    let filter = &settings.filter;
-    let camera = &world.camera;
     // Scattering events so far, counting the surface being processed.
     let mut depth = 0u32;
     // Null events (straight through window panes) since the last scattering.
@@ -246,55 +210,17 @@ pub fn trace_light_path(
                 .contains(crate::bxdf::MaterialFlags::ALL_DELTA);
         let want_e = settings.illuminance && object.light.is_none();
         if depth >= 2 && (want_l || want_e) {
-            if let Some(c) = camera.connect(hit.p, Vec2::new(lx, ly), filter.radius()) {
-                let cos_cam = c.wi.dot(hit.ng).abs();
-                let mut l = SampledSpectrum::ZERO;
-                let leak = normal_map.is_some()
-                    && crate::bxdf::normal_map::leaks(wo_world, c.wi, hit.ns, hit.ng);
-                if want_l && !leak {
-                    let wi = frame.to_local(c.wi);
-                    // Radiance convention: out toward the camera, in from the light.
-                    let f = material.eval(wi, wo, &wl);
-                    let g = cos_cam * wo_world.dot(hit.ns).abs() / wo_world.dot(hit.ng).abs();
-                    if !f.is_black() && g > 0.0 && g.is_finite() {
-                        l = beta * f * (g * c.importance);
-                    }
-                }
-                let mut e = SampledSpectrum::ZERO;
-                if want_e && c.wi.dot(hit.ng) * wo_world.dot(hit.ng) > 0.0 {
-                    e = beta * (cos_cam * c.importance);
-                }
-                if !(l.is_black() && e.is_black()) {
-                    stats.shadow_rays += 1;
-                    let origin = hit.spawn_origin(c.wi);
-                    let t_max = (c.lens_point - origin).length();
-                    // Through window panes with their transmittance, as the camera paths
-                    // see through them (a pane's straight transmission is a null event). The
-                    // illuminance channel is the illuminance on the first surface the camera
-                    // ray meets, so a surface behind a pane gives it nothing (the pane itself
-                    // receives its own splats on arrival).
-                    if let Some((tr, panes)) =
-                        transmittance_counted(world, origin, c.wi, t_max, &wl)
-                    {
-                        let xyz = radiance_to_xyz(&(l * tr), &wl);
-                        let e = if panes == 0 {
-                            radiance_to_xyz(&e, &wl)[1]
-                        } else {
-                            0.0
-                        };
-                        if !(xyz.iter().all(|v| v.is_finite()) && e.is_finite()) {
-                            stats.non_finite += 1;
-                        } else if xyz.iter().any(|&v| v != 0.0) || e != 0.0 {
-                            splats.push(Splat {
-                                path: index,
-                                film: c.film,
-                                xyz,
-                                e,
-                            });
-                        }
-                    }
-                }
-            }
+            let at = Vertex {
+                material,
+                hit: &hit,
+                frame: &frame,
+                wo,
+                wo_world,
+                normal_mapped: normal_map.is_some(),
+            };
+            let want = (want_l, want_e);
+            let u_lens = Vec2::new(lx, ly);
+            connect_to_camera(world, &at, want, beta, &wl, u_lens, index, splats, stats);
         }
 
         // A window pane: passing straight through is a null event, as for the camera paths
@@ -367,5 +293,130 @@ pub fn trace_light_path(
         straight_through = 0;
         ray_o = hit.spawn_origin(wi_world);
         ray_d = wi_world.normalize();
+    }
+}
+
+/// Where light path leaves `light` (chosen with probability `p_select`) and its flux per path
+/// (W/nm at `wl`); None when the sample carries nothing. `u` are the primitive's and the
+/// direction's numbers and the 2-D pairs of the point and the direction.
+fn leave_light(
+    world: &World,
+    caustics: &CausticLights,
+    light: &Light,
+    p_select: f32,
+    (u_prim, u_dir, u_point, u_cone): (f32, f32, Vec2, Vec2),
+    wl: &SampledWavelengths,
+) -> Option<(Vec3, Vec3, SampledSpectrum)> {
+    if let Light::Distant(crate::light::DistantLight {
+        to_light,
+        irradiance,
+    }) = light
+    {
+        // Parallel light: flux per path = irradiance normal to the beam / density per area.
+        let dir = -*to_light;
+        let (origin, pdf_area) = caustics.sample_parallel(dir, u_dir, u_cone)?;
+        let e = irradiance.sample(wl);
+        if e.is_black() || pdf_area.is_nan() || pdf_area <= 0.0 {
+            return None;
+        }
+        return Some((origin, dir, e * (1.0 / (pdf_area * p_select))));
+    }
+    let at = light.sample_emission_point(&world.geometry, u_prim, u_point)?;
+    let (dir, pdf_dir) = caustics.sample_direction(at.p, u_dir, u_cone)?;
+    let le = light.emission_toward(&at, dir, wl);
+    if le.is_black() || pdf_dir.is_nan() || pdf_dir <= 0.0 {
+        return None;
+    }
+    let origin = match at.n {
+        Some(n) => crate::geometry::offset_ray_origin(
+            at.p,
+            crate::geometry::point_error_bound(at.p),
+            n,
+            dir,
+        ),
+        None => at.p,
+    };
+    Some((origin, dir, le * (at.inv_pdf / (pdf_dir * p_select))))
+}
+
+/// A surface a light path reached: its material (normal-mapped and textured), hit, shading
+/// frame and the direction back toward the light.
+struct Vertex<'a> {
+    material: &'a crate::bxdf::Material,
+    hit: &'a crate::geometry::Hit,
+    frame: &'a Frame,
+    /// The direction toward the light, local and in the world.
+    wo: Vec3,
+    wo_world: Vec3,
+    normal_mapped: bool,
+}
+
+/// Connect a surface after the first (which scattered specularly) to the camera, for the
+/// luminance the surface sends toward it and the illuminance on it (`want`: each of them),
+/// with the path's flux `beta`; a visible connection is appended to `splats` as path `index`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn connect_to_camera(
+    world: &World,
+    at: &Vertex,
+    (want_l, want_e): (bool, bool),
+    beta: SampledSpectrum,
+    wl: &SampledWavelengths,
+    u_lens: Vec2,
+    index: u64,
+    splats: &mut Vec<Splat>,
+    stats: &mut RayStats,
+) {
+    let (hit, wo_world) = (at.hit, at.wo_world);
+    let Some(c) = world
+        .camera
+        .connect(hit.p, u_lens, world.settings.filter.radius())
+    else {
+        return;
+    };
+    let cos_cam = c.wi.dot(hit.ng).abs();
+    let mut l = SampledSpectrum::ZERO;
+    let leak = at.normal_mapped && crate::bxdf::normal_map::leaks(wo_world, c.wi, hit.ns, hit.ng);
+    if want_l && !leak {
+        let wi = at.frame.to_local(c.wi);
+        // Radiance convention: out toward the camera, in from the light.
+        let f = at.material.eval(wi, at.wo, wl);
+        let g = cos_cam * wo_world.dot(hit.ns).abs() / wo_world.dot(hit.ng).abs();
+        if !f.is_black() && g > 0.0 && g.is_finite() {
+            l = beta * f * (g * c.importance);
+        }
+    }
+    let mut e = SampledSpectrum::ZERO;
+    if want_e && c.wi.dot(hit.ng) * wo_world.dot(hit.ng) > 0.0 {
+        e = beta * (cos_cam * c.importance);
+    }
+    if l.is_black() && e.is_black() {
+        return;
+    }
+    stats.shadow_rays += 1;
+    let origin = hit.spawn_origin(c.wi);
+    let t_max = (c.lens_point - origin).length();
+    // Through window panes with their transmittance, as the camera paths see through them (a
+    // pane's straight transmission is a null event). The illuminance channel is the
+    // illuminance on the first surface the camera ray meets, so a surface behind a pane gives
+    // it nothing (the pane itself receives its own splats on arrival).
+    let Some((tr, panes)) = transmittance_counted(world, origin, c.wi, t_max, wl) else {
+        return;
+    };
+    let xyz = radiance_to_xyz(&(l * tr), wl);
+    let e = if panes == 0 {
+        radiance_to_xyz(&e, wl)[1]
+    } else {
+        0.0
+    };
+    if !(xyz.iter().all(|v| v.is_finite()) && e.is_finite()) {
+        stats.non_finite += 1;
+    } else if xyz.iter().any(|&v| v != 0.0) || e != 0.0 {
+        splats.push(Splat {
+            path: index,
+            film: c.film,
+            xyz,
+            e,
+        });
     }
 }

@@ -161,97 +161,25 @@ fn trace_impl<T: FnMut(Vec3, SampledSpectrum)>(
     tally: &mut T,
     keep_first_hit: bool,
 ) -> (SampledSpectrum, Option<Hit>) {
-    let settings = &world.settings;
+    let mut path = Path::new(origin, dir, &start);
     let mut first_hit = None;
     let mut seen_first = false;
-    let mut l = SampledSpectrum::ZERO;
-    let mut beta = SampledSpectrum::ONE;
-    let mut ray_o = origin;
-    let mut ray_d = dir;
-    // For MIS of emission found by BSDF sampling.
-    let mut prev_specular = start.specular;
-    let mut prev_pdf = start.pdf;
-    let mut prev_p = start.p;
-    let mut prev_n = start.n;
-    let mut depth = start.depth;
-    // Product of η′² over the refractions so far (see `Material::eta_scale`), for Russian
-    // roulette only.
-    let mut eta_scale = 1.0f32;
-    // Russian roulette weighs the throughput relative to its value after the first scattering
-    // of a path from a camera or a luminance meter (set at that scattering): its value is about
-    // that surface's albedo times the light it receives, so what the rest of the path brings
-    // matters relative to that albedo, not to 1. A dark surface's pixel is then as precise, for
-    // its value, as a bright one's. A receiver's path (depth ≥ 1 at the start) keeps 1.
-    let mut roulette_scale = 1.0f32;
-    // Whether the path's first scattering (at the surface the camera sees) was non-specular:
-    // with `start.caustics_by_light_tracing`, such paths that reach a light through a
-    // specular scattering are light tracing's part (see `super::light_path`).
-    // (A receiver's path, started at depth 1, begins at that non-specular receiver.)
-    let mut first_non_specular = start.depth >= 1;
-    // Null events (straight through window panes) since the last scattering.
-    let mut straight_through = 0u32;
-
     loop {
-        let hit = world.geometry.intersect(ray_o, ray_d, f32::INFINITY);
+        let hit = world
+            .geometry
+            .intersect(path.ray_o, path.ray_d, f32::INFINITY);
         if keep_first_hit && !seen_first {
             first_hit = hit;
         }
         seen_first = true;
         let Some(hit) = hit else {
-            if depth == start.depth && !start.unscattered_escapes {
-                break;
-            }
-            for &li in &world.infinite_lights {
-                let light = &world.lights[li as usize];
-                if start.sun_deposited
-                    && depth == start.depth
-                    && matches!(light, crate::light::Light::Sun(_))
-                {
-                    continue;
-                }
-                let le = light.escaped(ray_d, wl);
-                if le.is_black() {
-                    continue;
-                }
-                let c = if prev_specular {
-                    beta * le
-                } else {
-                    let p_light = world.light_sampler.pmf(prev_p, prev_n, li as usize, 0)
-                        * light.pdf_li_escape(prev_p, ray_d);
-                    beta * le * power_heuristic(prev_pdf, p_light)
-                };
-                l += c;
-                tally(ray_d, c);
-            }
+            path.escape(world, &start, wl, tally);
             break;
         };
         let object = world.objects[hit.object as usize];
-
-        // Emission seen along the path.
         if let Some(li) = object.light {
-            let light = &world.lights[li as usize];
-            let le = light.emitted(&hit, wl);
-            let light_traced = start.caustics_by_light_tracing
-                && first_non_specular
-                && prev_specular
-                && depth >= 2
-                && world
-                    .caustics
-                    .as_ref()
-                    .is_some_and(|c| c.handles(li as usize));
-            if !le.is_black() && !light_traced {
-                if prev_specular {
-                    l += beta * le;
-                } else {
-                    let p_light = world
-                        .light_sampler
-                        .pmf(prev_p, prev_n, li as usize, hit.prim)
-                        * light.pdf_li_hit_prim(&world.geometry, prev_p, &hit);
-                    l += beta * le * power_heuristic(prev_pdf, p_light);
-                }
-            }
+            path.add_emission(world, &start, &hit, li, wl);
         }
-
         let material = &world.materials[object.material as usize];
         let (material, normal_map) = material.normal_map();
         let hit = match normal_map {
@@ -270,129 +198,334 @@ fn trace_impl<T: FnMut(Vec3, SampledSpectrum)>(
             break;
         }
         let frame = Frame::from_normal(hit.ns);
-        let wo_world = -ray_d;
-        let wo = frame.to_local(wo_world);
+        let wo = frame.to_local(-path.ray_d);
         if wo.z == 0.0 {
             break;
         }
-
-        // A window pane: its lobe is chosen first. Passing straight through is a null event
-        // (no scattering vertex: depth, MIS state and the caustic partition stay those of the
-        // last real vertex), which matches next-event estimation, whose shadow rays pass
-        // through the pane with its transmittance (see `transmittance`).
-        let mut chosen = None;
-        if material
-            .flags()
-            .contains(crate::bxdf::MaterialFlags::STRAIGHT_THROUGH)
+        let chosen = match path.pane(material, wo, &hit, sampler, wl, stats) {
+            Pane::Absorbed => break,
+            Pane::Through => continue,
+            Pane::Scatter(chosen) => chosen,
+        };
+        if world
+            .settings
+            .max_depth
+            .is_some_and(|max| path.depth >= max)
         {
-            match choose_pane_lobe(material, wo, sampler, wl) {
-                None => break,
-                Some(PaneLobe::Straight(weight)) => {
-                    beta *= weight;
-                    straight_through += 1;
-                    if beta.is_black() || straight_through > MAX_STRAIGHT_THROUGH {
-                        break;
-                    }
-                    ray_o = hit.spawn_origin(ray_d);
-                    stats.bounce_rays += 1;
-                    continue;
-                }
-                Some(PaneLobe::Scatter(bs)) => chosen = Some(bs),
-            }
-        }
-
-        if settings.max_depth.is_some_and(|max| depth >= max) {
             stats.truncated_paths += 1;
             break;
         }
         material.prepare(wl);
-
-        // Next-event estimation. Each bounce takes two sets of four dimensions, each led by its
-        // 2-D pair (see `Sampler`): the point on the light, then the BSDF direction.
-        let [ptx, pty, u_light, u_prim] = sampler.get4();
-        let u_pt = glam::Vec2::new(ptx, pty);
-        let light_sample = if material
-            .flags()
-            .contains(crate::bxdf::MaterialFlags::ALL_DELTA)
-        {
-            None
-        } else {
-            world.light_sampler.sample(hit.p, Some(hit.ns), u_light)
+        let at = Shading {
+            material,
+            hit: &hit,
+            frame: &frame,
+            wo,
+            normal_mapped: normal_map.is_some(),
         };
-        if let Some((k, prim, p_select)) = light_sample {
-            let light = &world.lights[k];
-            if let Some(ls) = light.sample_li_prim(&world.geometry, hit.p, prim, u_prim, u_pt, wl) {
-                let leak = normal_map.is_some()
-                    && crate::bxdf::normal_map::leaks(wo_world, ls.wi, hit.ns, hit.ng);
-                if ls.pdf > 0.0 && !ls.li.is_black() && !leak {
-                    let wi = frame.to_local(ls.wi);
-                    let f = material.eval(wo, wi, wl) * wi.z.abs();
-                    if !f.is_black() {
-                        stats.shadow_rays += 1;
-                        if let Some(tr) =
-                            shadow_transmittance(world, &RayStart::surface(&hit), &ls, wl)
-                        {
-                            let pdf = p_select * ls.pdf;
-                            let w = if ls.delta {
-                                1.0
-                            } else {
-                                power_heuristic(pdf, material.pdf(wo, wi, wl))
-                            };
-                            let c = beta * f * tr * ls.li * (w / pdf);
-                            l += c;
-                            if ls.dist.is_infinite() {
-                                tally(ls.wi, c);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-
-        // Continue the path by sampling the BSDF.
-        let [ux, uy, uc, u_rr] = sampler.get4();
-        let u = glam::Vec2::new(ux, uy);
-        let Some(bs) = chosen.or_else(|| material.sample(wo, uc, u, wl)) else {
+        path.next_event(world, &at, sampler, wl, stats, tally);
+        if !path.scatter(world, &at, chosen, sampler, wl) {
             break;
-        };
-        if bs.pdf.is_nan() || bs.pdf <= 0.0 {
-            break;
-        }
-        if normal_map.is_some()
-            && crate::bxdf::normal_map::leaks(wo_world, frame.to_world(bs.wi), hit.ns, hit.ng)
-        {
-            break;
-        }
-        beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-        if beta.is_black() {
-            break;
-        }
-        eta_scale *= material.eta_scale(wo, bs.wi, wl);
-        if depth == 0 {
-            first_non_specular = !bs.specular;
-            roulette_scale = first_scatter_roulette_scale(beta.max_component());
-        }
-        prev_specular = bs.specular;
-        straight_through = 0;
-        prev_pdf = bs.pdf;
-        prev_p = hit.p;
-        prev_n = Some(hit.ns);
-        let wi_world = frame.to_world(bs.wi);
-        ray_o = hit.spawn_origin(wi_world);
-        ray_d = wi_world.normalize();
-        depth += 1;
-
-        // Russian roulette.
-        if depth > settings.rr_depth {
-            let p = super::survival_probability(beta.max_component() * eta_scale * roulette_scale);
-            if u_rr < 1.0 - p {
-                break;
-            }
-            beta = beta / p;
         }
         stats.bounce_rays += 1;
     }
-    (l, first_hit)
+    (path.l, first_hit)
+}
+
+/// The state of a camera path between its vertices: what it has gathered, its throughput,
+/// the ray it follows and what MIS and Russian roulette need of the vertex it left.
+struct Path {
+    /// Radiance gathered so far.
+    l: SampledSpectrum,
+    /// Throughput.
+    beta: SampledSpectrum,
+    ray_o: Vec3,
+    ray_d: Vec3,
+    /// For MIS of emission found by BSDF sampling: how the ray's direction was sampled, and
+    /// the point and normal it leaves.
+    prev_specular: bool,
+    prev_pdf: f32,
+    prev_p: Vec3,
+    prev_n: Option<Vec3>,
+    depth: u32,
+    /// Product of η′² over the refractions so far (see `Material::eta_scale`), for Russian
+    /// roulette only.
+    eta_scale: f32,
+    /// Russian roulette weighs the throughput relative to its value after the first
+    /// scattering of a path from a camera or a luminance meter (set at that scattering): its
+    /// value is about that surface's albedo times the light it receives, so what the rest of
+    /// the path brings matters relative to that albedo, not to 1. A dark surface's pixel is
+    /// then as precise, for its value, as a bright one's. A receiver's path (depth ≥ 1 at the
+    /// start) keeps 1.
+    roulette_scale: f32,
+    /// Whether the path's first scattering (at the surface the camera sees) was non-specular:
+    /// with `start.caustics_by_light_tracing`, such paths that reach a light through a
+    /// specular scattering are light tracing's part (see `super::light_path`). (A receiver's
+    /// path, started at depth 1, begins at that non-specular receiver.)
+    first_non_specular: bool,
+    /// Null events (straight through window panes) since the last scattering.
+    straight_through: u32,
+}
+
+/// A surface point as the path scatters there: its material (normal-mapped and textured),
+/// hit, shading frame and the local direction back along the ray.
+struct Shading<'a> {
+    material: &'a crate::bxdf::Material,
+    hit: &'a Hit,
+    frame: &'a Frame,
+    wo: Vec3,
+    normal_mapped: bool,
+}
+
+/// What a window pane did with the path.
+enum Pane {
+    /// Nothing more comes along the path.
+    Absorbed,
+    /// Straight through: a null event, the ray goes on from the far side.
+    Through,
+    /// A lobe that scatters (reflection or a rough lobe), or None for another material.
+    Scatter(Option<crate::bxdf::BsdfSample>),
+}
+
+impl Path {
+    #[inline(always)]
+    fn new(origin: Vec3, dir: Vec3, start: &PathStart) -> Self {
+        Self {
+            l: SampledSpectrum::ZERO,
+            beta: SampledSpectrum::ONE,
+            ray_o: origin,
+            ray_d: dir,
+            prev_specular: start.specular,
+            prev_pdf: start.pdf,
+            prev_p: start.p,
+            prev_n: start.n,
+            depth: start.depth,
+            eta_scale: 1.0,
+            roulette_scale: 1.0,
+            first_non_specular: start.depth >= 1,
+            straight_through: 0,
+        }
+    }
+
+    /// The ray left the scene: the lights at infinity it reaches, weighed by MIS.
+    #[inline(always)]
+    fn escape<T: FnMut(Vec3, SampledSpectrum)>(
+        &mut self,
+        world: &World,
+        start: &PathStart,
+        wl: &SampledWavelengths,
+        tally: &mut T,
+    ) {
+        if self.depth == start.depth && !start.unscattered_escapes {
+            return;
+        }
+        for &li in &world.infinite_lights {
+            let light = &world.lights[li as usize];
+            if start.sun_deposited
+                && self.depth == start.depth
+                && matches!(light, crate::light::Light::Sun(_))
+            {
+                continue;
+            }
+            let le = light.escaped(self.ray_d, wl);
+            if le.is_black() {
+                continue;
+            }
+            let c = if self.prev_specular {
+                self.beta * le
+            } else {
+                let p_light = world
+                    .light_sampler
+                    .pmf(self.prev_p, self.prev_n, li as usize, 0)
+                    * light.pdf_li_escape(self.prev_p, self.ray_d);
+                self.beta * le * power_heuristic(self.prev_pdf, p_light)
+            };
+            self.l += c;
+            tally(self.ray_d, c);
+        }
+    }
+
+    /// Emission of light `li` seen at `hit`, weighed by MIS; none for the caustic paths light
+    /// tracing estimates.
+    #[inline(always)]
+    fn add_emission(
+        &mut self,
+        world: &World,
+        start: &PathStart,
+        hit: &Hit,
+        li: u32,
+        wl: &SampledWavelengths,
+    ) {
+        let light = &world.lights[li as usize];
+        let le = light.emitted(hit, wl);
+        let light_traced = start.caustics_by_light_tracing
+            && self.first_non_specular
+            && self.prev_specular
+            && self.depth >= 2
+            && world
+                .caustics
+                .as_ref()
+                .is_some_and(|c| c.handles(li as usize));
+        if le.is_black() || light_traced {
+            return;
+        }
+        if self.prev_specular {
+            self.l += self.beta * le;
+        } else {
+            let p_light = world
+                .light_sampler
+                .pmf(self.prev_p, self.prev_n, li as usize, hit.prim)
+                * light.pdf_li_hit_prim(&world.geometry, self.prev_p, hit);
+            self.l += self.beta * le * power_heuristic(self.prev_pdf, p_light);
+        }
+    }
+
+    /// A window pane's lobe is chosen first. Passing straight through is a null event (no
+    /// scattering vertex: depth, MIS state and the caustic partition stay those of the last
+    /// real vertex), which matches next-event estimation, whose shadow rays pass through the
+    /// pane with its transmittance (see `transmittance`).
+    #[inline(always)]
+    fn pane(
+        &mut self,
+        material: &crate::bxdf::Material,
+        wo: Vec3,
+        hit: &Hit,
+        sampler: &mut Sampler,
+        wl: &mut SampledWavelengths,
+        stats: &mut RayStats,
+    ) -> Pane {
+        if !material
+            .flags()
+            .contains(crate::bxdf::MaterialFlags::STRAIGHT_THROUGH)
+        {
+            return Pane::Scatter(None);
+        }
+        match choose_pane_lobe(material, wo, sampler, wl) {
+            None => Pane::Absorbed,
+            Some(PaneLobe::Straight(weight)) => {
+                self.beta *= weight;
+                self.straight_through += 1;
+                if self.beta.is_black() || self.straight_through > MAX_STRAIGHT_THROUGH {
+                    return Pane::Absorbed;
+                }
+                self.ray_o = hit.spawn_origin(self.ray_d);
+                stats.bounce_rays += 1;
+                Pane::Through
+            }
+            Some(PaneLobe::Scatter(bs)) => Pane::Scatter(Some(bs)),
+        }
+    }
+
+    /// Next-event estimation at `at`. Each bounce takes two sets of four dimensions, each led
+    /// by its 2-D pair (see `Sampler`): the point on the light, then the BSDF direction.
+    #[inline(always)]
+    fn next_event<T: FnMut(Vec3, SampledSpectrum)>(
+        &mut self,
+        world: &World,
+        at: &Shading,
+        sampler: &mut Sampler,
+        wl: &SampledWavelengths,
+        stats: &mut RayStats,
+        tally: &mut T,
+    ) {
+        let (material, hit) = (at.material, at.hit);
+        let [ptx, pty, u_light, u_prim] = sampler.get4();
+        let u_pt = glam::Vec2::new(ptx, pty);
+        if material
+            .flags()
+            .contains(crate::bxdf::MaterialFlags::ALL_DELTA)
+        {
+            return;
+        }
+        let Some((k, prim, p_select)) = world.light_sampler.sample(hit.p, Some(hit.ns), u_light)
+        else {
+            return;
+        };
+        let light = &world.lights[k];
+        let Some(ls) = light.sample_li_prim(&world.geometry, hit.p, prim, u_prim, u_pt, wl) else {
+            return;
+        };
+        let leak =
+            at.normal_mapped && crate::bxdf::normal_map::leaks(-self.ray_d, ls.wi, hit.ns, hit.ng);
+        // (A NaN density is no sample either.)
+        let usable = ls.pdf > 0.0 && !ls.li.is_black() && !leak;
+        if !usable {
+            return;
+        }
+        let wi = at.frame.to_local(ls.wi);
+        let f = material.eval(at.wo, wi, wl) * wi.z.abs();
+        if f.is_black() {
+            return;
+        }
+        stats.shadow_rays += 1;
+        if let Some(tr) = shadow_transmittance(world, &RayStart::surface(hit), &ls, wl) {
+            let pdf = p_select * ls.pdf;
+            let w = if ls.delta {
+                1.0
+            } else {
+                power_heuristic(pdf, material.pdf(at.wo, wi, wl))
+            };
+            let c = self.beta * f * tr * ls.li * (w / pdf);
+            self.l += c;
+            if ls.dist.is_infinite() {
+                tally(ls.wi, c);
+            }
+        }
+    }
+
+    /// Continue the path by sampling the BSDF at `at` (or the pane's `chosen` lobe), then
+    /// Russian roulette; false when the path ends.
+    #[inline(always)]
+    fn scatter(
+        &mut self,
+        world: &World,
+        at: &Shading,
+        chosen: Option<crate::bxdf::BsdfSample>,
+        sampler: &mut Sampler,
+        wl: &mut SampledWavelengths,
+    ) -> bool {
+        let (material, hit, wo) = (at.material, at.hit, at.wo);
+        let [ux, uy, uc, u_rr] = sampler.get4();
+        let u = glam::Vec2::new(ux, uy);
+        let Some(bs) = chosen.or_else(|| material.sample(wo, uc, u, wl)) else {
+            return false;
+        };
+        if bs.pdf.is_nan() || bs.pdf <= 0.0 {
+            return false;
+        }
+        let wi_world = at.frame.to_world(bs.wi);
+        if at.normal_mapped && crate::bxdf::normal_map::leaks(-self.ray_d, wi_world, hit.ns, hit.ng)
+        {
+            return false;
+        }
+        self.beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+        if self.beta.is_black() {
+            return false;
+        }
+        self.eta_scale *= material.eta_scale(wo, bs.wi, wl);
+        if self.depth == 0 {
+            self.first_non_specular = !bs.specular;
+            self.roulette_scale = first_scatter_roulette_scale(self.beta.max_component());
+        }
+        self.prev_specular = bs.specular;
+        self.straight_through = 0;
+        self.prev_pdf = bs.pdf;
+        self.prev_p = hit.p;
+        self.prev_n = Some(hit.ns);
+        self.ray_o = hit.spawn_origin(wi_world);
+        self.ray_d = wi_world.normalize();
+        self.depth += 1;
+        if self.depth > world.settings.rr_depth {
+            let p = super::survival_probability(
+                self.beta.max_component() * self.eta_scale * self.roulette_scale,
+            );
+            if u_rr < 1.0 - p {
+                return false;
+            }
+            self.beta = self.beta / p;
+        }
+        true
+    }
 }
 
 /// Factor on the throughput for Russian roulette after a camera path's first scattering left it
