@@ -70,6 +70,9 @@ enum Command {
         /// Write the TM-30 colour vector graphic of a light source to this PNG.
         #[arg(long)]
         cvg: Option<PathBuf>,
+        /// How a CSV file is resampled to 1 nm: cie167 (Sprague / cubic spline, as colour-science) or linear.
+        #[arg(long, value_parser = ["cie167", "linear"], default_value = "cie167")]
+        interpolation: String,
     },
     /// Convert a photometric value between units, e.g. `candela convert 100 lx fc`.
     Convert {
@@ -112,6 +115,7 @@ fn main() -> ExitCode {
             method,
             efficacy_rule,
             cvg,
+            interpolation,
         } => {
             let obs = if observer == "1964" {
                 Observer::Cie1964_10
@@ -124,6 +128,8 @@ fn main() -> ExitCode {
                 efficacy_rule: efficacy_rule
                     .map(|r| cli::colour::health::parse_efficacy_rule(&r).expect("clap value")),
                 cvg,
+                interpolation: candela::colour::sd::Interpolation::parse(&interpolation)
+                    .expect("clap value"),
             };
             cli::colour::spectrum_command_with(&source, obs, json, &opts).map(|s| {
                 if json {

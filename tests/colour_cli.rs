@@ -233,3 +233,78 @@ fn convert_against_exact_unit_definitions() {
     close("1 fL", 1.0 / (pi * ft2), 3.426_259_099_635_39, 1e-12);
     close("1 fc", 1.0 / ft2, 10.763_910_416_709_722, 1e-12);
 }
+
+#[test]
+fn coarse_csv_interpolation_and_warnings() {
+    use candela::colour::sd::Interpolation;
+    use colour::health::SpectrumOptions;
+    // LED-B3 sampled every 10 nm over 380–780 nm. colour-science 0.4.7 refuses CIE 2017 for
+    // it; after `sd.interpolate(SpectralShape(380, 780, 1))` (Sprague) its
+    // colour_fidelity_index_ANSIIESTM3018 gives Rf 85.330047305, Rg 97.854788808 (computed in
+    // target/venv). tests/colour_health.rs compares 1 nm TM-30 to 1e-6.
+    let dir = tempfile::tempdir().unwrap();
+    let led = named_spectrum("LED-B3").unwrap();
+    let csv = |step: usize| {
+        let p = dir.path().join(format!("led-{step}nm.csv"));
+        let text: String = (380..=780)
+            .step_by(step)
+            .map(|l| format!("{l},{}\n", led.value(l as f64)))
+            .collect();
+        std::fs::write(&p, format!("nm,value\n{text}")).unwrap();
+        p
+    };
+    let run = |p: &std::path::Path, interpolation| -> Value {
+        let opts = SpectrumOptions {
+            interpolation,
+            ..Default::default()
+        };
+        let s =
+            colour::spectrum_command_with(p.to_str().unwrap(), Observer::Cie1931_2, true, &opts)
+                .unwrap();
+        serde_json::from_str(&s).unwrap()
+    };
+    let warnings = |j: &Value| -> Vec<String> {
+        j["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|w| w.as_str().unwrap().to_string())
+            .collect()
+    };
+    let p10 = csv(10);
+    let j = run(&p10, Interpolation::default());
+    let rf = j["colour_rendition"]["rf"].as_f64().unwrap();
+    let rg = j["colour_rendition"]["rg"].as_f64().unwrap();
+    assert!((rf - 85.330_047_305).abs() <= 1e-6, "Rf {rf}");
+    assert!((rg - 97.854_788_808).abs() <= 1e-6, "Rg {rg}");
+    let w = warnings(&j);
+    assert!(
+        w.len() == 1
+            && w[0].contains("10 nm")
+            && w[0].contains("CIE 224")
+            && w[0].contains("CIE 167"),
+        "{w:?}"
+    );
+    assert!(
+        j["description"].as_str().unwrap().contains("Sprague"),
+        "{}",
+        j["description"]
+    );
+    // Linear on request: the CSV and its interval named, and Rf moves by 0.24.
+    let j = run(&p10, Interpolation::Linear);
+    let w = warnings(&j);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("led-10nm.csv") && w.contains("10 nm") && w.contains("linear")),
+        "{w:?}"
+    );
+    let rf_lin = j["colour_rendition"]["rf"].as_f64().unwrap();
+    assert!(
+        (rf_lin - rf).abs() > 0.1,
+        "linear Rf {rf_lin} vs CIE 167 {rf}"
+    );
+    // 5 nm data: nothing to say, either way.
+    let p5 = csv(5);
+    assert!(warnings(&run(&p5, Interpolation::Linear)).is_empty());
+    assert!(warnings(&run(&p5, Interpolation::Cie167)).is_empty());
+}

@@ -467,7 +467,7 @@ fn spectrum_method_and_efficacy_rule_match_colour_science() {
                 let opts = SpectrumOptions {
                     method: Some(method),
                     efficacy_rule: Some(rule),
-                    cvg: None,
+                    ..Default::default()
                 };
                 let j: Value = serde_json::from_str(
                     &spectrum_command_with(name, Observer::Cie1931_2, true, &opts).unwrap(),

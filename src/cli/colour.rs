@@ -13,8 +13,9 @@ use health::SpectrumOptions;
 use candela::colour::tables::Observer;
 
 use candela::colour::grid::{END_NM, START_NM};
+use candela::colour::sd::Interpolation;
 use candela::photometry::{Quantity, UNITS};
-use candela::report::spectrum::{resolve_source, spectrum_colorimetry};
+use candela::report::spectrum::{resolve_source_with, spectrum_colorimetry};
 
 fn observer_name(o: Observer) -> &'static str {
     match o {
@@ -27,7 +28,7 @@ fn observer_name(o: Observer) -> &'static str {
 ///
 /// SOURCE is a two-column CSV file (nm, value), a named spectrum (see
 /// [`candela::colour::tables::named_spectrum_names`]), `blackbody:3000K` or `daylight:6504K`
-/// ([`resolve_source`]).  The spectrum is treated as a light source (for reflectances the
+/// ([`candela::report::spectrum::resolve_source`]).  The spectrum is treated as a light source (for reflectances the
 /// object colour under D65 is added).  Returns the human-readable table, or JSON with the keys
 /// documented in `docs/colour.md`.
 ///
@@ -49,9 +50,25 @@ pub fn spectrum_command_with(
     json: bool,
     opts: &SpectrumOptions,
 ) -> anyhow::Result<String> {
-    let src = resolve_source(source)?;
+    let src = resolve_source_with(source, opts.interpolation)?;
     let c = spectrum_colorimetry(&src, observer)?;
     let extras = health::extras(&src.table, src.reflectance, observer, opts)?;
+    let mut warnings = src.warnings.clone();
+    if let (Some(step), true) = (src.coarse_nm, extras.has_rendition()) {
+        // colour-science refuses such data; interpolated to 1 nm it computes them, as here.
+        warnings.push(format!(
+            "{source}: CIE 224:2017 and TM-30 need spectral data at 5 nm or finer; the samples \
+             are up to {step} nm apart, so Rf and Rg are those of the spectrum interpolated to \
+             1 nm ({}), not of a measurement",
+            match opts.interpolation {
+                Interpolation::Linear => "linearly",
+                Interpolation::Cie167 => "as CIE 167 recommends",
+            }
+        ));
+    }
+    for w in &warnings {
+        eprintln!("warning: {}", candela::limits::printable(w, 4096));
+    }
     let (xyz_n, xyz_abs, xy, upvp, uv) = (c.xyz_y100, c.xyz_absolute, c.xy, c.upvp, c.uv_1960);
     let (ohno, rob) = (c.cct_duv_ohno, c.cct_duv_robertson);
     let (efficacy, sp) = (c.luminous_efficacy_lm_per_w, c.sp_ratio);
@@ -81,6 +98,7 @@ pub fn spectrum_command_with(
             "srgb_linear": srgb_lin,
             "srgb_encoded": srgb_enc,
             "notes": notes,
+            "warnings": warnings,
         });
         if let Some(e) = bb_eff {
             j["blackbody_luminous_efficacy_lm_per_w"] = json!(e);

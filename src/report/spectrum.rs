@@ -14,7 +14,7 @@ use crate::colour::illuminants::sd_cie_daylight;
 use crate::colour::models::{xyz_to_lab, xyz_to_upvp, xyz_to_uv1960, xyz_to_xy};
 use crate::colour::planck::blackbody_table;
 use crate::colour::rgb::{srgb_encode, xyz_to_linear_srgb};
-use crate::colour::sd::SpectralDistribution;
+use crate::colour::sd::{Interpolation, SpectralDistribution, COARSE_INTERVAL_NM};
 use crate::colour::tables::{named_spectrum, named_spectrum_names, Observer};
 use crate::colour::temperature::{uv_to_cct_ohno2013, uv_to_cct_robertson1968};
 use crate::photometry::{blackbody_luminous_efficacy, luminous_efficacy, sp_ratio};
@@ -29,6 +29,11 @@ pub struct SpectrumSource {
     pub blackbody_k: Option<f64>,
     /// True for reflectance spectra (ColorChecker, TCS, Cornell surfaces).
     pub reflectance: bool,
+    /// A CSV file's largest sample interval when it is coarser than 5 nm (CIE 224 and TM-30
+    /// need 5 nm or finer).
+    pub coarse_nm: Option<f64>,
+    /// What the output must say about how the source was resampled.
+    pub warnings: Vec<String>,
 }
 
 fn parse_temperature(spec: &str, what: &str) -> anyhow::Result<f64> {
@@ -46,6 +51,14 @@ fn parse_temperature(spec: &str, what: &str) -> anyhow::Result<f64> {
 /// Resolves SOURCE: a two-column CSV file (nm, value), a named spectrum (see
 /// [`named_spectrum_names`]), `blackbody:3000K` or `daylight:6504K`.
 pub fn resolve_source(source: &str) -> anyhow::Result<SpectrumSource> {
+    resolve_source_with(source, Interpolation::default())
+}
+
+/// [`resolve_source`] with a CSV file resampled by `interpolation`.
+pub fn resolve_source_with(
+    source: &str,
+    interpolation: Interpolation,
+) -> anyhow::Result<SpectrumSource> {
     let lower = source.trim().to_lowercase();
     if let Some(rest) = lower.strip_prefix("blackbody:") {
         let t = parse_temperature(rest, "blackbody")?;
@@ -62,6 +75,8 @@ pub fn resolve_source(source: &str) -> anyhow::Result<SpectrumSource> {
             table: blackbody_table(t),
             blackbody_k: Some(t),
             reflectance: false,
+            coarse_nm: None,
+            warnings: Vec::new(),
         });
     }
     if let Some(rest) = lower.strip_prefix("daylight:") {
@@ -74,6 +89,8 @@ pub fn resolve_source(source: &str) -> anyhow::Result<SpectrumSource> {
             table: sd_cie_daylight(t),
             blackbody_k: None,
             reflectance: false,
+            coarse_nm: None,
+            warnings: Vec::new(),
         });
     }
     if let Some(sd) = named_spectrum(source) {
@@ -85,6 +102,8 @@ pub fn resolve_source(source: &str) -> anyhow::Result<SpectrumSource> {
             table: sd.to_table(),
             blackbody_k: None,
             reflectance,
+            coarse_nm: None,
+            warnings: Vec::new(),
         });
     }
     let path = Path::new(source);
@@ -106,16 +125,23 @@ pub fn resolve_source(source: &str) -> anyhow::Result<SpectrumSource> {
             path.display()
         );
     }
+    let step = sd.max_interval_nm();
     Ok(SpectrumSource {
         description: format!(
-            "CSV file {} ({} samples, {first}–{last} nm, linearly interpolated to 1 nm over \
-             {START_NM}–{END_NM} nm, zero outside its range)",
+            "CSV file {} ({} samples, {first}–{last} nm, at most {step} nm apart, resampled by {} to 1 nm \
+             over {START_NM}–{END_NM} nm, zero outside its range)",
             path.display(),
-            sd.values.len()
+            sd.values.len(),
+            sd.method(interpolation).name()
         ),
-        table: sd.to_table(),
+        table: sd.to_table_with(interpolation),
         blackbody_k: None,
         reflectance: false,
+        coarse_nm: (step > COARSE_INTERVAL_NM).then_some(step),
+        warnings: sd
+            .coarse_linear_warning(&path.display().to_string(), interpolation)
+            .into_iter()
+            .collect(),
     })
 }
 

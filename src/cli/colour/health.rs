@@ -14,6 +14,7 @@ use candela::colour::colorimetry::{sd_to_xyz_emissive_with, XyzMethod};
 use candela::colour::cqs::{colour_quality_scale, Cqs};
 use candela::colour::grid::LEN;
 use candela::colour::models::xyz_to_xy;
+use candela::colour::sd::Interpolation;
 use candela::colour::tables::Observer;
 use candela::colour::tm30::{colour_rendition, ColourRendition, Reference, N_BINS};
 use candela::output::draw;
@@ -38,6 +39,8 @@ pub struct SpectrumOptions {
     pub efficacy_rule: Option<EfficacyRule>,
     /// `--cvg FILE.png`: write TM-30's colour vector graphic there.
     pub cvg: Option<PathBuf>,
+    /// `--interpolation`: how a CSV file is resampled to 1 nm.
+    pub interpolation: Interpolation,
 }
 
 /// Parses `--method`: "integration" or "astm-e308".
@@ -79,6 +82,13 @@ pub struct Extras {
     cqs: Option<Cqs>,
     method: Option<(XyzMethod, [f64; 3], [f64; 2])>,
     efficacy: Option<(EfficacyRule, f64)>,
+}
+
+impl Extras {
+    /// Whether CIE 224 / TM-30 colour rendition was computed.
+    pub fn has_rendition(&self) -> bool {
+        self.rendition.is_some()
+    }
 }
 
 /// Computes the extras for `table` (as given, not rescaled). Lights get α-opic quantities and
