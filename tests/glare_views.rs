@@ -51,7 +51,13 @@ fn unit(a: [f64; 3]) -> [f64; 3] {
     a.map(|v| v / n)
 }
 
-fn cases() -> (PathBuf, Vec<Value>) {
+/// The pictures and evalglare's results, made once for all tests of this file.
+fn cases() -> &'static (PathBuf, Vec<Value>) {
+    static CASES: std::sync::OnceLock<(PathBuf, Vec<Value>)> = std::sync::OnceLock::new();
+    CASES.get_or_init(make_cases)
+}
+
+fn make_cases() -> (PathBuf, Vec<Value>) {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("glare_views");
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/glare/evalglare_views.py");
     let out = Command::new(python())
@@ -70,6 +76,7 @@ fn cases() -> (PathBuf, Vec<Value>) {
 #[test]
 fn tilted_and_rolled_views_match_evalglare() {
     let (dir, cases) = cases();
+    let dir = dir.as_path();
     let mut compared = 0;
     let mut tilted_differs = 0;
     for c in cases.iter().filter(|c| c["kind"] != "uniform") {
@@ -184,6 +191,7 @@ fn tilted_and_rolled_views_match_evalglare() {
 #[test]
 fn uniform_pictures_give_evalglare_illuminance() {
     let (dir, cases) = cases();
+    let dir = dir.as_path();
     let mut n = 0;
     let mut bad = Vec::new();
     for c in cases.iter().filter(|c| c["kind"] == "uniform") {
@@ -220,4 +228,108 @@ fn uniform_pictures_give_evalglare_illuminance() {
     }
     assert!(bad.is_empty(), "{bad:#?}");
     assert_eq!(n, 11);
+}
+
+/// `candela glare` with `--background`, `--peak-limit` and `--position-index-up` against
+/// evalglare with `-q`, `-Y` and its own convention, on the tilted picture.
+#[test]
+fn cli_options_match_evalglare() {
+    let (dir, cases) = cases();
+    let find = |opts: &[&str]| {
+        cases
+            .iter()
+            .find(|c| {
+                c["picture"] == "sources_down26.hdr" && c["options"] == serde_json::json!(opts)
+            })
+            .unwrap()
+    };
+    let run = |args: &[&str]| -> Value {
+        let mut a = vec!["glare", "sources_down26.hdr", "--json", "--draws", "0"];
+        a.extend_from_slice(args);
+        let (code, out, err) = common::cli(&a, dir);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        serde_json::from_str(&out).unwrap()
+    };
+    for (ours, theirs) in [
+        (vec![], vec![]),
+        (vec!["--background", "mean"], vec!["-q", "1"]),
+        (vec!["--background", "ev-over-pi"], vec!["-q", "2"]),
+        (vec!["--background", "cie"], vec![]),
+        (vec!["--peak-limit", "20000"], vec!["-Y", "20000"]),
+        (vec!["--peak-limit", "100000"], vec!["-Y", "100000"]),
+        (vec!["--position-index-up", "as-given"], vec![]),
+    ] {
+        let (r, e) = (run(&ours), find(&theirs));
+        println!(
+            "{ours:?}: DGP {} UGR {} DGI {}",
+            r["dgp"]["value"], r["ugr"]["value"], r["dgi"]["value"]
+        );
+        for (k, tol) in [("dgp", 2e-6), ("ugr", 2e-4), ("dgi", 2e-4)] {
+            let (a, b) = (r[k]["value"].as_f64().unwrap(), e[k].as_f64().unwrap());
+            assert!((a - b).abs() <= tol, "{ours:?}: {k} {a} vs evalglare {b}");
+        }
+        assert!(
+            (r["background_cd_m2"].as_f64().unwrap() / e["lb"].as_f64().unwrap() - 1.0).abs()
+                < 1e-6
+        );
+        assert_eq!(
+            r["sources"].as_array().unwrap().len(),
+            e["sources"].as_array().unwrap().len()
+        );
+    }
+    // The perpendicular up changes the position indices of this tilted view.
+    let p = run(&["--position-index-up", "perpendicular"]);
+    let e = find(&[]);
+    let d = (p["ugr"]["value"].as_f64().unwrap() - e["ugr"].as_f64().unwrap()).abs();
+    assert!(d > 0.01, "UGR moved by {d}");
+    for bad in [
+        vec!["--peak-limit", "0"],
+        vec!["--peak-limit", "nan"],
+        vec!["--peak-limit", "1000", "--no-peaks"],
+        vec!["--background", "median"],
+        vec!["--position-index-up", "world"],
+    ] {
+        let mut a = vec!["glare", "sources_down26.hdr"];
+        a.extend_from_slice(&bad);
+        let (code, _, err) = common::cli(&a, dir);
+        assert_eq!(code, 2, "{bad:?}: {err}");
+    }
+}
+
+/// Views that no projection can have, or that do not fit their picture, are refused with the
+/// file and the VIEW option named, not evaluated.
+#[test]
+fn impossible_views_are_refused() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("glare_views_refused");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (k, (view, option)) in [
+        ("-vth -vh 300 -vv 300", "-vh 300"),
+        ("-vtv -vh 400 -vv 400", "-vh 400"),
+        ("-vtv -vh 180 -vv 180", "-vh 180"),
+        ("-vta -vh 400 -vv 180", "-vh 400"),
+        ("-vts -vh 360 -vv 360", "-vh 360"),
+        ("-vta -vh 0 -vv 0", "-vh 0"),
+        ("-vta -vh -180 -vv -180", "-vh -180"),
+        ("-vta -vh nan -vv 180", "-vh"),
+        ("-vta -vh 180 -vv 180 -vu 0 1 0", "-vu"),
+        ("-vta -vh 180 -vv 90", "-vh 180 -vv 90"),
+        ("-vta -vh 180 -vv 180 -vs 0.3", "-vs 0.3"),
+        ("-vtc -vh 180 -vv 180", "-vtc"),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let name = format!("bad{k}.hdr");
+        let mut bytes =
+            format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\nVIEW= {view}\n\n-Y 8 +X 8\n").into_bytes();
+        bytes.extend_from_slice(&[128, 128, 128, 136].repeat(64));
+        std::fs::write(dir.join(&name), bytes).unwrap();
+        let (code, out, err) = common::cli(&["glare", &name], &dir);
+        println!("{view}: {}", err.trim());
+        assert_eq!(code, 1, "{view}: {out} {err}");
+        assert!(
+            err.contains(&name) && err.contains("VIEW") && err.contains(option),
+            "{view}: {err}"
+        );
+    }
 }
