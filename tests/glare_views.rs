@@ -333,3 +333,65 @@ fn impossible_views_are_refused() {
         );
     }
 }
+
+/// A candela EXR's `projection` attribute: what is behind the eye is left out (a uniform
+/// luminance L gives E_v = πL also for a 360° fisheye and an equirectangular image, whose
+/// rear half would otherwise cancel the front), and projections out of range are refused.
+#[test]
+fn exr_projection_attribute_views() {
+    use candela::output::{write_exr, Layers, ATTRIBUTE_PROJECTION, CHANNEL_Y};
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("glare_views_exr");
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, projection: &str, w: usize, h: usize| {
+        let layers = Layers {
+            width: w,
+            height: h,
+            channels: vec![(CHANNEL_Y.to_string(), vec![100.0; w * h])],
+            attributes: vec![(ATTRIBUTE_PROJECTION.to_string(), projection.to_string())],
+        };
+        let path = dir.join(name);
+        write_exr(&path, &layers).unwrap();
+        path
+    };
+    let pi_l = std::f64::consts::PI * 100.0;
+    for (projection, w, h, tol) in [
+        // Rim pixels hold the mean over their whole area: the sum is exact to rounding.
+        (
+            "Fisheye(mapping: Equidistant, fov_deg: 180)",
+            200,
+            200,
+            1e-3,
+        ),
+        (
+            "Fisheye(mapping: Equidistant, fov_deg: 360)",
+            200,
+            200,
+            1e-3,
+        ),
+        // Pixels across the horizon count by their centre's side: half a row's error.
+        ("Equirectangular", 400, 200, 1e-2),
+    ] {
+        let img = read_glare_image(&write("a.exr", projection, w, h)).unwrap();
+        let r = evaluate(&img, &GlareOptions::default()).unwrap();
+        println!("{projection}: Ev {:.3} πL {pi_l:.3}", r.ev_lx);
+        assert!(
+            (r.ev_lx / pi_l - 1.0).abs() < tol,
+            "{projection}: Ev {}",
+            r.ev_lx
+        );
+    }
+    for bad in [
+        "Fisheye(mapping: Orthographic, fov_deg: 300)",
+        "Fisheye(mapping: Equidistant, fov_deg: 400)",
+        "Fisheye(mapping: Stereographic, fov_deg: 0)",
+        "Perspective(vfov_deg: 180)",
+        "Perspective(vfov_deg: -10)",
+    ] {
+        let path = write("bad.exr", bad, 16, 16);
+        let e = read_glare_image(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("bad.exr") && e.contains("projection"),
+            "{bad}: {e}"
+        );
+    }
+}
