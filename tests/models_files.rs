@@ -415,15 +415,13 @@ fn vertices_out_of_range_are_refused_after_transforms() {
     }
     // A scene transform that takes an OBJ out of range is refused with the vertex, too.
     std::fs::write(d.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
-    let text = format!(
-        r#"(
+    let text = r#"(
     camera: (position: (0, 0, 3), look_at: (0, 0, 0), vfov_deg: 40, resolution: (4, 4)),
-    materials: {{ "g": Diffuse(reflectance: Constant(0.5)) }},
+    materials: { "g": Diffuse(reflectance: Constant(0.5)) },
     objects: [(shape: Obj("m.obj"), material: "g", transform: (translate: (1e18, 0, 0))),
               (shape: Sphere(center: (0, 0, 0), radius: 1), material: "g")],
     lights: [Point(position: (0, 0, 2), spectrum: Named("D65"), amount: Intensity(10.0))],
-)"#
-    );
+)"#;
     std::fs::write(d.join("s.ron"), text).unwrap();
     let (code, _, stderr) = common::cli(&["render", "--quiet", "--out", "o", "s.ron"], d);
     assert_eq!(code, 1, "{stderr}");

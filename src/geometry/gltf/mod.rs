@@ -191,11 +191,51 @@ fn parse_file(path: &Path) -> Result<gltf::Gltf, GeometryError> {
             path: path.to_path_buf(),
             source,
         })?;
+    precheck(path, &bytes)?;
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         gltf::Gltf::from_slice(&bytes)
     }))
     .map_err(|_| parse_err(path, "the glTF parser failed on malformed input".into()))?
     .map_err(|e| parse_err(path, e.to_string()))
+}
+
+/// Refuses a primitive whose `POSITION` names an accessor the file does not have, which the
+/// `gltf` crate's validation would index unchecked (a panic). Anything else malformed is left
+/// to the parser, which reports it.
+fn precheck(path: &Path, bytes: &[u8]) -> Result<(), GeometryError> {
+    let glb;
+    let json: &[u8] = if bytes.starts_with(b"glTF") {
+        match gltf::Glb::from_slice(bytes) {
+            Ok(g) => {
+                glb = g;
+                &glb.json
+            }
+            Err(_) => return Ok(()),
+        }
+    } else {
+        bytes
+    };
+    let Ok(root) = gltf::json::Root::from_slice(json) else {
+        return Ok(());
+    };
+    let n = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (k, p) in mesh.primitives.iter().enumerate() {
+            for (semantic, a) in &p.attributes {
+                if a.value() >= n {
+                    return Err(parse_err(
+                        path,
+                        format!(
+                            "mesh {m} primitive {k}: attribute {:?} names accessor {}, but the file has {n}",
+                            semantic,
+                            a.value()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Loads a `.gltf` or `.glb` file (see the module docs). The scene is the file's default
