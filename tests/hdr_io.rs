@@ -247,18 +247,29 @@ fn malformed_pictures_are_refused_naming_the_file() {
     refused("exposures.hdr", &tiny, "out of range");
     // A run longer than its scanline.
     let mut rle = with(b"-Y 1 +X 8\n");
-    rle.extend([2, 2, 0, 8, 128 + 9, 5]);
+    rle.extend([2, 2, 0, 8, 128 + 9, 5, 0, 0]);
     refused("overrun.hdr", &rle, "overruns");
     // An old-style run with nothing to repeat.
     refused(
         "orphan.hdr",
-        &with(b"-Y 1 +X 2\n\x01\x01\x01\x05"),
+        &with(b"-Y 1 +X 2\n\x01\x01\x01\x05\0\0\0\0"),
         "repeats no previous",
     );
-    // Huge: refused before allocating, from the header alone.
+    // Huge: refused before allocating, from the header alone: more scanlines than the file
+    // could hold, or more pixels than memory (16 scanlines of 2³¹ − 1 pixels, 20 bytes each
+    // in old-style runs, 412 GB decoded).
     refused(
         "huge.hdr",
         &with(b"-Y 2000000000 +X 2000000000\n"),
+        "take at least 40000000000 bytes",
+    );
+    let mut line = vec![128, 128, 128, 129];
+    for digit in [255, 255, 255, 127] {
+        line.extend([1, 1, 1, digit]);
+    }
+    refused(
+        "wide.hdr",
+        &with(&[&b"-Y 16 +X 2147483647\n"[..], &line.repeat(16)].concat()),
         "memory",
     );
     // Not a Radiance picture at all.
@@ -354,4 +365,103 @@ fn a_fisheye_render_writes_its_view_into_the_hdr_and_the_exr() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let l = v["luminance"]["mean"].as_f64().or(v["luminance"].as_f64());
     assert!(l.is_some(), "{v}");
+}
+
+/// A constant picture in the densest scanlines the reader takes: one literal pixel, then
+/// old-style runs of it whose counts are the base-256 digits of the remaining width − 1.
+fn densest_picture(w: usize, h: usize, flip: bool) -> (Vec<u8>, usize) {
+    let mut b = format!(
+        "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n{} {h} +X {w}\n",
+        if flip { "+Y" } else { "-Y" }
+    )
+    .into_bytes();
+    let head = b.len();
+    let mut line = vec![128, 128, 128, 129];
+    let mut rest = w - 1;
+    while rest > 0 {
+        line.extend([1, 1, 1, (rest & 255) as u8]);
+        rest >>= 8;
+    }
+    for _ in 0..h {
+        b.extend(&line);
+    }
+    (b, head)
+}
+
+/// The size check from the resolution line is exact: a picture in the densest scanlines
+/// (`min_scanline_bytes` each) is read, to the values Radiance's `pvalue` reads from it, and
+/// the same picture one byte short is refused before any pixel is decoded, naming the file
+/// and the bytes the declared size needs.
+#[test]
+fn the_densest_scanlines_pass_the_size_check_and_one_byte_less_does_not() {
+    use candela::output::min_scanline_bytes;
+    let dir = tempfile::tempdir().unwrap();
+    // 128 at exponent 129 is (128.5/256)·2 = 1.00390625 in every channel: a grey.
+    let want = 179.0 * 1.003_906_25f64;
+    for (w, h) in [
+        (1, 3),
+        (2, 2),
+        (7, 2),
+        (256, 2),
+        (257, 3),
+        (300, 2),
+        (65537, 2),
+    ] {
+        for flip in [false, true] {
+            let (bytes, head) = densest_picture(w, h, flip);
+            assert_eq!(
+                (bytes.len() - head) as u64,
+                h as u64 * min_scanline_bytes(w)
+            );
+            let path = dir.path().join(format!("dense-{w}.hdr"));
+            std::fs::write(&path, &bytes).unwrap();
+            let (rw, rh, lum, _) = read_hdr_luminance(&path).unwrap();
+            assert_eq!((rw, rh, lum.len()), (w, h, w * h));
+            for l in &lum {
+                assert!((*l as f64 / want - 1.0).abs() < 1e-6, "{w}×{h}: {l}");
+            }
+            let layers = read_image(&path).unwrap();
+            assert_eq!(layers.channel("Y").unwrap(), lum.as_slice());
+            let cut = dir.path().join(format!("cut-{w}.hdr"));
+            std::fs::write(&cut, &bytes[..bytes.len() - 1]).unwrap();
+            let e = read_hdr(&cut).unwrap_err().to_string();
+            let need = h as u64 * min_scanline_bytes(w);
+            assert!(
+                e.contains(&format!("cut-{w}.hdr"))
+                    && e.contains(&format!("at least {need} bytes")),
+                "{e}"
+            );
+        }
+    }
+    // Radiance reads the densest picture to the same brightness (its getinfo, then pvalue).
+    let (bytes, _) = densest_picture(300, 2, false);
+    let path = dir.path().join("dense.hdr");
+    std::fs::write(&path, &bytes).unwrap();
+    let out = radiance("pvalue", &["-h", "-H", "-b", "-d", path.to_str().unwrap()]);
+    let values: Vec<f64> = out.split_whitespace().map(|t| t.parse().unwrap()).collect();
+    assert_eq!(values.len(), 600, "{out}");
+    // pvalue prints 4 significant digits: half a unit of the last is 5e-4 of 1.004.
+    for v in values {
+        assert!((v * 179.0 / want - 1.0).abs() < 5e-4, "pvalue gives {v}");
+    }
+}
+
+/// Rows are placed by the resolution line's orientation: a `+Y` picture's first scanline is
+/// the bottom row, read the same through `read_hdr` and `read_image`.
+#[test]
+fn bottom_to_top_pictures_read_the_same_both_ways() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("rows.hdr");
+    let mut b = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n+Y 3 +X 1\n".to_vec();
+    for e in [129, 130, 131] {
+        b.extend([128, 128, 128, e]);
+    }
+    std::fs::write(&path, &b).unwrap();
+    let img = read_hdr(&path).unwrap();
+    let layers = read_image(&path).unwrap();
+    let y: Vec<f32> = img.xyz.iter().map(|p| p[1]).collect();
+    assert_eq!(layers.channel("Y").unwrap(), y.as_slice());
+    assert_eq!(layers, img.to_layers());
+    // Top row first: the last scanline in the file (exponent 131) is 4 × the first.
+    assert!((y[0] / y[2] - 4.0).abs() < 1e-6, "{y:?}");
 }

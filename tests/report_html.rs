@@ -193,6 +193,9 @@ fn pages_hold_the_exact_channels_and_mismatches_are_refused() {
     // The output may not replace an input.
     let (code, _, err) = cli(&["report", "room.exr", "-o", "room.exr"], d);
     assert_eq!(code, 1);
-    assert!(err.contains("would replace the input"), "{err}");
+    assert!(
+        err.contains("refusing to overwrite the input room.exr"),
+        "{err}"
+    );
     assert_eq!(std::fs::read(d.join("room.exr")).unwrap(), bytes);
 }

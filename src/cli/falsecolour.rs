@@ -3,11 +3,11 @@
 
 use std::path::PathBuf;
 
-use candela::output::read_image;
+use candela::output::read_image_with;
 use candela::photometry::Quantity;
 use candela::report::check_photometric_layers;
 use candela::report::falsecolour::{
-    describe_scale, render_falsecolour, FalsecolourSettings, Palette, Scale,
+    bytes_per_pixel, describe_scale, render_falsecolour, FalsecolourSettings, Palette, Scale,
 };
 use candela::report::units::UnitSystem;
 
@@ -125,8 +125,6 @@ pub fn run(args: &FalsecolourArgs) -> anyhow::Result<String> {
             args.exr.display()
         );
     }
-    let layers = read_image(&args.exr).map_err(|e| anyhow::anyhow!("{e}"))?;
-    check_photometric_layers(&args.exr, &layers).map_err(|e| anyhow::anyhow!(e))?;
     let file_name = args
         .exr
         .file_name()
@@ -148,6 +146,10 @@ pub fn run(args: &FalsecolourArgs) -> anyhow::Result<String> {
             &q[1..]
         )),
     };
+    // The map's buffers are part of the memory checked before the image is decoded.
+    let layers = read_image_with(&args.exr, &|_| bytes_per_pixel(&settings))
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    check_photometric_layers(&args.exr, &layers).map_err(|e| anyhow::anyhow!(e))?;
     let (img, info) = render_falsecolour(&layers, &settings)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.exr.display()))?;
     candela::output::write_rgb_png(&out, &img).map_err(|e| anyhow::anyhow!("{e}"))?;

@@ -194,6 +194,7 @@ impl RenderOpts {
             overwrite: self.overwrite,
             save_state: self.save_state,
             falsecolour: self.falsecolour,
+            report_html: self.report_html,
             shard: self
                 .shard
                 .as_deref()

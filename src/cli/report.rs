@@ -43,6 +43,17 @@ pub fn run(a: &ReportArgs) -> anyhow::Result<String> {
         .out
         .clone()
         .unwrap_or_else(|| candela::output::with_suffix(&base, ".html"));
+    if let Some(g) = a
+        .glare
+        .as_deref()
+        .filter(|g| candela::output::would_replace(&out, g))
+    {
+        anyhow::bail!(
+            "{}: refusing to overwrite the input {} (--glare) with the HTML report; choose another output",
+            out.display(),
+            g.display()
+        );
+    }
     let glare = a.glare.as_deref().map(read_glare_json).transpose()?;
     let r = write_html_report(&a.exr, report.as_deref(), glare.as_ref(), &out)?;
     Ok(format!(

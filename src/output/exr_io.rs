@@ -265,6 +265,15 @@ const MAX_EXR_FILE_BYTES: u64 = 1 << 40;
 /// compression, is refused before decoding, as [`OutputError::InvalidImage`] naming its size
 /// (the decoder allocates the whole image from the header alone).
 pub fn read_exr(path: &Path) -> Result<Layers, OutputError> {
+    read_exr_with(path, &|_| 0)
+}
+
+/// [`read_exr`] for a caller that will hold `beside(channel names)` more bytes per pixel
+/// beside the image; that is part of the memory checked before decoding.
+pub(super) fn read_exr_with(
+    path: &Path,
+    beside: super::BesideBytes,
+) -> Result<Layers, OutputError> {
     let exr_err = |message: String| OutputError::Exr {
         path: path.to_path_buf(),
         message,
@@ -274,7 +283,7 @@ pub fn read_exr(path: &Path) -> Result<Layers, OutputError> {
             path: path.to_path_buf(),
             source,
         })?;
-    check_decoded_size(path, &bytes)?;
+    check_decoded_size(path, &bytes, beside)?;
     let decoded = std::panic::catch_unwind(|| {
         read()
             .no_deep_data()
@@ -293,7 +302,8 @@ pub fn read_exr(path: &Path) -> Result<Layers, OutputError> {
 
     let mut out = Layers::default();
     let multi = image.layer_data.len() > 1;
-    for (i, layer) in image.layer_data.iter().enumerate() {
+    let image_attributes = image.attributes;
+    for (i, mut layer) in image.layer_data.into_iter().enumerate() {
         let (w, h) = (layer.size.width(), layer.size.height());
         if i == 0 {
             out.width = w;
@@ -308,8 +318,13 @@ pub fn read_exr(path: &Path) -> Result<Layers, OutputError> {
             (Some(name), true) => format!("{}.", from_text(name)),
             _ => String::new(),
         };
-        for channel in &layer.channel_data.list {
-            let samples: Vec<f32> = channel.sample_data.values_as_f32().collect();
+        for channel in std::mem::take(&mut layer.channel_data.list) {
+            // f32 samples are moved, not copied: a second copy of the image would double the
+            // peak memory.
+            let samples: Vec<f32> = match channel.sample_data {
+                FlatSamples::F32(v) => v,
+                other => other.values_as_f32().collect(),
+            };
             if samples.len() != w * h {
                 return Err(exr_err(format!(
                     "channel '{}' has {} samples, expected {}",
@@ -327,7 +342,7 @@ pub fn read_exr(path: &Path) -> Result<Layers, OutputError> {
                 out.attributes.push((name.to_string(), from_text(value)));
             }
         }
-        for (name, value) in attrs.other.iter().chain(image.attributes.other.iter()) {
+        for (name, value) in attrs.other.iter().chain(image_attributes.other.iter()) {
             if let AttributeValue::Text(text) = value {
                 let name = from_text(name);
                 if out.attributes.iter().all(|(n, _)| *n != name) {
@@ -346,11 +361,17 @@ pub fn read_exr(path: &Path) -> Result<Layers, OutputError> {
 /// describes pixels the file cannot hold.
 const MAX_EXPANSION: u64 = 2048;
 
-/// Refuses, from the header alone, an image whose samples would exceed the memory available
-/// (every channel of every part at its largest size, as the decoder stores it plus the f32 copy
-/// [`read_exr`] returns), or more than the file could hold at any compression
-/// ([`MAX_EXPANSION`]). A header that cannot be read is left to the decoder to report.
-fn check_decoded_size(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+/// Refuses, from the header alone, an image whose samples would exceed the memory available,
+/// or more than the file could hold at any compression ([`MAX_EXPANSION`]). The memory is the
+/// larger of what decoding holds at once (the file's bytes, every channel of every part at its
+/// largest size as the decoder stores it, and the f32 copy [`read_exr`] returns) and what the
+/// caller then holds (that copy and `beside(channel names)` per pixel of the first part). A
+/// header that cannot be read is left to the decoder to report.
+fn check_decoded_size(
+    path: &Path,
+    bytes: &[u8],
+    beside: super::BesideBytes,
+) -> Result<(), OutputError> {
     let meta = std::panic::catch_unwind(|| {
         exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
     });
@@ -360,8 +381,21 @@ fn check_decoded_size(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     let Some(first) = meta.headers.first() else {
         return Ok(());
     };
-    let (mut stored, mut need, mut samples) = (0u64, 0u64, 0u64);
+    let (mut stored, mut samples, mut f32_bytes) = (0u64, 0u64, 0u64);
+    let mut names = Vec::new();
+    let multi = meta.headers.len() > 1;
     for header in meta.headers.iter() {
+        let prefix = match (&header.own_attributes.layer_name, multi) {
+            (Some(name), true) => format!("{}.", from_text(name)),
+            _ => String::new(),
+        };
+        names.extend(
+            header
+                .channels
+                .list
+                .iter()
+                .map(|c| format!("{prefix}{}", from_text(&c.name))),
+        );
         let (w, h) = (header.layer_size.width(), header.layer_size.height());
         for channel in header.channels.list.iter() {
             let n =
@@ -369,9 +403,26 @@ fn check_decoded_size(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
             let bytes_per_sample = channel.sample_type.bytes_per_sample() as u64;
             samples = samples.saturating_add(n);
             stored = stored.saturating_add(n.saturating_mul(bytes_per_sample));
-            need = need.saturating_add(n.saturating_mul(bytes_per_sample + 4));
+            if channel.sample_type == exr::meta::attribute::SampleType::F32 {
+                f32_bytes = f32_bytes.saturating_add(n.saturating_mul(4));
+            }
         }
     }
+    let pixels = first.layer_size.width() as u64 * first.layer_size.height() as u64;
+    // Decoding: the file, the decoded samples, and the f32 copy of those that are not f32
+    // already; then the f32 channels and the caller's buffers.
+    let converted = samples.saturating_mul(4).saturating_sub(f32_bytes);
+    let decoding = (bytes.len() as u64)
+        .saturating_add(stored)
+        .saturating_add(converted);
+    let after = samples
+        .saturating_mul(4)
+        .saturating_add(pixels.saturating_mul(beside(
+            &names.iter().map(String::as_str).collect::<Vec<_>>(),
+        )));
+    let need = decoding
+        .max(after)
+        .saturating_add(crate::limits::BASE_BYTES);
     let what = format!(
         "the image ({}×{} pixels, {} part(s), {samples} samples in all)",
         first.layer_size.width(),

@@ -53,28 +53,45 @@ impl HdrImage {
     /// file has them, the `radiance_view` and `projection` attributes.
     pub fn to_layers(&self) -> Layers {
         let component = |i: usize| self.xyz.iter().map(|p| p[i]).collect::<Vec<f32>>();
-        let mut layers = Layers::new(self.width, self.height);
-        layers.channels = vec![
-            (super::CHANNEL_X.to_string(), component(0)),
-            (super::CHANNEL_Y.to_string(), component(1)),
-            (super::CHANNEL_Z.to_string(), component(2)),
-        ];
-        layers.attributes.push((
-            super::ATTRIBUTE_UNITS.to_string(),
-            super::UNITS_CD_PER_M2.to_string(),
-        ));
-        if let Some(v) = &self.view {
-            layers
-                .attributes
-                .push((super::ATTRIBUTE_VIEW.to_string(), v.clone()));
-        }
-        if let Some(p) = &self.projection {
-            layers
-                .attributes
-                .push((super::ATTRIBUTE_PROJECTION.to_string(), p.clone()));
-        }
-        layers
+        layers_of(
+            self.width,
+            self.height,
+            [component(0), component(1), component(2)],
+            &self.view,
+            &self.projection,
+        )
     }
+}
+
+/// The [`Layers`] of a Radiance picture: its X, Y, Z channels and attributes.
+fn layers_of(
+    width: usize,
+    height: usize,
+    [x, y, z]: [Vec<f32>; 3],
+    view: &Option<String>,
+    projection: &Option<String>,
+) -> Layers {
+    let mut layers = Layers::new(width, height);
+    layers.channels = vec![
+        (super::CHANNEL_X.to_string(), x),
+        (super::CHANNEL_Y.to_string(), y),
+        (super::CHANNEL_Z.to_string(), z),
+    ];
+    layers.attributes.push((
+        super::ATTRIBUTE_UNITS.to_string(),
+        super::UNITS_CD_PER_M2.to_string(),
+    ));
+    if let Some(v) = view {
+        layers
+            .attributes
+            .push((super::ATTRIBUTE_VIEW.to_string(), v.clone()));
+    }
+    if let Some(p) = projection {
+        layers
+            .attributes
+            .push((super::ATTRIBUTE_PROJECTION.to_string(), p.clone()));
+    }
+    layers
 }
 
 /// The RGB → XYZ matrix (rows X, Y, Z) of primaries and white `p` (xy), white scaled to Y = 1.
@@ -278,17 +295,69 @@ fn encode_scanline(row: &[[u8; 4]], out: &mut Vec<u8>) {
 /// Reads a Radiance picture (RGBE or XYZE; new-style run-length encoded, old-style or flat
 /// scanlines; top-to-bottom or bottom-to-top rows) into absolute XYZ in cd/m², undoing
 /// `EXPOSURE` and `COLORCORR` and using its `PRIMARIES`. A malformed, truncated or
-/// unsupported file gives [`OutputError::Hdr`] naming it; an image that would not fit in the
-/// memory available is refused before its pixels are allocated.
+/// unsupported file gives [`OutputError::Hdr`] naming it; so does a resolution line that
+/// declares more scanlines than the rest of the file could hold at the densest encoding.
+/// An image that would not fit in the memory available is refused before its pixels are
+/// allocated.
 pub fn read_hdr(path: &Path) -> Result<HdrImage, OutputError> {
-    let bytes =
-        crate::limits::read_file(path, MAX_HDR_FILE_BYTES).map_err(|source| OutputError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-    decode(&bytes).map_err(|message| OutputError::Hdr {
+    let bytes = read_bytes(path)?;
+    let hdr_err = |message| OutputError::Hdr {
         path: path.to_path_buf(),
         message,
+    };
+    let head = parse_header(&bytes).map_err(hdr_err)?;
+    let (w, h) = (head.width, head.height);
+    let n = head.check_size(path, bytes.len(), 0)?;
+    let mut xyz = vec![[0f32; 3]; n];
+    head.decode(&bytes, |y, row| {
+        xyz[y * w..(y + 1) * w].copy_from_slice(row);
+    })
+    .map_err(hdr_err)?;
+    Ok(HdrImage {
+        width: w,
+        height: h,
+        xyz,
+        view: head.view(),
+        projection: head.projection,
+    })
+}
+
+/// A Radiance picture read straight into [`Layers`] (as [`HdrImage::to_layers`], without the
+/// intermediate copy), checking first that the decoded channels and `beside_bytes_per_pixel`
+/// more (what the caller will hold per pixel beside them) fit in the memory available.
+pub(super) fn read_hdr_layers(
+    path: &Path,
+    beside_bytes_per_pixel: u64,
+) -> Result<Layers, OutputError> {
+    let bytes = read_bytes(path)?;
+    let hdr_err = |message| OutputError::Hdr {
+        path: path.to_path_buf(),
+        message,
+    };
+    let head = parse_header(&bytes).map_err(hdr_err)?;
+    let w = head.width;
+    let n = head.check_size(path, bytes.len(), beside_bytes_per_pixel)?;
+    let (mut x, mut y, mut z) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
+    head.decode(&bytes, |r, row| {
+        let at = r * w;
+        for (i, p) in row.iter().enumerate() {
+            (x[at + i], y[at + i], z[at + i]) = (p[0], p[1], p[2]);
+        }
+    })
+    .map_err(hdr_err)?;
+    Ok(layers_of(
+        w,
+        head.height,
+        [x, y, z],
+        &head.view(),
+        &head.projection,
+    ))
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>, OutputError> {
+    crate::limits::read_file(path, MAX_HDR_FILE_BYTES).map_err(|source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
     })
 }
 
@@ -307,11 +376,116 @@ pub fn looks_like_hdr(bytes: &[u8]) -> bool {
     bytes.starts_with(b"#?")
 }
 
-fn decode(bytes: &[u8]) -> Result<HdrImage, String> {
+/// Fewest bytes a scanline of `width` pixels takes in any encoding [`read_scanline`] reads: a
+/// literal pixel, then old-style runs of it whose counts are the base-256 digits of the
+/// remaining `width − 1` pixels, 4 bytes each (a new-style scanline takes at least 12 bytes,
+/// never fewer than this for the widths it allows).
+pub fn min_scanline_bytes(width: usize) -> u64 {
+    let mut rest = width.saturating_sub(1) as u64;
+    let mut bytes = 4;
+    while rest > 0 {
+        bytes += 4;
+        rest >>= 8;
+    }
+    bytes
+}
+
+/// What the header and the resolution line of a Radiance picture say.
+struct Header {
+    /// Offset of the first scanline.
+    data: usize,
+    width: usize,
+    height: usize,
+    /// `+Y`: the first scanline is the bottom row.
+    flip: bool,
+    exposure: [f64; 3],
+    primaries: [[f64; 2]; 4],
+    xyze: bool,
+    views: Vec<String>,
+    projection: Option<String>,
+}
+
+impl Header {
+    fn view(&self) -> Option<String> {
+        (!self.views.is_empty()).then(|| self.views.join(" "))
+    }
+
+    /// The number of pixels, once it is known that the file can hold them
+    /// ([`OutputError::Hdr`] if not) and that they fit in the memory available as three f32
+    /// channels with `beside_bytes_per_pixel` more ([`OutputError::InvalidImage`] if not).
+    fn check_size(
+        &self,
+        path: &Path,
+        file_len: usize,
+        beside_bytes_per_pixel: u64,
+    ) -> Result<usize, OutputError> {
+        let (w, h) = (self.width, self.height);
+        let hdr_err = |message| OutputError::Hdr {
+            path: path.to_path_buf(),
+            message,
+        };
+        let n = w
+            .checked_mul(h)
+            .ok_or_else(|| hdr_err(format!("image size {w}×{h} is too large")))?;
+        let least = (h as u64).saturating_mul(min_scanline_bytes(w));
+        let have = (file_len - self.data) as u64;
+        if have < least {
+            return Err(hdr_err(format!(
+                "the resolution line declares {w}×{h} pixels: {h} scanlines of {w} pixels take at least {least} bytes even run-length encoded, and the file has {have} after its header: it is truncated or corrupt"
+            )));
+        }
+        crate::limits::check_memory(
+            (n as u64)
+                .saturating_mul(12 + beside_bytes_per_pixel)
+                .saturating_add(file_len as u64 + crate::limits::BASE_BYTES),
+            &format!("decoding the {w}×{h} Radiance picture"),
+        )
+        .map_err(|reason| OutputError::invalid(path, reason))?;
+        Ok(n)
+    }
+
+    /// Decodes every scanline, giving `row(y, xyz)` each row (top row first by index `y`) in
+    /// absolute XYZ, cd/m².
+    fn decode(&self, bytes: &[u8], mut row: impl FnMut(usize, &[[f32; 3]])) -> Result<(), String> {
+        let (w, h) = (self.width, self.height);
+        let m = if self.xyze {
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+        } else {
+            rgb_to_xyz_matrix(&self.primaries).ok_or("PRIMARIES are degenerate")?
+        };
+        let mut rgbe_row = vec![[0u8; 4]; w];
+        let mut xyz_row = vec![[0f32; 3]; w];
+        let mut data = &bytes[self.data..];
+        for s in 0..h {
+            read_scanline(&mut data, &mut rgbe_row).map_err(|e| format!("scanline {s}: {e}"))?;
+            let y = if self.flip { h - 1 - s } else { s };
+            for (x, (p, out)) in rgbe_row.iter().zip(xyz_row.iter_mut()).enumerate() {
+                let c = if p[3] == 0 {
+                    [0.0; 3]
+                } else {
+                    let f = 2f64.powi(p[3] as i32 - 136);
+                    [0, 1, 2].map(|i| (p[i] as f64 + 0.5) * f / self.exposure[i])
+                };
+                let v = mul(&m, c).map(|k| (k.max(0.0) * RADIANCE_EFFICACY) as f32);
+                if !v.iter().all(|k| k.is_finite()) {
+                    return Err(format!(
+                        "pixel ({x}, {y}) is too bright for 32-bit floats ({} cd/m² or more)",
+                        f32::MAX
+                    ));
+                }
+                *out = v;
+            }
+            row(y, &xyz_row);
+        }
+        Ok(())
+    }
+}
+
+/// The header lines up to the first empty one, and the resolution line after it.
+fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     if !looks_like_hdr(bytes) {
         return Err("no Radiance header (the file does not start with \"#?\")".into());
     }
-    // Header: lines up to the first empty one.
     let mut pos = 0;
     let mut exposure = [1.0f64; 3];
     let mut primaries = RADIANCE_PRIMARIES;
@@ -389,7 +563,12 @@ fn decode(bytes: &[u8]) -> Result<HdrImage, String> {
     let res = String::from_utf8_lossy(&bytes[pos..pos + end]).into_owned();
     pos += end + 1;
     let t: Vec<&str> = res.split_whitespace().collect();
-    let bad_res = || format!("resolution line '{}' is not '-Y H +X W'", res.trim());
+    let bad_res = || {
+        format!(
+            "resolution line '{}' is not '-Y H +X W'",
+            crate::limits::printable(res.trim(), 64)
+        )
+    };
     if t.len() != 4 || t[2] != "+X" {
         return Err(bad_res());
     }
@@ -403,50 +582,15 @@ fn decode(bytes: &[u8]) -> Result<HdrImage, String> {
     if width == 0 || height == 0 || width > i32::MAX as usize || height > i32::MAX as usize {
         return Err(format!("image size {width}×{height} is empty or too large"));
     }
-    let n = width
-        .checked_mul(height)
-        .ok_or_else(|| format!("image size {width}×{height} is too large"))?;
-    // The RGBE pixels and the f32 XYZ returned.
-    crate::limits::check_memory(
-        (n as u64).saturating_mul(4 + 12),
-        &format!("decoding the {width}×{height} image"),
-    )?;
-    let mut rgbe_px = vec![[0u8; 4]; n];
-    let mut data = &bytes[pos..];
-    for y in 0..height {
-        let row = &mut rgbe_px[y * width..(y + 1) * width];
-        read_scanline(&mut data, row).map_err(|e| format!("scanline {y}: {e}"))?;
-    }
-    let m = if xyze {
-        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-    } else {
-        rgb_to_xyz_matrix(&primaries).ok_or("PRIMARIES are degenerate")?
-    };
-    let mut xyz = Vec::with_capacity(n);
-    for y in 0..height {
-        let src = if flip { height - 1 - y } else { y };
-        for (x, p) in rgbe_px[src * width..(src + 1) * width].iter().enumerate() {
-            let c = if p[3] == 0 {
-                [0.0; 3]
-            } else {
-                let f = 2f64.powi(p[3] as i32 - 136);
-                [0, 1, 2].map(|i| (p[i] as f64 + 0.5) * f / exposure[i])
-            };
-            let v = mul(&m, c).map(|k| (k.max(0.0) * RADIANCE_EFFICACY) as f32);
-            if !v.iter().all(|k| k.is_finite()) {
-                return Err(format!(
-                    "pixel ({x}, {y}) is too bright for 32-bit floats ({} cd/m² or more)",
-                    f32::MAX
-                ));
-            }
-            xyz.push(v);
-        }
-    }
-    Ok(HdrImage {
+    Ok(Header {
+        data: pos,
         width,
         height,
-        xyz,
-        view: (!views.is_empty()).then(|| views.join(" ")),
+        flip,
+        exposure,
+        primaries,
+        xyze,
+        views,
         projection,
     })
 }

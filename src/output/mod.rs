@@ -23,8 +23,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 pub use exr_io::{read_exr, write_exr, Layers};
 pub use hdr::{
-    read_hdr, read_hdr_luminance, rgb_to_xyz_matrix, write_hdr, HdrImage, RADIANCE_EFFICACY,
-    RADIANCE_PRIMARIES,
+    min_scanline_bytes, read_hdr, read_hdr_luminance, rgb_to_xyz_matrix, write_hdr, HdrImage,
+    RADIANCE_EFFICACY, RADIANCE_PRIMARIES,
 };
 pub use png::{
     auto_exposure_ev, ev_to_scale, log_average_luminance, write_rgb_png, write_srgb_png, PngInfo,
@@ -161,6 +161,19 @@ impl OutputError {
 /// Reads an image candela can measure: a Radiance picture (a file starting with `#?`, as
 /// [`HdrImage::to_layers`]) or else an OpenEXR file ([`read_exr`]).
 pub fn read_image(path: &Path) -> Result<Layers, OutputError> {
+    read_image_with(path, &|_| 0)
+}
+
+/// What a reader of an image will hold per pixel beside the image's channels while it works
+/// on them, in bytes, given the names of the channels the file declares.
+pub type BesideBytes<'a> = &'a dyn Fn(&[&str]) -> u64;
+
+/// [`read_image`] for a caller that will hold `beside(channel names)` more bytes per pixel
+/// while the image is in memory (its own buffers): the image is refused, before its pixels
+/// are decoded, if the decoding and those buffers together would not fit in the memory
+/// available ([`crate::limits::check_memory`]), so a command reading a huge image fails with
+/// a message naming the file instead of aborting part-way.
+pub fn read_image_with(path: &Path, beside: BesideBytes) -> Result<Layers, OutputError> {
     let mut head = [0u8; 2];
     // Only a regular file is opened here (opening a FIFO would block); anything else goes
     // to the EXR reader, which refuses it by kind.
@@ -174,10 +187,43 @@ pub fn read_image(path: &Path) -> Result<Layers, OutputError> {
         None => false,
     };
     if is_hdr {
-        Ok(read_hdr(path)?.to_layers())
+        let names = [CHANNEL_X, CHANNEL_Y, CHANNEL_Z];
+        hdr::read_hdr_layers(path, beside(&names))
     } else {
-        read_exr(path)
+        exr_io::read_exr_with(path, beside)
     }
+}
+
+/// The directory of outputs at `path` ("." for a bare file name).
+pub(crate) fn dir_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// The directory entry `path` names: its directory resolved (links, `..`) and its file name.
+pub(crate) fn entry(path: &Path) -> Option<PathBuf> {
+    Some(dir_of(path).canonicalize().ok()?.join(path.file_name()?))
+}
+
+/// Whether writing `output` (a new file renamed over the entry, see
+/// [`write_atomic`]) would replace or change `input`: the same directory entry,
+/// the entry a link at `input` resolves to, or the same file by another name (inode).
+pub fn would_replace(output: &Path, input: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(output), std::fs::metadata(input)) {
+            if a.dev() == b.dev() && a.ino() == b.ino() {
+                return true;
+            }
+        }
+    }
+    let Some(out) = entry(output) else {
+        return output == input;
+    };
+    entry(input).is_some_and(|e| e == out) || input.canonicalize().is_ok_and(|c| c == out)
 }
 
 /// Temporary files being written right now, so that [`remove_temporary_files`] can delete them

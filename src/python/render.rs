@@ -190,6 +190,7 @@ fn render<'py>(
         overwrite,
         save_state,
         falsecolour,
+        report_html: false,
         shard: shard
             .map(job::shard::parse_from_env)
             .transpose()

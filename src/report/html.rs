@@ -20,7 +20,7 @@ use super::falsecolour::{ColourScale, FalsecolourSettings, Palette, Scale};
 use super::probe::Z95;
 use super::units::UnitSystem;
 use crate::output::{
-    read_image, write_atomic, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR, CHANNEL_X,
+    read_image_with, write_atomic, Layers, CHANNEL_E, CHANNEL_E_MASK, CHANNEL_E_STDERR, CHANNEL_X,
     CHANNEL_Y, CHANNEL_Y_STDERR, CHANNEL_Z, ILLUMINANCE_SENTINEL,
 };
 use crate::photometry::Quantity;
@@ -78,15 +78,15 @@ pub fn write_html_report(
     out: &Path,
 ) -> anyhow::Result<HtmlReport> {
     for input in [Some(exr), report].into_iter().flatten() {
-        if same_file(input, out) {
+        if crate::output::would_replace(out, input) {
             bail!(
-                "{}: the output would replace the input {}",
+                "{}: refusing to overwrite the input {} with the HTML report; choose another output",
                 out.display(),
                 input.display()
             );
         }
     }
-    let layers = read_image(exr).map_err(|e| anyhow!("{e}"))?;
+    let layers = read_image_with(exr, &bytes_per_pixel).map_err(|e| anyhow!("{e}"))?;
     super::check_photometric_layers(exr, &layers).map_err(|e| anyhow!(e))?;
     let report = match report {
         None => None,
@@ -115,6 +115,19 @@ pub fn write_html_report(
     })
 }
 
+/// Bytes per pixel the page's making holds beside the image's channels, given their names: the
+/// larger of the work on the image (an XYZ copy, the false-colour ranges' values: 40) and two
+/// copies of the page's data, each embedded channel deflated and in base64 (at most 5.4 bytes
+/// a sample, for samples that do not compress). Measured peaks: 33 bytes a pixel for a
+/// constant Radiance picture, 60 for a noisy render with illuminance (7 channels embedded).
+pub fn bytes_per_pixel(channels: &[&str]) -> u64 {
+    let embedded = channels
+        .iter()
+        .filter(|c| EMBEDDED_CHANNELS.contains(c))
+        .count() as u64;
+    (40u64).max(12 * embedded) + 8
+}
+
 /// Reads the JSON of `candela glare --json` from `path`; anything else is refused, naming the
 /// file.
 pub fn read_glare_json(path: &Path) -> anyhow::Result<Value> {
@@ -126,13 +139,6 @@ pub fn read_glare_json(path: &Path) -> anyhow::Result<Value> {
         );
     }
     Ok(v)
-}
-
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => a == b,
-    }
 }
 
 fn read_json(path: &Path) -> anyhow::Result<Value> {
@@ -293,9 +299,13 @@ pub fn html_page(
     });
     // Inside <script type="application/json"> only "</script" or "<!--" could end or bend the
     // element; with every "<" escaped (it occurs only inside JSON strings) neither can.
-    let data = serde_json::to_string(&data)
-        .map_err(|e| e.to_string())?
-        .replace('<', "\\u003c");
+    let data = {
+        let text = serde_json::to_string(&data).map_err(|e| e.to_string())?;
+        // Two copies of the page's data at once, not four (`json!` copied the channels).
+        drop(data);
+        drop(encoded);
+        text.replace('<', "\\u003c")
+    };
     let title = html_escape(&format!("candela report: {name}"));
     let mut page = String::with_capacity(data.len() + TEMPLATE.len() + CSS.len() + JS.len());
     let mut rest = TEMPLATE;

@@ -63,6 +63,15 @@ fn extract(
     }
 }
 
+/// Bytes per image pixel a false-colour map holds beside the image's channels: its value, whether
+/// it is defined, the defined values, the range's sorted copy of them, and their positive part
+/// (log scale) or contour classes; then the PNG's 3 (the measured peak of `candela
+/// falsecolour` is the image's channels and 25 bytes a pixel, linear scale).
+pub fn bytes_per_pixel(settings: &FalsecolourSettings) -> u64 {
+    let log_or_contours = settings.scale == super::Scale::Log || settings.contours;
+    8 + 1 + 8 + 8 + if log_or_contours { 8 } else { 0 } + 3
+}
+
 /// Renders the false-colour image in memory (see [`write_falsecolour`]).
 pub fn render_falsecolour(
     layers: &Layers,
@@ -86,12 +95,8 @@ pub fn render_falsecolour(
             c.len()
         ));
     }
-    // Per pixel: its value, whether it is defined, the defined values, the range's sorted
-    // copy of them, and their positive part (log scale) or contour classes.
-    let log_or_contours = settings.scale == super::Scale::Log || settings.contours;
-    let per_pixel = 8 + 1 + 8 + 8 + if log_or_contours { 8 } else { 0 };
     check_memory(
-        pixels as u64 * per_pixel,
+        pixels as u64 * bytes_per_pixel(settings),
         &format!("the false-colour map of the {w}×{h} image"),
     )?;
     let (values, defined) = extract(layers, settings)?;

@@ -22,7 +22,7 @@ use crate::photometry::Quantity;
 
 pub use legend::describe_scale;
 pub(crate) use legend::Legend;
-pub use map::{render_falsecolour, write_falsecolour};
+pub use map::{bytes_per_pixel, render_falsecolour, write_falsecolour};
 pub use scale::{nice_ceil, ColourScale, Palette, Scale};
 
 /// How to draw a false-colour map or heat map. Values (`range`) are in the display units
