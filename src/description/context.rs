@@ -236,12 +236,24 @@ impl Context<'_> {
                 in_range(self, field, &sd, "the table")?;
                 DenseSpectrum::from_fn(|nm| sd.value(nm))
             }
-            SpectrumDesc::Csv(rel) => {
+            SpectrumDesc::Csv(rel, interpolation) => {
                 let p = self.resolve(rel);
                 let sd = SpectralDistribution::from_csv_path(&p)
                     .map_err(|e| self.err(field, e.to_string()))?;
                 in_range(self, field, &sd, &format!("{}", p.display()))?;
-                DenseSpectrum::from_fn(|nm| sd.value(nm))
+                // CIE 167's interpolants can ring below 0 next to a sharp line (and a
+                // reflectance above 1): held at those bounds, valid samples stay valid and
+                // invalid ones are still refused below.
+                let t = sd.to_table_with(*interpolation);
+                let max = sd.values.iter().fold(f64::NEG_INFINITY, |m, &v| v.max(m));
+                let lo = sd.min_value().min(0.0);
+                let hi = if role == Role::Reflectance {
+                    max.max(1.0)
+                } else {
+                    f64::INFINITY
+                };
+                let start = crate::colour::grid::START_NM as f64;
+                DenseSpectrum::from_fn(|nm| t[(nm - start) as usize].clamp(lo, hi))
             }
             SpectrumDesc::Texture { .. } => {
                 return Err(self.err(

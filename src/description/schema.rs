@@ -380,8 +380,9 @@ pub enum SpectrumDesc {
     /// (wavelength nm, value) pairs, strictly increasing in wavelength; linear interpolation,
     /// 0 outside.
     Tabulated(Vec<(f64, f64)>),
-    /// A two-column CSV file (nm, value), path relative to the scene file.
-    Csv(String),
+    /// A two-column CSV file (nm, value), path relative to the scene file, resampled to 1 nm
+    /// as CIE 167 recommends (default) or linearly (`Csv("f.csv", Linear)`).
+    Csv(String, #[serde(default)] crate::colour::sd::Interpolation),
     /// A linear-sRGB colour (components in [0, 1]) upsampled to a smooth spectrum.
     Rgb(f64, f64, f64),
     /// An sRGB colour as encoded in images and colour pickers (IEC 61966-2-1 transfer function,
