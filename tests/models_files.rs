@@ -430,3 +430,115 @@ fn vertices_out_of_range_are_refused_after_transforms() {
         "{stderr}"
     );
 }
+
+/// A PNG signature and IHDR chunk claiming `w`×`h` 8-bit RGB pixels, and no image data.
+fn png_header(w: u32, h: u32) -> Vec<u8> {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in bytes {
+            c ^= b as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend(w.to_be_bytes());
+    ihdr.extend(h.to_be_bytes());
+    ihdr.extend([8, 2, 0, 0, 0]);
+    let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+    out.extend(13u32.to_be_bytes());
+    out.extend(&ihdr);
+    out.extend(crc32(&ihdr).to_be_bytes());
+    out.extend(0u32.to_be_bytes());
+    out.extend(b"IDAT");
+    out.extend(crc32(b"IDAT").to_be_bytes());
+    out
+}
+
+/// A real 8×8 JPEG whose frame header (SOF0) is changed to claim 65535×65535 pixels
+/// (4.3·10⁹).
+fn jpeg_header() -> Vec<u8> {
+    let img = image::RgbImage::from_pixel(8, 8, image::Rgb([100, 150, 200]));
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Jpeg).unwrap();
+    let mut b = out.into_inner();
+    let sof = b.windows(2).position(|w| w == [0xFF, 0xC0]).unwrap();
+    b[sof + 5..sof + 9].copy_from_slice(&[0xFF; 4]);
+    b
+}
+
+#[test]
+fn every_kind_of_model_texture_is_checked_from_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("m.bin"), quad_bin()).unwrap();
+    std::fs::write(d.join("big.png"), png_header(1 << 20, 1 << 20)).unwrap();
+    std::fs::write(d.join("big.jpg"), jpeg_header()).unwrap();
+    let load = |file: &str| {
+        std::fs::write(
+            d.join("s.ron"),
+            scene(file).replace("Model(file", "Model(ke_luminance: 100, file"),
+        )
+        .unwrap();
+        let text = std::fs::read_to_string(d.join("s.ron")).unwrap();
+        let text = if file.ends_with(".gltf") {
+            text.replace("ke_luminance: 100, ", "")
+        } else {
+            text
+        };
+        std::fs::write(d.join("s.ron"), text).unwrap();
+        let t = std::time::Instant::now();
+        let e = match candela::scene::load_world(&d.join("s.ron"), &Default::default()) {
+            Ok(_) => panic!("{file}: loaded"),
+            Err(e) => e.to_string(),
+        };
+        (e, t.elapsed())
+    };
+    for image in ["big.png", "big.jpg"] {
+        let slots = [
+            ("baseColorTexture", true),
+            ("metallicRoughnessTexture", true),
+            ("normalTexture", false),
+            ("emissiveTexture", false),
+        ];
+        for (slot, pbr) in slots {
+            let mut doc = quad("m.bin", None, json!({"mesh": 0}));
+            doc["textures"] = json!([{"source": 0}]);
+            doc["images"] = json!([{"uri": image}]);
+            if pbr {
+                doc["materials"][0]["pbrMetallicRoughness"][slot] = json!({"index": 0});
+            } else {
+                doc["materials"][0][slot] = json!({"index": 0});
+                doc["materials"][0]["emissiveFactor"] = json!([1, 1, 1]);
+            }
+            std::fs::write(d.join("m.gltf"), doc.to_string()).unwrap();
+            let (e, took) = load("m.gltf");
+            assert!(
+                e.contains(image) && e.contains("texels"),
+                "{slot} {image}: {e}"
+            );
+            assert!(took.as_secs() < 5, "{slot} {image}: {took:?}");
+        }
+        for stmt in ["map_Kd", "norm", "map_Ke"] {
+            let obj = "mtllib m.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl a\nf 1/1 2/2 3/3\n";
+            std::fs::write(d.join("m.obj"), obj).unwrap();
+            std::fs::write(
+                d.join("m.mtl"),
+                format!("newmtl a\nKe 1 1 1\n{stmt} {image}\n"),
+            )
+            .unwrap();
+            let (e, took) = load("m.obj");
+            assert!(
+                e.contains(image) && e.contains("texels"),
+                "{stmt} {image}: {e}"
+            );
+            assert!(took.as_secs() < 5, "{stmt} {image}: {took:?}");
+        }
+    }
+}

@@ -39,7 +39,7 @@ impl<const C: usize> ByteTexture<C> {
     /// Channels `channels` (0 = R, 1 = G, 2 = B) of the PNG or JPEG image in `bytes`, checked
     /// as [`super::Texture::load`] checks images; `path` names it in messages.
     pub fn decode(path: &Path, bytes: &[u8], channels: [usize; C]) -> Result<Self, TextureError> {
-        let rgb = decode_rgb8(path, bytes)?;
+        let rgb = decode_rgb8(path, bytes, super::LOAD_BYTE_MAP_BYTES_PER_TEXEL)?;
         let (w, h) = rgb.dimensions();
         let texels = rgb.pixels().map(|p| channels.map(|c| p.0[c])).collect();
         Ok(Self::from_texels(w, h, texels))

@@ -96,7 +96,8 @@ impl EmissionTexture {
         bytes: &[u8],
         tint: [f32; 3],
     ) -> Result<EmissionTexture, super::TextureError> {
-        let (w, h, texels) = super::linear_texels(path, bytes, tint)?;
+        let (w, h, texels) =
+            super::linear_texels(path, bytes, tint, super::LOAD_EMISSION_BYTES_PER_TEXEL)?;
         Ok(Self::from_linear_rgb(w, h, &texels))
     }
 

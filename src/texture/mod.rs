@@ -25,10 +25,19 @@ pub const MAX_TEXELS: u64 = 1 << 28;
 /// Largest image file read.
 pub(crate) const MAX_TEXTURE_FILE_BYTES: u64 = 4 << 30;
 
-/// Peak bytes per texel while loading, with room to spare: the decoded image (up to 16 B for
-/// 16-bit RGBA), its 8-bit copy (3 B), the linear colours (12 B), the colour index (4 B), the
-/// map of distinct colours (up to ~24 B) and the coefficients (12 B).
-const LOAD_BYTES_PER_TEXEL: u64 = 64;
+/// Peak bytes per texel while loading a reflectance texture, with room to spare: the decoded
+/// image (up to 16 B, the limit the decoder is given), its 8-bit copy (3 B), the linear colours (12 B), the
+/// colour index (4 B), the map of distinct colours (up to ~24 B) and the coefficients (12 B).
+pub(crate) const LOAD_BYTES_PER_TEXEL: u64 = 64;
+
+/// The same for an emission texture, which keeps 8 B more per texel (a scale and a luminance,
+/// [`emission::BYTES_PER_TEXEL`] in all).
+pub(crate) const LOAD_EMISSION_BYTES_PER_TEXEL: u64 = LOAD_BYTES_PER_TEXEL + 8;
+
+/// Peak bytes per texel while loading a byte texture ([`bytes::ByteTexture`]): the decoded
+/// image (up to 16 B, the decoder's limit), its 8-bit RGB copy (3 B) and the kept channels (up
+/// to 3 B).
+pub(crate) const LOAD_BYTE_MAP_BYTES_PER_TEXEL: u64 = 22;
 
 /// Wavelength span of the normalised coefficients: t = (λ − 360 nm) / 470 nm.
 const T_MIN_NM: f64 = 360.0;
@@ -116,8 +125,8 @@ pub(crate) fn footprint(
 }
 
 /// Refuses an image of `w × h` texels that is empty, over [`MAX_TEXELS`] or too large for the
-/// memory available.
-pub(crate) fn check_size(path: &Path, w: u64, h: u64) -> Result<(), TextureError> {
+/// memory available, loading taking `per_texel` bytes per texel at its peak.
+pub(crate) fn check_size(path: &Path, w: u64, h: u64, per_texel: u64) -> Result<(), TextureError> {
     let err = |message: String| TextureError {
         path: path.to_path_buf(),
         message,
@@ -132,7 +141,7 @@ pub(crate) fn check_size(path: &Path, w: u64, h: u64) -> Result<(), TextureError
         )));
     }
     crate::limits::check_memory(
-        n.saturating_mul(LOAD_BYTES_PER_TEXEL),
+        n.saturating_mul(per_texel),
         &format!("loading this {w}×{h} texture"),
     )
     .map_err(err)
@@ -172,7 +181,7 @@ impl Texture {
                 path: path.to_path_buf(),
                 message: e.to_string(),
             })?;
-        let (w, h, texels) = linear_texels(path, &bytes, [1.0; 3])?;
+        let (w, h, texels) = linear_texels(path, &bytes, [1.0; 3], LOAD_BYTES_PER_TEXEL)?;
         Ok(Texture::from_linear_rgb(w, h, &texels))
     }
 
@@ -180,7 +189,7 @@ impl Texture {
     /// texel's linear colour multiplied by `tint` (in [0, 1]) before upsampling; `path` names it
     /// in messages. Checked as [`Texture::load`].
     pub fn decode(path: &Path, bytes: &[u8], tint: [f32; 3]) -> Result<Texture, TextureError> {
-        let (w, h, texels) = linear_texels(path, bytes, tint)?;
+        let (w, h, texels) = linear_texels(path, bytes, tint, LOAD_BYTES_PER_TEXEL)?;
         Ok(Texture::from_linear_rgb(w, h, &texels))
     }
 
@@ -255,11 +264,13 @@ fn bilinear_shapes(
 /// The linear-sRGB colours of an image's texels (top row first) times `tint`, with its width
 /// and height: an OpenEXR file's R, G, B as they are (non-finite values as 0; read from
 /// `path`, which `bytes` came from), or a PNG's or JPEG's decoded with the sRGB transfer
-/// function (alpha ignored). Checked as [`Texture::load`]; `path` names the image in messages.
+/// function (alpha ignored). Checked as [`Texture::load`], loading taking `per_texel` bytes per
+/// texel at its peak; `path` names the image in messages.
 pub(crate) fn linear_texels(
     path: &Path,
     bytes: &[u8],
     tint: [f32; 3],
+    per_texel: u64,
 ) -> Result<(u32, u32, Vec<[f32; 3]>), TextureError> {
     let err = |message: String| TextureError {
         path: path.to_path_buf(),
@@ -267,7 +278,7 @@ pub(crate) fn linear_texels(
     };
     if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
         let layers = crate::output::read_exr(path).map_err(|e| err(e.to_string()))?;
-        check_size(path, layers.width as u64, layers.height as u64)?;
+        check_size(path, layers.width as u64, layers.height as u64, per_texel)?;
         let ch = |name: &str| {
             layers
                 .channel(name)
@@ -282,7 +293,7 @@ pub(crate) fn linear_texels(
             .collect();
         return Ok((layers.width as u32, layers.height as u32, texels));
     }
-    let rgb = decode_rgb8(path, bytes)?;
+    let rgb = decode_rgb8(path, bytes, per_texel)?;
     let (w, h) = rgb.dimensions();
     let lut: Vec<f32> = (0..=255u8)
         .map(|v| crate::colour::rgb::srgb_decode(v as f64 / 255.0) as f32)
@@ -326,13 +337,18 @@ fn fit_distinct<T: Send>(
 }
 
 /// The 8-bit RGB texels of a PNG or JPEG image (alpha dropped), after the checks of
-/// [`Texture::load`]; `path` names it in messages.
-pub(crate) fn decode_rgb8(path: &Path, bytes: &[u8]) -> Result<image::RgbImage, TextureError> {
+/// [`Texture::load`] (loading taking `per_texel` bytes per texel at its peak, checked from the
+/// header before decoding); `path` names it in messages.
+pub(crate) fn decode_rgb8(
+    path: &Path,
+    bytes: &[u8],
+    per_texel: u64,
+) -> Result<image::RgbImage, TextureError> {
     let err = |message: String| TextureError {
         path: path.to_path_buf(),
         message,
     };
-    let check = |w: u64, h: u64| check_size(path, w, h);
+    let check = |w: u64, h: u64| check_size(path, w, h, per_texel);
     let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| err(e.to_string()))?;
@@ -354,6 +370,8 @@ pub(crate) fn decode_rgb8(path: &Path, bytes: &[u8]) -> Result<image::RgbImage, 
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(w);
     limits.max_image_height = Some(h);
+    // The decoder's own bound, so that an image whose data claims more than its header cannot
+    // allocate past what was checked.
     limits.max_alloc = Some((w as u64 * h as u64).saturating_mul(16).max(1 << 20));
     reader.limits(limits);
     let img = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))
