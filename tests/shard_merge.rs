@@ -681,3 +681,24 @@ fn fisheye_shards_merge_and_resume_with_the_pixels_outside_the_circle_unsampled(
     );
     assert_eq!(code, 0, "{err}");
 }
+
+/// `merge` attempts every output when one fails: with OUT.exr taken by a directory, the PNG,
+/// the report and the merged state are still written, and the error names the EXR (exit 1).
+#[test]
+fn merge_attempts_every_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    scene(d, "f.ron", 0.5);
+    for i in 0..2 {
+        shard(d, "f.ron", "f", i, 2, 4);
+    }
+    let states: Vec<String> = (0..2).map(|i| shard_state("f", i, 2)).collect();
+    std::fs::create_dir(d.join("m.exr")).unwrap();
+    let (code, _, err) = merge(d, &states, "m", &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("m.exr"), "{err}");
+    for f in ["m.png", "m.report.json", "m.state"] {
+        assert!(d.join(f).is_file(), "{f} missing: {err}");
+    }
+    assert!(d.join("m.exr").is_dir());
+}

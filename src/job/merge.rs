@@ -189,12 +189,19 @@ pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Res
             }
         }
     }
-    output::write_exr(&exr_path, &layers).context("cannot write the EXR")?;
+    // Every output is attempted whether or not an earlier one failed (on a nearly full disk
+    // the small ones still get written); the error lists each that failed.
+    let mut writes = super::Writes::default();
+    writes.attempt(&exr_path, || {
+        output::write_exr(&exr_path, &layers).context("cannot write the EXR")
+    });
     if let Some(spectral) = crate::film::spectral_layers(&film, &first.scene) {
         let path = with_suffix(&stem, ".spectral.exr");
-        output::write_exr(&path, &spectral).context("cannot write the spectral EXR")?;
+        writes.attempt(&path, || {
+            output::write_exr(&path, &spectral).context("cannot write the spectral EXR")
+        });
     }
-    write_png(&film, &png_path, exposure_ev)?;
+    writes.attempt(&png_path, || write_png(&film, &png_path, exposure_ev));
     let hdr_path = match &view {
         Some(v) => {
             let extra: Vec<String> = v
@@ -202,15 +209,17 @@ pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Res
                 .iter()
                 .map(|p| format!("CANDELA_PROJECTION={p}"))
                 .collect();
-            output::write_hdr(
-                &hdr_path,
-                film.width,
-                film.height,
-                &film.xyz_image(),
-                v.view.as_deref(),
-                &extra,
-            )
-            .context("cannot write the HDR")?;
+            writes.attempt(&hdr_path, || {
+                output::write_hdr(
+                    &hdr_path,
+                    film.width,
+                    film.height,
+                    &film.xyz_image(),
+                    v.view.as_deref(),
+                    &extra,
+                )
+                .context("cannot write the HDR")
+            });
             Some(hdr_path)
         }
         None => None,
@@ -226,7 +235,9 @@ pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Res
     let report_path = match &shards {
         Some(s) => {
             let path = with_suffix(&stem, ".report.json");
-            super::shard::write_report(&path, s, &merged, &meters)?;
+            writes.attempt(&path, || {
+                super::shard::write_report(&path, s, &merged, &meters)
+            });
             Some(path)
         }
         None => None,
@@ -234,10 +245,13 @@ pub fn merge_with(states: &[PathBuf], out: &Path, options: &MergeOptions) -> Res
     // A partial estimate's state would resume past samples of shards it lacks and repeat
     // them: it gets none (merge the shards again once they are all done).
     if !shards.as_ref().is_some_and(|s| s.partial) {
-        merged
-            .save(&state_path)
-            .context("cannot write the merged state")?;
+        writes.attempt(&state_path, || {
+            merged
+                .save(&state_path)
+                .context("cannot write the merged state")
+        });
     }
+    writes.finish()?;
     Ok(MergeOutputs {
         exr_path,
         png_path,
