@@ -163,6 +163,39 @@ fn obj_libraries_and_maps_named_like_outputs_are_not_replaced() {
 }
 
 #[test]
+fn an_obj_shapes_library_named_like_an_output_is_not_replaced() {
+    // An `Obj` shape does not use its library, but the library is the model's file all the same.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("m.obj"),
+        "mtllib o.png\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("o.png"), "newmtl a\nKd 0.5 0.5 0.5\n").unwrap();
+    let text = scene("m.obj")
+        .replace("Model(file: \"m.obj\")", "Obj(\"m.obj\"), material: \"g\"")
+        .replace(
+            "render: (spp: 1),",
+            "render: (spp: 1),\n    materials: { \"g\": Diffuse(reflectance: Constant(0.5)) },",
+        );
+    std::fs::write(d.join("s.ron"), text).unwrap();
+    refused_untouched(
+        d,
+        &["render", "--quiet", "--out", "o", "s.ron"],
+        &[OVERWRITE, "o.png"],
+    );
+    // A library that is not there is no file to protect: the render goes on.
+    std::fs::write(
+        d.join("m.obj"),
+        "mtllib p.png\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let (code, _, stderr) = common::cli(&["render", "--quiet", "--out", "p", "s.ron"], d);
+    assert_eq!(code, 0, "{stderr}");
+}
+
+#[test]
 fn a_changed_model_texture_makes_a_state_not_match() {
     // The texture is part of the state's hash: after it changes, --resume refuses.
     let dir = tempfile::tempdir().unwrap();

@@ -1,7 +1,7 @@
 //! Shapes and transforms read from the scene description: every value checked, meshes loaded
 //! from files relative to the scene, errors naming the file and the field.
 
-use super::{load_obj, load_ply, GeometryError, Shape, Transform, TriangleMesh};
+use super::{load_ply, GeometryError, Shape, Transform, TriangleMesh};
 use crate::description::context::{Context, SceneError};
 use crate::description::schema::{ShapeDesc, TransformDesc};
 use glam::Vec3;
@@ -124,7 +124,16 @@ impl Shape {
                 Shape::Mesh(mesh)
             }
             ShapeDesc::Obj(rel) => {
-                Shape::Mesh(load_obj(&ctx.resolve(rel)).map_err(|e| mesh_err(ctx, field, rel, e))?)
+                let (mesh, libraries) = super::io::load_obj_and_libraries(&ctx.resolve(rel))
+                    .map_err(|e| mesh_err(ctx, field, rel, e))?;
+                // Unused, but the model's: outputs must not replace them.
+                let mut sources = ctx.sources.borrow_mut();
+                for l in libraries {
+                    if !sources.contains(&l) {
+                        sources.push(l);
+                    }
+                }
+                Shape::Mesh(mesh)
             }
             ShapeDesc::Model { .. } => {
                 return Err(ctx.err(field, "a Model is built with its materials by the scene"))

@@ -389,7 +389,6 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
                 continue;
             }
             seen.borrow_mut().push(key);
-            read.borrow_mut().push(mtl.clone());
             #[cfg(test)]
             MTL_READS.with(|n| n.set(n.get() + 1));
             let bytes = match limits::read_file(&mtl, MAX_MTL_FILE_BYTES) {
@@ -405,6 +404,7 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
                 }
                 Ok(b) => b,
             };
+            read.borrow_mut().push(mtl.clone());
             if mtl_mode == Mtl::Ignore {
                 continue;
             }
@@ -587,7 +587,14 @@ fn all_have_normals(models: &[&tobj::Model]) -> bool {
 /// Material libraries (`mtllib`) are not used, so one that does not exist is ignored; one that
 /// is a FIFO, a device, a directory or over 16 MiB is refused, naming it.
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
-    let (models, _, _) = parse_obj(path, Mtl::Ignore)?;
+    load_obj_and_libraries(path).map(|(mesh, _)| mesh)
+}
+
+/// [`load_obj`], with the material libraries it read (to check them, not to use them).
+pub fn load_obj_and_libraries(
+    path: &Path,
+) -> Result<(TriangleMesh, Vec<std::path::PathBuf>), GeometryError> {
+    let (models, _, libraries) = parse_obj(path, Mtl::Ignore)?;
     let models: Vec<&tobj::Model> = models.iter().collect();
     let mut mesh = TriangleMesh::default();
     let with_normals = all_have_normals(&models);
@@ -603,7 +610,7 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, GeometryError> {
         mesh.normals = Some(normals);
     }
     validate(path, &mesh)?;
-    Ok(mesh)
+    Ok((mesh, libraries))
 }
 
 /// The faces of an OBJ file that share one material.
