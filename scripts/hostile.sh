@@ -21,7 +21,7 @@ fi
 bin=$(realpath "$bin")
 mkdir -p "$work"
 work=$(realpath "$work")
-if [ ! -f "$work/bomb-65536.exr" ]; then
+if [ ! -f "$work/epw-48-hours.epw" ]; then
     python3 scripts/hostile_inputs.py "$work" || exit 1
 fi
 rm -f "$work/fifo.ron" && mkfifo "$work/fifo.ron"
@@ -42,6 +42,29 @@ cases=(
     "EXR bomb, falsecolour|falsecolour -o out/bomb.png bomb-65536.exr|bomb-65536.exr"
     "IES claiming 10^9 angles|render --quiet --out out/i huge-angles.ron|huge-angles"
     "bench, 10^8 triangles|bench --spp 1 --triangles 100000000|triangles"
+    "bench traversal, 8192^2 rays|bench traversal --resolution 8192 --triangles 1000|--resolution"
+    "glTF buffer /etc/passwd|render --quiet --out out/gb gltf-buffer-etc.ron|outside the model's folder"
+    "glTF image ../../etc/passwd|render --quiet --out out/gi gltf-image-up.ron|outside the model's folder"
+    "glTF POSITION names no accessor|render --quiet --out out/ga gltf-no-accessor.ron|accessor 9"
+    "glTF node scaled past 10^12 m|render --quiet --out out/gn gltf-far-node.ron|gltf-far-node"
+    "OBJ mtllib /etc/passwd|render --quiet --out out/om obj-mtllib-etc.ron|outside the model's folder"
+    "OBJ vertex at 10^18 m|render --quiet --out out/ov obj-far-vertex.ron|vertex 1"
+    "OBJ naming its library 5000 times|render --quiet --out out/o5 obj-5000-mtllib.ron|obj-5000-mtllib"
+    "HDR VIEW -vth -vh 300, glare|glare view-vth-300.hdr|view-vth-300.hdr"
+    "HDR VIEW -vtv -vh 400, glare|glare view-vtv-400.hdr|view-vtv-400.hdr"
+    "HDR of 200 kB declaring 16384^2, probe|probe big-16384.hdr 0 0|big-16384.hdr"
+    "HDR declaring 16384^2, report|report big-16384.hdr -o out/big.html|big-16384.hdr"
+    "HDR declaring 16384^2, falsecolour|falsecolour -o out/big.png big-16384.hdr|big-16384.hdr"
+    "HDR declaring 16384^2, glare|glare big-16384.hdr|big-16384.hdr"
+    "EXR bomb, report|report bomb-65536.exr -o out/bomb.html|bomb-65536.exr"
+    "EPW elevation 1e300 m|annual --quiet annual.ron --weather epw-elevation.epw -o out/e|epw-elevation.epw: line 1"
+    "EPW time zone 5,5|annual --quiet annual.ron --weather epw-timezone-comma.epw -o out/e|epw-timezone-comma.epw: line 1"
+    "EPW record of 31 February|annual --quiet annual.ron --weather epw-feb31.epw -o out/e|epw-feb31.epw: line"
+    "EPW hour repeated|annual --quiet annual.ron --weather epw-repeated.epw -o out/e|epw-repeated.epw: line"
+    "EPW hours swapped|annual --quiet annual.ron --weather epw-swapped.epw -o out/e|epw-swapped.epw: line"
+    "EPW irradiance 9999 (missing)|annual --quiet annual.ron --weather epw-missing.epw -o out/e|epw-missing.epw: line"
+    "EPW direct sun at 02:00|annual --quiet annual.ron --weather epw-night-sun.epw -o out/e|epw-night-sun.epw: line"
+    "EPW of 48 hours, annual|annual --quiet annual.ron --weather epw-48-hours.epw -o out/e|epw-48-hours.epw"
 )
 
 echo "| case | exit | seconds | peak RSS (MB) | outcome | message (first line) |"
