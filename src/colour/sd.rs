@@ -391,28 +391,31 @@ impl SpectralDistribution {
     /// Samples the distribution at 360..=830 nm every 1 nm with `interpolation`; 0 outside the
     /// tabulated range, exactly the sample at a tabulated wavelength.
     pub fn to_table_with(&self, interpolation: Interpolation) -> [f64; LEN] {
-        let mut out = [0.0; LEN];
-        let nm = |i: usize| START_NM as f64 + i as f64;
-        match self.method(interpolation) {
-            Method::Linear => return self.to_table(),
-            Method::Sprague => {
-                let s = Sprague::new(self);
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o = s.value(nm(i));
-                }
-            }
-            Method::CubicSpline => {
-                let s = CubicSpline::new(self);
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o = s.value(nm(i));
-                }
-            }
-        }
-        out
+        let nm: [f64; LEN] = std::array::from_fn(|i| START_NM as f64 + i as f64);
+        let v = self.values_with(interpolation, &nm);
+        std::array::from_fn(|i| v[i])
     }
 
     /// Values at `nm` by `interpolation` (0 outside the tabulated range), for any wavelengths.
     pub fn values_with(&self, interpolation: Interpolation, nm: &[f64]) -> Vec<f64> {
+        // The interpolants are linear in the values, and their sums of up to 3033 times a
+        // value would overflow near f64::MAX: such data are interpolated at a smaller scale.
+        let peak = self.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if peak > 1e300 && self.method(interpolation) != Method::Linear {
+            let scaled = Self {
+                wavelengths_nm: self.wavelengths_nm.clone(),
+                values: self.values.iter().map(|v| v / peak).collect(),
+            };
+            return scaled
+                .values_unscaled(interpolation, nm)
+                .into_iter()
+                .map(|v| v * peak)
+                .collect();
+        }
+        self.values_unscaled(interpolation, nm)
+    }
+
+    fn values_unscaled(&self, interpolation: Interpolation, nm: &[f64]) -> Vec<f64> {
         match self.method(interpolation) {
             Method::Linear => nm.iter().map(|&x| self.value(x)).collect(),
             Method::Sprague => {
@@ -627,6 +630,26 @@ mod tests {
         assert_eq!(sd.value(600.0), 16.0);
         assert_eq!(sd.value(600.1), 0.0);
         assert_eq!(sd.value(f64::NAN), 0.0);
+    }
+
+    #[test]
+    fn cie167_of_values_near_the_largest_float_stays_finite() {
+        // Sprague's boundary sums reach 3033 times a value: interpolated at a smaller scale.
+        let w: Vec<f64> = (0..7).map(|i| 400.0 + 10.0 * i as f64).collect();
+        let sd = SpectralDistribution::new(w, vec![1e308; 7]).unwrap();
+        let t = sd.to_table_with(Interpolation::Cie167);
+        for (i, v) in t.iter().enumerate() {
+            let inside = (40..=100).contains(&i);
+            assert!(
+                if inside {
+                    (v / 1e308 - 1.0).abs() < 1e-12
+                } else {
+                    *v == 0.0
+                },
+                "{} nm: {v}",
+                360 + i
+            );
+        }
     }
 
     #[test]
