@@ -352,3 +352,237 @@ fn memory_guard_counts_light_tracing_when_the_scene_has_caustics() {
     let world = candela::scene::load_world(&path, &overrides).unwrap();
     assert!(world.caustics.is_none());
 }
+
+// --- Under an address-space limit (`ulimit -v`) ------------------------------------------------
+
+/// 4 GiB of address space, as scripts/hostile.sh runs its cases.
+const ULIMIT_KB: u64 = 4 << 20;
+
+/// `candela ARGS` in `dir` under `ulimit -v ULIMIT_KB`: exit code and standard error.
+fn candela_under_ulimit(args: &[&str], dir: &std::path::Path) -> (i32, String) {
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {ULIMIT_KB} && exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_candela"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A constant Radiance picture of `w`×`h` in the fewest bytes a scanline can take (one pixel,
+/// then old-style runs of it): 16384² in 197 kB.
+fn dense_hdr(w: usize, h: usize, view: bool) -> Vec<u8> {
+    let mut b = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n".to_vec();
+    if view {
+        b.extend(b"VIEW= -vta -vh 180 -vv 180\n");
+    }
+    b.extend(format!("\n-Y {h} +X {w}\n").bytes());
+    let mut line = vec![128, 128, 128, 129];
+    let mut rest = w - 1;
+    while rest > 0 {
+        line.extend([1, 1, 1, (rest & 255) as u8]);
+        rest >>= 8;
+    }
+    for _ in 0..h {
+        b.extend(&line);
+    }
+    b
+}
+
+/// A scan-line EXR of `w`×`h` f32 pixels in `channels`, ZIP-compressed zeros (16 lines a
+/// block, each ~1000 times smaller than its pixels): 16384² × 7 channels in 7 MB.
+fn zip_exr(w: u32, h: u32, channels: &[&str]) -> Vec<u8> {
+    let mut v = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+    let mut attr = |name: &str, ty: &str, value: &[u8]| {
+        v.extend(name.as_bytes());
+        v.push(0);
+        v.extend(ty.as_bytes());
+        v.push(0);
+        v.extend((value.len() as u32).to_le_bytes());
+        v.extend(value);
+    };
+    let mut names = channels.to_vec();
+    names.sort();
+    let mut chlist = Vec::new();
+    for c in &names {
+        chlist.extend(c.as_bytes());
+        chlist.push(0);
+        chlist.extend(2i32.to_le_bytes()); // FLOAT
+        chlist.extend([0, 0, 0, 0]);
+        chlist.extend(1i32.to_le_bytes());
+        chlist.extend(1i32.to_le_bytes());
+    }
+    chlist.push(0);
+    attr("channels", "chlist", &chlist);
+    attr("compression", "compression", &[3]);
+    let window: Vec<u8> = [0i32, 0, w as i32 - 1, h as i32 - 1]
+        .iter()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+    attr("dataWindow", "box2i", &window);
+    attr("displayWindow", "box2i", &window);
+    attr("lineOrder", "lineOrder", &[0]);
+    attr("pixelAspectRatio", "float", &1f32.to_le_bytes());
+    attr("screenWindowCenter", "v2f", &[0; 8]);
+    attr("screenWindowWidth", "float", &1f32.to_le_bytes());
+    v.push(0);
+    let block = miniz_oxide::deflate::compress_to_vec_zlib(
+        &vec![0u8; w as usize * 4 * channels.len() * 16],
+        9,
+    );
+    let chunks = h.div_ceil(16) as u64;
+    let first = v.len() as u64 + chunks * 8;
+    for i in 0..chunks {
+        v.extend((first + i * (8 + block.len() as u64)).to_le_bytes());
+    }
+    for i in 0..chunks {
+        v.extend((i as i32 * 16).to_le_bytes());
+        v.extend((block.len() as i32).to_le_bytes());
+        v.extend(&block);
+    }
+    v
+}
+
+/// Under `ulimit -v` 4 GiB, every command that reads an image refuses one that needs more
+/// than the address space left, before decoding it and naming the file and the limit, where
+/// each used to abort (exit 134, "memory allocation of … failed") after seconds of decoding:
+/// a 197 kB picture of 16384² (report, falsecolour, glare hold 36 to 57 bytes a pixel beside
+/// its 12), a 7-channel EXR of 16384² (probe: 7.5 GB of samples), the HTML report of it, and
+/// `bench traversal --resolution 8192` (13 GB of rays). The 16384² picture's probe needs
+/// 3.1 GB (measured peak RSS) and is not refused for want of memory.
+#[test]
+fn under_an_address_space_limit_images_are_refused_not_aborted() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("big.hdr"), dense_hdr(16384, 16384, true)).unwrap();
+    let seven = ["X", "Y", "Z", "stderr.Y", "E", "stderr.E", "mask.E"];
+    std::fs::write(d.join("seven.exr"), zip_exr(16384, 16384, &seven)).unwrap();
+    for (args, file) in [
+        (&["report", "big.hdr", "-o", "big.html"][..], "big.hdr"),
+        (&["falsecolour", "big.hdr", "-o", "big.png"], "big.hdr"),
+        (&["glare", "big.hdr"], "big.hdr"),
+        (&["probe", "seven.exr", "0", "0"], "seven.exr"),
+        (&["report", "seven.exr", "-o", "seven.html"], "seven.exr"),
+        (
+            &["falsecolour", "seven.exr", "-o", "seven.png"],
+            "seven.exr",
+        ),
+        (&["glare", "seven.exr"], "seven.exr"),
+        (
+            &[
+                "bench",
+                "traversal",
+                "--resolution",
+                "8192",
+                "--triangles",
+                "1000",
+            ],
+            "--resolution 8192",
+        ),
+    ] {
+        let t0 = Instant::now();
+        let (code, stderr) = candela_under_ulimit(args, d);
+        assert_eq!(code, 1, "{args:?}: {stderr}");
+        for n in [
+            file,
+            "needs about",
+            "under the address-space limit (ulimit -v)",
+        ] {
+            assert!(
+                stderr.contains(n),
+                "{args:?}: {n:?} missing from:\n{stderr}"
+            );
+        }
+        assert!(
+            t0.elapsed() < Duration::from_secs(10),
+            "{args:?}: {:?}",
+            t0.elapsed()
+        );
+    }
+    let left: Vec<_> = std::fs::read_dir(d).unwrap().collect();
+    assert_eq!(left.len(), 2, "files written: {left:?}");
+}
+
+/// A picture whose resolution line declares more scanlines than the file could hold at the
+/// densest encoding (30000 lines of 30000 pixels take 360 kB; the file has 200 kB) is refused
+/// from its header by every command, with or without an address-space limit, naming the file
+/// and both sizes: it used to be decoded up to the 16662nd scanline (1.9 GB) first.
+#[test]
+fn a_picture_shorter_than_its_declared_size_is_refused_from_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut bytes = dense_hdr(30000, 30000, true);
+    bytes.truncate(200_000);
+    std::fs::write(d.join("short.hdr"), bytes).unwrap();
+    for args in [
+        &["probe", "short.hdr", "0", "0"][..],
+        &["report", "short.hdr", "-o", "s.html"],
+        &["falsecolour", "short.hdr", "-o", "s.png"],
+        &["glare", "short.hdr"],
+    ] {
+        let t0 = Instant::now();
+        let (code, stderr, _) = candela(args, d);
+        assert_eq!(code, 1, "{args:?}: {stderr}");
+        for n in ["short.hdr", "30000×30000", "at least 360000 bytes"] {
+            assert!(
+                stderr.contains(n),
+                "{args:?}: {n:?} missing from:\n{stderr}"
+            );
+        }
+        assert!(
+            t0.elapsed() < Duration::from_secs(2),
+            "{args:?}: {:?}",
+            t0.elapsed()
+        );
+        let (code, stderr) = candela_under_ulimit(args, d);
+        assert_eq!(code, 1, "{args:?} under ulimit: {stderr}");
+    }
+}
+
+/// Under `ulimit -v` 4 GiB a normal render works (with its HTML report and false colour), and
+/// a film that needs more than the address space left (4096², about 10 GB) is refused naming
+/// the scene's resolution and the limit, where the machine's free memory alone would let it
+/// start and abort.
+#[test]
+fn renders_under_an_address_space_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.ron"), scene_with_grid("desk", 4, 4)).unwrap();
+    let (code, stderr) = candela_under_ulimit(
+        &[
+            "render",
+            "--quiet",
+            "s.ron",
+            "--resolution",
+            "512x512",
+            "--illuminance",
+            "--falsecolour",
+            "--report-html",
+        ],
+        d,
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(d.join("s.html").is_file() && d.join("s.luminance.png").is_file());
+    let (code, stderr) = candela_under_ulimit(
+        &[
+            "render",
+            "--quiet",
+            "s.ron",
+            "--resolution",
+            "4096x4096",
+            "--out",
+            "big",
+        ],
+        d,
+    );
+    assert_eq!(code, 1, "{stderr}");
+    for n in ["s.ron", "4096×4096", "is available"] {
+        assert!(stderr.contains(n), "{n:?} missing from:\n{stderr}");
+    }
+    assert!(!d.join("big.exr").exists());
+}

@@ -425,3 +425,82 @@ fn merge_never_replaces_an_input_state_by_any_name() {
         );
     }
 }
+
+/// The HTML report of `--report-html` (NAME.html) is checked with the other outputs before
+/// rendering: a scene file named like it, or a mesh it refers to, is refused and left byte for
+/// byte; without `--report-html` the same files render and stay as they were.
+#[test]
+fn the_html_report_never_replaces_an_input() {
+    let obj = b"v -0.2 -0.2 2\nv 0.2 -0.2 2\nv 0 0.2 2\nf 1 2 3\n".to_vec();
+    // The scene itself is room.html: its report would be room.html.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("room.html"), plain()).unwrap();
+    let before = snapshot(dir.path());
+    assert_refused_untouched(
+        dir.path(),
+        &["render", "--quiet", "--report-html", "room.html"],
+        &[
+            "refusing to overwrite the scene file",
+            "the HTML report",
+            "room.html",
+        ],
+        &before,
+    );
+    // A mesh m.html and `--out m`.
+    let mesh = r#", (shape: Obj("m.html"), material: "grey")"#;
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("s.ron"),
+        scene("Constant(0.5)", mesh, "", ""),
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("m.html"), &obj).unwrap();
+    let before = snapshot(dir.path());
+    assert_refused_untouched(
+        dir.path(),
+        &["render", "--quiet", "--report-html", "--out", "m", "s.ron"],
+        &[
+            "refusing to overwrite the file the scene refers to",
+            "m.html",
+        ],
+        &before,
+    );
+    let (code, _, stderr) = common::cli(&["render", "--quiet", "--out", "m", "s.ron"], dir.path());
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(std::fs::read(dir.path().join("m.html")).unwrap(), obj);
+}
+
+/// `candela report` refuses an output that is its image, its report JSON or its glare JSON, by
+/// any name (a hard link), and leaves them as they were.
+#[test]
+fn report_never_replaces_its_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.ron"), plain()).unwrap();
+    let (code, _, stderr) = common::cli(&["render", "--quiet", "s.ron"], d);
+    assert_eq!(code, 0, "{stderr}");
+    let glare = r#"{"dgp": {"value": 0.2}, "sources": []}"#;
+    std::fs::write(d.join("g.json"), glare).unwrap();
+    std::fs::hard_link(d.join("s.exr"), d.join("link.html")).unwrap();
+    let before = snapshot(d);
+    for (args, input) in [
+        (&["report", "s.exr", "-o", "s.exr"][..], "s.exr"),
+        (&["report", "s.exr", "-o", "link.html"], "s.exr"),
+        (
+            &["report", "s.exr", "s.report.json", "-o", "s.report.json"],
+            "s.report.json",
+        ),
+        (
+            &["report", "s.exr", "--glare", "g.json", "-o", "g.json"],
+            "g.json",
+        ),
+    ] {
+        let stderr = assert_refused_untouched(
+            d,
+            args,
+            &["refusing to overwrite the input", input],
+            &before,
+        );
+        assert!(stderr.contains("HTML report"), "{stderr}");
+    }
+}
