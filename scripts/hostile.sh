@@ -21,7 +21,7 @@ fi
 bin=$(realpath "$bin")
 mkdir -p "$work"
 work=$(realpath "$work")
-if [ ! -f "$work/epw-48-hours.epw" ]; then
+if [ ! -f "$work/exr7-16384.exr" ]; then
     python3 scripts/hostile_inputs.py "$work" || exit 1
 fi
 rm -f "$work/fifo.ron" && mkfifo "$work/fifo.ron"
@@ -57,6 +57,12 @@ cases=(
     "HDR declaring 16384^2, falsecolour|falsecolour -o out/big.png big-16384.hdr|big-16384.hdr"
     "HDR declaring 16384^2, glare|glare big-16384.hdr|big-16384.hdr"
     "EXR bomb, report|report bomb-65536.exr -o out/bomb.html|bomb-65536.exr"
+    "HDR 16384^2 in 197 kB, probe|probe hdr-16384.hdr 0 0|hdr-16384.hdr"
+    "HDR 16384^2 in 197 kB, report|report -o out/hdr.html hdr-16384.hdr|hdr-16384.hdr"
+    "HDR 16384^2 in 197 kB, falsecolour|falsecolour -o out/hdr.png hdr-16384.hdr|hdr-16384.hdr"
+    "HDR 16384^2 fisheye in 197 kB, glare|glare hdr-16384v.hdr|hdr-16384v.hdr"
+    "HDR declaring 30000^2 in 200 kB|probe hdr-30000.hdr 0 0|hdr-30000.hdr"
+    "EXR of 7 channels 16384^2, probe|probe exr7-16384.exr 0 0|exr7-16384.exr"
     "EPW elevation 1e300 m|annual --quiet annual.ron --weather epw-elevation.epw -o out/e|epw-elevation.epw: line 1"
     "EPW time zone 5,5|annual --quiet annual.ron --weather epw-timezone-comma.epw -o out/e|epw-timezone-comma.epw: line 1"
     "EPW record of 31 February|annual --quiet annual.ron --weather epw-feb31.epw -o out/e|epw-feb31.epw: line"

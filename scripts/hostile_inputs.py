@@ -270,3 +270,48 @@ epw("epw-48-hours.epw", rows=year[:48])
     '    grids: [(name: "desk", origin: (-1, 0.8, -1), edge_u: (2, 0, 0), edge_v: (0, 0, 2), nx: 2, ny: 2, normal: (0, 1, 0))],\n'
     ")\n"
 )
+
+
+# Pictures that hold what they declare in the densest scanlines the reader accepts (one pixel,
+# then old-style runs): 16384² in 197 kB, and 30000² cut to 200 kB; a 7-channel EXR of 16384².
+def hdr_rle(w, h, view=False):
+    line, n = bytes([128, 128, 128, 129]), w - 1
+    while n:
+        line += bytes([1, 1, 1, n & 255])
+        n >>= 8
+    head = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n" + (b"VIEW= -vta -vh 180 -vv 180\n" if view else b"")
+    return head + b"\n-Y %d +X %d\n" % (h, w) + line * h
+
+
+(out / "hdr-16384.hdr").write_bytes(hdr_rle(16384, 16384))
+(out / "hdr-16384v.hdr").write_bytes(hdr_rle(16384, 16384, view=True))
+(out / "hdr-30000.hdr").write_bytes(hdr_rle(30000, 30000)[:200_000])
+
+
+def exr_zeros(path, w, h, channels):
+    chlist = b"".join(c.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for c in sorted(channels)) + b"\0"
+    header = (
+        b"\x76\x2f\x31\x01"
+        + struct.pack("<i", 2)
+        + attr("channels", "chlist", chlist)
+        + attr("compression", "compression", b"\x03")
+        + attr("dataWindow", "box2i", struct.pack("<4i", 0, 0, w - 1, h - 1))
+        + attr("displayWindow", "box2i", struct.pack("<4i", 0, 0, w - 1, h - 1))
+        + attr("lineOrder", "lineOrder", b"\x00")
+        + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+        + attr("screenWindowCenter", "v2f", struct.pack("<2f", 0, 0))
+        + attr("screenWindowWidth", "float", struct.pack("<f", 1.0))
+        + b"\0"
+    )
+    block = zlib.compress(bytes(w * 4 * len(channels) * 16), 9)
+    blocks = (h + 15) // 16
+    first = len(header) + 8 * blocks
+    with open(path, "wb") as f:
+        f.write(header)
+        f.write(b"".join(struct.pack("<Q", first + i * (8 + len(block))) for i in range(blocks)))
+        for i in range(blocks):
+            f.write(struct.pack("<ii", i * 16, len(block)))
+            f.write(block)
+
+
+exr_zeros(out / "exr7-16384.exr", 16384, 16384, ["X", "Y", "Z", "stderr.Y", "E", "stderr.E", "mask.E"])

@@ -11,7 +11,7 @@ use crate::colour::colorimetry::{
 use crate::colour::cri::{colour_rendering_index, Cri};
 use crate::colour::grid::LEN;
 use crate::colour::models::{xyz_to_uv1960, xyz_to_xy};
-use crate::colour::sd::SpectralDistribution;
+use crate::colour::sd::{Interpolation, SpectralDistribution};
 use crate::colour::tables::Observer;
 use crate::colour::temperature::{uv_to_cct_ohno2013, uv_to_cct_robertson1968};
 use crate::colour::tm30::{colour_rendition, ColourRendition, HueBin};
@@ -42,7 +42,7 @@ fn per_row<T>(
         .enumerate()
         .map(|(i, row)| {
             SpectralDistribution::new(wl.clone(), row.to_vec())
-                .map(|sd| f(&sd.to_table()))
+                .map(|sd| f(&sd.to_table_with(Interpolation::default())))
                 .map_err(|e| error_msg(format!("values: spectrum {i}: {e}")))
         })
         .collect()
@@ -102,7 +102,7 @@ fn sd_to_xyz<'py>(
             })?;
             let ill = SpectralDistribution::new(iw.as_array().to_vec(), iv.as_array().to_vec())
                 .map_err(|e| error_msg(format!("illuminant: {e}")))?
-                .to_table();
+                .to_table_with(Interpolation::default());
             per_row(wavelengths_nm, values, |s| {
                 sd_to_xyz_relative_with(s, &ill, obs, m)
             })?

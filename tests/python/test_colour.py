@@ -135,3 +135,19 @@ def test_bad_spectra_raise_candela_error():
         cc.sd_to_xyz([400, 500, 600], np.array([[1, 1, 1], [1, np.nan, 1]]))
     with pytest.raises(candela.CandelaError, match="observer"):
         cc.sd_to_xyz(WL, np.ones(WL.size), observer="1976")
+
+
+def test_coarse_rows_are_resampled_as_colour_science_interpolates():
+    """A 10 nm row gives the XYZ of colour-science's own interpolation of it to 1 nm (Sprague,
+    its default for even steps), not that of straight lines between the samples."""
+    coarse_wl = np.arange(360.0, 831.0, 10.0)
+    rng = np.random.default_rng(7)
+    mu, sigma = rng.uniform(450, 650), rng.uniform(20, 60)
+    values = 0.05 + np.exp(-0.5 * ((coarse_wl - mu) / sigma) ** 2)
+    fine = colour.SpectralDistribution(values, coarse_wl).copy().interpolate(colour.SpectralShape(360, 830, 1))
+    got = cc.sd_to_xyz(coarse_wl, values, "absolute")
+    want = cc.sd_to_xyz(WL, fine.values, "absolute")
+    linear = cc.sd_to_xyz(WL, np.interp(WL, coarse_wl, values), "absolute")
+    assert rel_dev(got, want) < 1e-12
+    # The difference the test can see: straight lines are off by far more than the tolerance.
+    assert rel_dev(linear, want) > 1e-6
