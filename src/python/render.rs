@@ -112,15 +112,7 @@ fn render<'py>(
         crate::film::MAX_SPECTRAL_BANDS as u64,
     )?
     .unwrap_or(0) as usize;
-    if let Some(ev) = exposure_ev {
-        let max = job::MAX_ABS_EXPOSURE_EV;
-        args::number(
-            "exposure_ev",
-            ev,
-            &format!("a finite number of EV between -{max} and {max}"),
-            |v| v.abs() <= max,
-        )?;
-    }
+    check_exposure(exposure_ev)?;
     args::number(
         "target_fraction",
         target_fraction,
@@ -371,15 +363,7 @@ fn merge<'py>(
     exposure_ev: Option<f64>,
     partial: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if let Some(ev) = exposure_ev {
-        let max = job::MAX_ABS_EXPOSURE_EV;
-        args::number(
-            "exposure_ev",
-            ev,
-            &format!("a finite number of EV between -{max} and {max}"),
-            |v| v.abs() <= max,
-        )?;
-    }
+    check_exposure(exposure_ev)?;
     let options = job::MergeOptions {
         exposure_ev,
         partial,
@@ -422,5 +406,19 @@ fn merge<'py>(
 pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
+    Ok(())
+}
+
+/// `exposure_ev`, when given, within the command line's range for `--exposure`.
+fn check_exposure(exposure_ev: Option<f64>) -> PyResult<()> {
+    if let Some(ev) = exposure_ev {
+        let max = job::MAX_ABS_EXPOSURE_EV;
+        args::number(
+            "exposure_ev",
+            ev,
+            &format!("a finite number of EV between -{max} and {max}"),
+            |v| v.abs() <= max,
+        )?;
+    }
     Ok(())
 }
