@@ -6,6 +6,7 @@ pub mod coefficients;
 pub mod metrics;
 pub mod output;
 pub mod results;
+pub mod room;
 pub mod run;
 pub mod sun;
 pub mod view;

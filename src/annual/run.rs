@@ -54,7 +54,7 @@ pub struct AnnualSettings {
     pub keep_coefficients: bool,
     /// The output stem the caller will write to (NAME of NAME.annual.json): when given, its
     /// directory is checked to take the files and to have room for them before the
-    /// computation ([`super::output::check_room`]).
+    /// computation ([`super::room::check_room`]).
     pub out: Option<PathBuf>,
 }
 
@@ -306,9 +306,9 @@ pub fn run(
     )
     .map_err(|m| anyhow!("{}: {m}", scene_path.display()))?;
     if let Some(stem) = &settings.out {
-        super::output::check_room(
+        super::room::check_room(
             stem,
-            &super::output::Planned {
+            &super::room::Planned {
                 points: receivers.len(),
                 hours: year.len(),
                 sunny_hours: sunny.len(),
