@@ -7,6 +7,7 @@
 //! finite positions within the coordinate limit) and rendered in a tiny scene, which must give
 //! finite pixels or be refused naming the scene. `PROPTEST_CASES=N` sets the number of cases.
 
+mod common;
 mod fuzz_common;
 
 use candela::geometry::gltf::load_gltf;
@@ -93,24 +94,6 @@ fn base64(bytes: &[u8]) -> String {
         }
     }
     s
-}
-
-/// The GLB of `j` and `bin`: header, JSON chunk (padded with spaces), BIN chunk.
-fn glb(j: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut text = serde_json::to_vec(j).unwrap();
-    while text.len() % 4 != 0 {
-        text.push(b' ');
-    }
-    let mut out = b"glTF".to_vec();
-    out.extend(2u32.to_le_bytes());
-    out.extend(((12 + 8 + text.len() + 8 + bin.len()) as u32).to_le_bytes());
-    out.extend((text.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(text);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
 }
 
 /// The three seeds: (is GLB, document).
@@ -336,7 +319,7 @@ fn encode(k: usize, edits: &[Edit]) -> (bool, Vec<u8>) {
     let (is_glb, j) = seeds().swap_remove(k);
     let j = edited(j, edits);
     if is_glb {
-        (true, glb(&j, &bin()))
+        (true, common::glb(&j, &bin()))
     } else {
         (false, serde_json::to_vec(&j).unwrap())
     }
