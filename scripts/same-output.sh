@@ -3,10 +3,10 @@
 #   bash scripts/same-output.sh OLD_BIN NEW_BIN [WORK_DIR]
 # Renders every scene in scenes/ at a fixed seed and a few samples per pixel (with and without
 # --illuminance/--falsecolour/--save-state), one adaptive render, a resumed render, a merge,
-# refused options (messages and exit codes), and runs probe,
-# falsecolour, luminaire, spectrum and convert with both binaries; then compares EXR pixel
-# data and PNG/CSV bytes exactly, report JSON numbers exactly (timings excepted) and standard
-# output with timings removed (scripts/same_output.py). Exit 0 when everything matches.
+# refused options (messages and exit codes), and runs probe, falsecolour, luminaire, spectrum,
+# convert, glare, report and two small annual runs (one with --view) with both binaries; then
+# compares EXR pixel data and PNG/CSV bytes exactly, report JSON numbers exactly (timings
+# excepted) and standard output with timings removed (scripts/same_output.py). Exit 0 when everything matches.
 set -euo pipefail
 old=$(realpath "$1"); new=$(realpath "$2")
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -42,7 +42,25 @@ run_all() {
   "$bin" spectrum D65 --json >"$out/spectrum.txt" 2>&1
   "$bin" spectrum blackbody:3000K >>"$out/spectrum.txt" 2>&1
   "$bin" convert 100 lx fc >"$out/convert.txt" 2>&1
+  "$bin" spectrum FL2 --observer 1964 --method astm-e308 --efficacy-rule trapezoid --cvg "$out/fl2-cvg.png" >>"$out/spectrum.txt" 2>&1
+  "$bin" spectrum LED-B3 --json >>"$out/spectrum.txt" 2>&1
+  "$bin" spectrum "$root/data/cornell-box.csv" --interpolation linear >>"$out/spectrum.txt" 2>&1 || echo "exit $?" >>"$out/spectrum.txt"
+  # The rest of the subcommands: glare, the HTML report, an annual run (with the view and the
+  # coefficients) and its refusals.
+  "$bin" glare "$out/glare-office.exr" --json >"$out/glare.txt" 2>&1 || echo "exit $?" >>"$out/glare.txt"
+  "$bin" glare "$out/glare-office.hdr" >>"$out/glare.txt" 2>&1 || echo "exit $?" >>"$out/glare.txt"
+  "$bin" report "$out/office-e.exr" -o "$out/office-report.html" >"$out/report.txt" 2>&1 || echo "exit $?" >>"$out/report.txt"
+  local epw="$work/year.epw"
+  "$bin" annual "$root/scenes/annual-shoebox.ron" --weather "$epw" --mf 1 --sky-samples 64 --sun-samples 32 --direct-samples 8 --draws 20 --coefficients --seed 4 --threads 2 --quiet --out "$out/annual" >"$out/annual.txt" 2>&1 || echo "exit $?" >>"$out/annual.txt"
+  "$bin" annual "$root/scenes/annual-glare.ron" --weather "$epw" --mf 1 --sky-samples 32 --sun-samples 16 --direct-samples 4 --draws 0 --view --view-resolution 16 --view-sky-samples 8 --view-sun-samples 2 --seed 4 --threads 2 --quiet --out "$out/annual-view" >"$out/annual-view.txt" 2>&1 || echo "exit $?" >>"$out/annual-view.txt"
+  for args in "--mf 9" "--occupied 18-8" "--udi x-3" "--draws 1"; do
+    # shellcheck disable=SC2086
+    "$bin" annual "$root/scenes/annual-shoebox.ron" --weather "$epw" --quiet --out "$out/annual-refused" $args >>"$out/annual-refusals.txt" 2>&1 && echo "exit 0" >>"$out/annual-refusals.txt" || echo "exit $?" >>"$out/annual-refusals.txt"
+  done
 }
+# A whole synthetic year (every 8th day lit) for the annual runs: needs ladybug-core in target/venv
+# (scripts/setup_python.sh).
+"$root/target/venv/bin/python" "$root/scripts/synthetic_epw.py" "$work/year.epw" --every 8 >/dev/null
 (cd "$work" && run_all "$old" "$work/old")
 (cd "$work" && run_all "$new" "$work/new")
 python3 "$root/scripts/same_output.py" "$work/old" "$work/new"
