@@ -1,12 +1,11 @@
-//! OBJ (tobj) and PLY (ply-rs-bw) loading. Every failure is a [`GeometryError`] naming the
-//! file; malformed input never panics.
+//! OBJ loading (tobj), and the reading and checks every mesh loader shares (PLY: `ply`).
+//! Every failure is a [`GeometryError`] naming the file; malformed input never panics.
 //!
 //! Files are read whole through [`crate::limits::read_file`] (so a FIFO, a device or a
 //! directory is refused unread). Meshes may be gigabytes and the parsers hold several times
-//! the file's size, in a proportion that depends on what the file holds (a 5 MB PLY of
-//! one-byte elements takes 1.8 GB in ply-rs), so before parsing, the memory the parse will need
-//! is estimated from the file's contents (OBJ: its statements; PLY: its header) and checked
-//! against the memory available.
+//! the file's size, in a proportion that depends on what the file holds, so before parsing,
+//! the memory the parse will need is estimated from the file's contents (OBJ: its statements;
+//! PLY: its header) and checked against the memory available.
 
 use super::mtl::MtlMaterial;
 use super::{GeometryError, TriangleMesh};
@@ -20,14 +19,14 @@ const MAX_MESH_FILE_BYTES: u64 = 1 << 40;
 /// Largest material library (`mtllib`) read; real ones are kilobytes.
 const MAX_MTL_FILE_BYTES: u64 = 16 << 20;
 
-fn read_mesh(path: &Path) -> Result<Vec<u8>, GeometryError> {
+pub(super) fn read_mesh(path: &Path) -> Result<Vec<u8>, GeometryError> {
     limits::read_file(path, MAX_MESH_FILE_BYTES).map_err(|source| GeometryError::Io {
         path: path.to_path_buf(),
         source,
     })
 }
 
-fn check_memory(path: &Path, what: &str, need: u64) -> Result<(), GeometryError> {
+pub(super) fn check_memory(path: &Path, what: &str, need: u64) -> Result<(), GeometryError> {
     limits::check_memory(need, what).map_err(|message| GeometryError::TooLarge {
         path: path.to_path_buf(),
         message,
@@ -73,61 +72,8 @@ fn obj_memory(bytes: &[u8]) -> u64 {
         .saturating_add(160 * triples + 350 * groups)
 }
 
-/// Peak memory of loading a PLY file whose payload is `payload` bytes, in bytes, from its
-/// header. ply-rs holds every element as a map from property name to value: about 250 bytes
-/// per element and 180 per property (measured peaks are 0.55–0.9 of this estimate: 2·10⁶
-/// vertices of 3 floats, 10⁶ of 9, 2·10⁶ faces, 5·10⁶ one-byte elements, ASCII and binary).
-/// The count of an element is taken as no more than the payload can hold, so a header that
-/// claims more than the file has is not refused for it (ply-rs stops at the end of the data).
-fn ply_memory(header: &ply_rs_bw::ply::Header, payload: usize) -> u64 {
-    use ply_rs_bw::ply::{Encoding, PropertyType, ScalarType};
-    let size = |t: &ScalarType| match t {
-        ScalarType::Char | ScalarType::UChar => 1u64,
-        ScalarType::Short | ScalarType::UShort => 2,
-        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
-        ScalarType::Double => 8,
-    };
-    let ascii = matches!(header.encoding, Encoding::Ascii);
-    let payload = payload as u64;
-    let mut need = 6 * payload;
-    for (_, element) in header.elements.iter() {
-        let props = element.properties.len() as u64;
-        // Fewest bytes one element takes in the file: a value and a separator per property in
-        // ASCII (an element is a line), its scalars and list lengths in binary.
-        let min_bytes = if ascii {
-            (2 * props).max(1)
-        } else {
-            element
-                .properties
-                .iter()
-                .map(|(_, p)| match &p.data_type {
-                    PropertyType::Scalar(t) => size(t),
-                    PropertyType::List(count, _) => size(count),
-                })
-                .sum()
-        };
-        let count = match min_bytes {
-            0 => element.count as u64,
-            m => (element.count as u64).min(payload / m),
-        };
-        need = need.saturating_add(count.saturating_mul(250 + 180 * props));
-    }
-    need
-}
-
-/// Joins a multi-line parser message into one line without a trailing period.
-fn one_paragraph(msg: &str) -> String {
-    let joined = msg
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty())
-        .collect::<Vec<_>>()
-        .join("; ");
-    joined.trim_end_matches('.').to_string()
-}
-
 /// Checks indices, finiteness and that there is at least one triangle.
-fn validate(path: &Path, mesh: &TriangleMesh) -> Result<(), GeometryError> {
+pub(super) fn validate(path: &Path, mesh: &TriangleMesh) -> Result<(), GeometryError> {
     let nv = mesh.positions.len();
     for (f, tri) in mesh.indices.iter().enumerate() {
         if let Some(&i) = tri.iter().find(|&&i| i as usize >= nv) {
@@ -343,109 +289,55 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
     )?;
     let text = String::from_utf8_lossy(&bytes);
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let libraries = MtlLibraries::new(path, mtl_mode);
+    let models = run_tobj(path, text, &libraries)?;
+    check_reach(path, text, &models)?;
+    let mtls = libraries.materials.into_inner();
+    let read = libraries.read.into_inner();
+    if mtl_mode == Mtl::Use {
+        check_usemtl(path, text, &mtls)?;
+    }
+    Ok((models, mtls, read))
+}
+
+fn obj_error(path: &Path, message: String) -> GeometryError {
+    GeometryError::Parse {
+        path: path.to_path_buf(),
+        format: "OBJ",
+        message,
+    }
+}
+
+/// The objects tobj parses from `text`, its `mtllib` statements read through `libraries`. The
+/// first library error comes before tobj's own.
+fn run_tobj(
+    path: &Path,
+    text: &str,
+    libraries: &MtlLibraries,
+) -> Result<Vec<tobj::Model>, GeometryError> {
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let parse = |message: String| GeometryError::Parse {
-        path: path.to_path_buf(),
-        format: "OBJ",
-        message,
-    };
-    let mtl_error = std::cell::RefCell::new(None);
-    let mtls = std::cell::RefCell::new(Vec::<MtlMaterial>::new());
-    // Libraries already read: each is read once however often `mtllib` names it.
-    let read = std::cell::RefCell::new(Vec::<std::path::PathBuf>::new());
-    let seen = std::cell::RefCell::new(Vec::<std::path::PathBuf>::new());
-    let dir = path.parent().unwrap_or(Path::new(""));
-    let load_mtl = |line: &Path| -> tobj::MTLLoadResult {
-        let fail = |e: GeometryError| {
-            mtl_error.borrow_mut().get_or_insert(e);
-            Ok(Default::default())
-        };
-        // tobj's own map type (it is not named in tobj's API).
-        let empty: tobj::MTLLoadResult = Ok(Default::default());
-        let Ok((mut mats, mut map)) = empty else {
-            unreachable!()
-        };
-        for name in mtllib_names(&line.to_string_lossy()) {
-            let mtl = match model_file(path, dir, &name, "the material library") {
-                Ok(f) => f,
-                // An unused library outside the folder is not read; one that is not there is
-                // ignored, as missing libraries are.
-                Err(_)
-                    if mtl_mode == Mtl::Ignore
-                        && std::fs::symlink_metadata(dir.join(&name)).is_err() =>
-                {
-                    continue
-                }
-                Err(e) => return fail(e),
-            };
-            // The same file by another spelling (`./a.mtl`, `sub/../a.mtl`) is the same library.
-            let key = mtl.canonicalize().unwrap_or_else(|_| mtl.clone());
-            if seen.borrow().contains(&key) {
-                continue;
-            }
-            seen.borrow_mut().push(key);
-            #[cfg(test)]
-            MTL_READS.with(|n| n.set(n.get() + 1));
-            let bytes = match limits::read_file(&mtl, MAX_MTL_FILE_BYTES) {
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound && mtl_mode == Mtl::Ignore => {
-                    continue
-                }
-                Err(source) => {
-                    return fail(GeometryError::Material {
-                        path: path.to_path_buf(),
-                        mtl,
-                        source,
-                    })
-                }
-                Ok(b) => b,
-            };
-            read.borrow_mut().push(mtl.clone());
-            if mtl_mode == Mtl::Ignore {
-                continue;
-            }
-            let parsed = match super::mtl::parse_mtl(&mtl, &bytes) {
-                Ok(p) => p,
-                Err(e) => return fail(e),
-            };
-            let mut all = mtls.borrow_mut();
-            for m in parsed {
-                if let Some(prev) = all.iter().find(|p| p.name == m.name) {
-                    return fail(GeometryError::MaterialSyntax {
-                        mtl: m.file.clone(),
-                        line: m.line,
-                        message: format!(
-                            "material {:?} is defined again (first in '{}', line {})",
-                            m.name,
-                            prev.file.display(),
-                            prev.line
-                        ),
-                    });
-                }
-                map.insert(m.name.clone(), mats.len());
-                mats.push(tobj::Material {
-                    name: m.name.clone(),
-                    ..Default::default()
-                });
-                all.push(m);
-            }
-        }
-        Ok((mats, map))
-    };
     // tobj should not panic on malformed input, but a mesh loader must never take the
     // renderer down: convert any panic into an error.
     let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        tobj::load_obj_buf(&mut text.as_bytes(), &opts, load_mtl)
+        tobj::load_obj_buf(&mut text.as_bytes(), &opts, |line| libraries.load(line))
     }))
-    .map_err(|_| parse("the OBJ parser failed on malformed input".into()))?;
-    if let Some(e) = mtl_error.into_inner() {
+    .map_err(|_| obj_error(path, "the OBJ parser failed on malformed input".into()))?;
+    if let Some(e) = libraries.error.take() {
         return Err(e);
     }
-    let (models, _materials) = loaded.map_err(|e| match e {
+    let (models, _materials) = loaded.map_err(|e| tobj_error(path, text, e))?;
+    Ok(models)
+}
+
+/// tobj's error `e` on `text` as ours, with the line of a bad face.
+fn tobj_error(path: &Path, text: &str, e: tobj::LoadError) -> GeometryError {
+    let parse = |message: String| obj_error(path, message);
+    match e {
         tobj::LoadError::FaceVertexOutOfBounds | tobj::LoadError::FaceParseError => {
             // tobj does not say where: find the face ourselves.
             parse(locate_bad_face(text).unwrap_or_else(|| {
@@ -465,46 +357,189 @@ fn parse_obj(path: &Path, mtl_mode: Mtl) -> Result<Models, GeometryError> {
             parse("a 'usemtl' statement names no material".into())
         }
         e => parse(e.to_string()),
-    })?;
+    }
+}
+
+/// Refuses a vertex that is not finite or lies beyond [`super::bvh::MAX_COORDINATE`],
+/// naming its line of `text`.
+fn check_reach(path: &Path, text: &str, models: &[tobj::Model]) -> Result<(), GeometryError> {
     let far =
         |p: &[f32]| (p.iter()).any(|c| !c.is_finite() || c.abs() > super::bvh::MAX_COORDINATE);
     if models.iter().any(|m| far(&m.mesh.positions)) {
-        return Err(parse(far_vertex(text).unwrap_or_else(|| {
-            format!(
-                "a vertex lies beyond ±{:e} m from the origin (or is not finite)",
-                super::bvh::MAX_COORDINATE
-            )
-        })));
+        return Err(obj_error(
+            path,
+            far_vertex(text).unwrap_or_else(|| {
+                format!(
+                    "a vertex lies beyond ±{:e} m from the origin (or is not finite)",
+                    super::bvh::MAX_COORDINATE
+                )
+            }),
+        ));
     }
-    let mtls = mtls.into_inner();
-    let libraries = read.into_inner();
-    if mtl_mode == Mtl::Use {
-        // A `usemtl` naming no material of the libraries would silently lose its faces'
-        // material: say where it is.
-        for (n, line) in text.lines().enumerate() {
-            let l = line.trim_start();
-            if let Some(name) = l
-                .strip_prefix("usemtl")
-                .filter(|r| r.starts_with([' ', '\t']))
-            {
-                let name = name.trim();
-                if !mtls.iter().any(|m| m.name == name) {
-                    let mut known: Vec<&str> = mtls.iter().map(|m| m.name.as_str()).collect();
-                    known.sort_unstable();
-                    return Err(parse(format!(
-                        "line {}: `usemtl {name}` names a material that no material library (`mtllib`) of the file defines{}",
-                        n + 1,
-                        if known.is_empty() {
-                            " (it has none)".to_string()
-                        } else {
-                            format!("; defined: {}", known.join(", "))
-                        }
-                    )));
-                }
+    Ok(())
+}
+
+/// Refuses a `usemtl` naming no material of the libraries, which would silently lose its
+/// faces' material: says where it is.
+fn check_usemtl(path: &Path, text: &str, mtls: &[MtlMaterial]) -> Result<(), GeometryError> {
+    for (n, line) in text.lines().enumerate() {
+        let l = line.trim_start();
+        if let Some(name) = l
+            .strip_prefix("usemtl")
+            .filter(|r| r.starts_with([' ', '\t']))
+        {
+            let name = name.trim();
+            if !mtls.iter().any(|m| m.name == name) {
+                let mut known: Vec<&str> = mtls.iter().map(|m| m.name.as_str()).collect();
+                known.sort_unstable();
+                return Err(obj_error(path, format!(
+                    "line {}: `usemtl {name}` names a material that no material library (`mtllib`) of the file defines{}",
+                    n + 1,
+                    if known.is_empty() {
+                        " (it has none)".to_string()
+                    } else {
+                        format!("; defined: {}", known.join(", "))
+                    }
+                )));
             }
         }
     }
-    Ok((models, mtls, libraries))
+    Ok(())
+}
+
+/// The material libraries of the OBJ file `path`, read as tobj meets its `mtllib`
+/// statements (through a callback that cannot return our errors, hence the cells).
+struct MtlLibraries<'a> {
+    path: &'a Path,
+    /// The OBJ file's directory, which library names are relative to.
+    dir: &'a Path,
+    mode: Mtl,
+    /// The first error met.
+    error: std::cell::RefCell<Option<GeometryError>>,
+    /// The materials of the libraries parsed (with [`Mtl::Use`]).
+    materials: std::cell::RefCell<Vec<MtlMaterial>>,
+    /// Libraries read, each once however often `mtllib` names it.
+    read: std::cell::RefCell<Vec<std::path::PathBuf>>,
+    /// The libraries met, canonical: the same file by another spelling is the same library.
+    seen: std::cell::RefCell<Vec<std::path::PathBuf>>,
+}
+
+impl<'a> MtlLibraries<'a> {
+    fn new(path: &'a Path, mode: Mtl) -> Self {
+        MtlLibraries {
+            path,
+            dir: path.parent().unwrap_or(Path::new("")),
+            mode,
+            error: Default::default(),
+            materials: Default::default(),
+            read: Default::default(),
+            seen: Default::default(),
+        }
+    }
+
+    /// tobj's material loader for the `mtllib` statement `line`: the materials it adds, by
+    /// name only (ours are kept in `materials`). On an error, none (the error is kept).
+    fn load(&self, line: &Path) -> tobj::MTLLoadResult {
+        // tobj's own map type (it is not named in tobj's API).
+        let empty: tobj::MTLLoadResult = Ok(Default::default());
+        let Ok((mut mats, mut map)) = empty else {
+            unreachable!()
+        };
+        for name in mtllib_names(&line.to_string_lossy()) {
+            let added = match self.library(&name) {
+                Ok(added) => added,
+                Err(e) => {
+                    self.error.borrow_mut().get_or_insert(e);
+                    return Ok(Default::default());
+                }
+            };
+            for name in added {
+                map.insert(name.clone(), mats.len());
+                mats.push(tobj::Material {
+                    name,
+                    ..Default::default()
+                });
+            }
+        }
+        Ok((mats, map))
+    }
+
+    /// The names of the materials the library `name` adds: none when it is skipped (read
+    /// before, or missing while unused) or not used.
+    fn library(&self, name: &str) -> Result<Vec<String>, GeometryError> {
+        let Some((mtl, bytes)) = self.read_library(name)? else {
+            return Ok(Vec::new());
+        };
+        if self.mode == Mtl::Ignore {
+            return Ok(Vec::new());
+        }
+        let parsed = super::mtl::parse_mtl(&mtl, &bytes)?;
+        self.add(parsed)
+    }
+
+    /// The path and bytes of the library `name`, or `None` when it is skipped.
+    fn read_library(
+        &self,
+        name: &str,
+    ) -> Result<Option<(std::path::PathBuf, Vec<u8>)>, GeometryError> {
+        let mtl = match model_file(self.path, self.dir, name, "the material library") {
+            Ok(f) => f,
+            // An unused library outside the folder is not read; one that is not there is
+            // ignored, as missing libraries are.
+            Err(_)
+                if self.mode == Mtl::Ignore
+                    && std::fs::symlink_metadata(self.dir.join(name)).is_err() =>
+            {
+                return Ok(None)
+            }
+            Err(e) => return Err(e),
+        };
+        let key = mtl.canonicalize().unwrap_or_else(|_| mtl.clone());
+        if self.seen.borrow().contains(&key) {
+            return Ok(None);
+        }
+        self.seen.borrow_mut().push(key);
+        #[cfg(test)]
+        MTL_READS.with(|n| n.set(n.get() + 1));
+        let bytes = match limits::read_file(&mtl, MAX_MTL_FILE_BYTES) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound && self.mode == Mtl::Ignore => {
+                return Ok(None)
+            }
+            Err(source) => {
+                return Err(GeometryError::Material {
+                    path: self.path.to_path_buf(),
+                    mtl,
+                    source,
+                })
+            }
+            Ok(b) => b,
+        };
+        self.read.borrow_mut().push(mtl.clone());
+        Ok(Some((mtl, bytes)))
+    }
+
+    /// Adds the materials `parsed` of one library, refusing one defined before; their names.
+    fn add(&self, parsed: Vec<MtlMaterial>) -> Result<Vec<String>, GeometryError> {
+        let mut all = self.materials.borrow_mut();
+        let mut names = Vec::new();
+        for m in parsed {
+            if let Some(prev) = all.iter().find(|p| p.name == m.name) {
+                return Err(GeometryError::MaterialSyntax {
+                    mtl: m.file.clone(),
+                    line: m.line,
+                    message: format!(
+                        "material {:?} is defined again (first in '{}', line {})",
+                        m.name,
+                        prev.file.display(),
+                        prev.line
+                    ),
+                });
+            }
+            names.push(m.name.clone());
+            all.push(m);
+        }
+        Ok(names)
+    }
 }
 
 /// Appends the triangles of `models` to `mesh` (and their normals to `normals` when
@@ -689,151 +724,6 @@ pub fn load_obj_model(path: &Path) -> Result<ObjModel, GeometryError> {
         materials,
         libraries,
     })
-}
-
-/// Loads a PLY file (ascii, binary little- or big-endian): element `vertex` with float
-/// properties `x, y, z` (optionally `nx, ny, nz`), element `face` with a list property
-/// `vertex_indices` (or `vertex_index`); polygons are triangulated as fans.
-pub fn load_ply(path: &Path) -> Result<TriangleMesh, GeometryError> {
-    use ply_rs_bw::parser::{Parser, Reader};
-    use ply_rs_bw::ply::{DefaultElement, Property};
-    let bytes = read_mesh(path)?;
-    let parse = |message: String| GeometryError::Parse {
-        path: path.to_path_buf(),
-        format: "PLY",
-        message,
-    };
-    // A byte-order mark before the "ply" magic line (as some editors write) is skipped.
-    let mut reader = Reader::new(bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes));
-    let parser = Parser::<DefaultElement>::new();
-    let failed = |_| parse("the PLY parser failed on malformed input".into());
-    let header = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        parser.read_header(&mut reader)
-    }))
-    .map_err(failed)?
-    .map_err(|e| parse(one_paragraph(&e.to_string())))?;
-    let payload_bytes = reader.get_ref().len();
-    let elements =
-        (header.elements.iter()).fold(0u64, |n, (_, e)| n.saturating_add(e.count as u64));
-    check_memory(
-        path,
-        &format!(
-            "loading the {elements} elements its header declares (in a file of {} bytes)",
-            bytes.len()
-        ),
-        ply_memory(&header, payload_bytes),
-    )?;
-    let payload = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        parser.read_payload(&mut reader, &header)
-    }))
-    .map_err(failed)?
-    .map_err(|e| parse(one_paragraph(&e.to_string())))?;
-    let ply = ply_rs_bw::ply::Ply::<DefaultElement> { header, payload };
-
-    let vertices = ply
-        .payload
-        .get("vertex")
-        .ok_or_else(|| parse("there is no 'vertex' element".into()))?;
-    let expected_vertices = ply
-        .header
-        .elements
-        .get("vertex")
-        .map(|e| e.count)
-        .unwrap_or(vertices.len());
-    if vertices.len() != expected_vertices {
-        return Err(parse(format!(
-            "the header declares {expected_vertices} vertices but only {} could be read (truncated file?)",
-            vertices.len()
-        )));
-    }
-    let scalar = |el: &DefaultElement, key: &str, i: usize| -> Result<Option<f32>, GeometryError> {
-        match el.get(key) {
-            None => Ok(None),
-            Some(p) => p.to_f32_lossy().map(Some).ok_or_else(|| {
-                parse(format!(
-                    "vertex {i}: property '{key}' is a list, expected a number"
-                ))
-            }),
-        }
-    };
-    let mut mesh = TriangleMesh::default();
-    let mut normals = Vec::with_capacity(vertices.len());
-    let mut has_normals = true;
-    mesh.positions.reserve(vertices.len());
-    for (i, v) in vertices.iter().enumerate() {
-        let x = scalar(v, "x", i)?;
-        let y = scalar(v, "y", i)?;
-        let z = scalar(v, "z", i)?;
-        match (x, y, z) {
-            (Some(x), Some(y), Some(z)) => mesh.positions.push(Vec3::new(x, y, z)),
-            _ => {
-                return Err(parse(format!(
-                    "vertex {i} lacks one of the properties 'x', 'y', 'z'"
-                )))
-            }
-        }
-        if has_normals {
-            match (
-                scalar(v, "nx", i)?,
-                scalar(v, "ny", i)?,
-                scalar(v, "nz", i)?,
-            ) {
-                (Some(x), Some(y), Some(z)) => normals.push(Vec3::new(x, y, z)),
-                _ => has_normals = false,
-            }
-        }
-    }
-    if has_normals && !normals.is_empty() {
-        mesh.normals = Some(normals);
-    }
-    let nv = mesh.positions.len();
-    let faces: &[DefaultElement] = ply.payload.get("face").map(|v| &v[..]).unwrap_or(&[]);
-    if let Some(def) = ply.header.elements.get("face") {
-        if faces.len() != def.count {
-            return Err(parse(format!(
-                "the header declares {} faces but only {} could be read (truncated file?)",
-                def.count,
-                faces.len()
-            )));
-        }
-    }
-    for (f, face) in faces.iter().enumerate() {
-        let prop = face
-            .get("vertex_indices")
-            .or_else(|| face.get("vertex_index"))
-            .ok_or_else(|| {
-                parse(format!(
-                    "face {f} has no 'vertex_indices' (or 'vertex_index') list property"
-                ))
-            })?;
-        let idx: Vec<i64> = match prop {
-            Property::ListChar(v) => v.iter().map(|&x| x as i64).collect(),
-            Property::ListUChar(v) => v.iter().map(|&x| x as i64).collect(),
-            Property::ListShort(v) => v.iter().map(|&x| x as i64).collect(),
-            Property::ListUShort(v) => v.iter().map(|&x| x as i64).collect(),
-            Property::ListInt(v) => v.iter().map(|&x| x as i64).collect(),
-            Property::ListUInt(v) => v.iter().map(|&x| x as i64).collect(),
-            _ => {
-                return Err(parse(format!(
-                    "face {f}: the vertex index property is not a list of integers"
-                )))
-            }
-        };
-        if let Some(&bad) = idx.iter().find(|&&i| i < 0 || i as usize >= nv) {
-            return Err(GeometryError::IndexOutOfRange {
-                path: path.to_path_buf(),
-                face: f,
-                index: bad,
-                vertex_count: nv,
-            });
-        }
-        for k in 1..idx.len().saturating_sub(1) {
-            mesh.indices
-                .push([idx[0] as u32, idx[k] as u32, idx[k + 1] as u32]);
-        }
-    }
-    validate(path, &mesh)?;
-    Ok(mesh)
 }
 
 #[cfg(test)]

@@ -40,6 +40,7 @@ mod instance;
 mod io;
 pub mod mtl;
 mod pages;
+mod ply;
 mod prim;
 mod query;
 mod robust;
@@ -52,7 +53,8 @@ mod wide;
 pub use bvh::BUILD_PEAK_BYTES_PER_PRIM;
 pub(crate) use desc::mesh_err;
 pub use instance::{InstanceGroup, NO_INSTANCE};
-pub use io::{load_obj, load_obj_model, load_ply, model_file, ObjGroup, ObjModel};
+pub use io::{load_obj, load_obj_model, model_file, ObjGroup, ObjModel};
+pub use ply::load_ply;
 pub use prim::flat_point;
 pub use query::RayHit;
 pub use robust::{
