@@ -11,20 +11,26 @@ use super::metrics::{Schedule, Thresholds};
 use super::results::{hourly, hourly_bytes, metrics, GridResult, Hourly};
 use super::sun::{sun_coefficient_bytes, sun_coefficients, SunCoefficients};
 use super::view::{
-    view_bytes, view_camera, view_coefficients, view_metrics, HourGlare, ViewResult, ViewSettings,
+    view_bytes, view_camera, view_coefficients, view_metrics, HourGlare, ViewMatrix, ViewResult,
+    ViewSettings,
 };
 use super::year::{hourly_skies, HourSky};
+use crate::camera::Camera;
 use crate::daylight::epw::{Site, Weather};
 use crate::daylight::patches::SkyPatches;
 use crate::description::schema::{
     Amount, LightDesc, SceneFile, SkyModelDesc, SpectrumDesc, SunDesc,
 };
 use crate::glare::GlareOptions;
+use crate::light::sky::SiteFrame;
 use crate::light::Light;
 use crate::scene::build::Overrides;
+use crate::world::World;
 use anyhow::{anyhow, bail, Result};
 use glam::Vec3;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 /// What [`run`] computes and how finely.
 #[derive(Clone, Debug)]
@@ -194,13 +200,121 @@ fn scene_sky(scene: &SceneFile) -> (SceneSky, usize) {
     (sky, electric)
 }
 
+/// The scene, its weather and the year's skies, read and checked for an annual run.
+struct Input {
+    scene: SceneFile,
+    sky: SceneSky,
+    /// Electric lights of the scene (left out).
+    electric: usize,
+    /// The scene file's directory.
+    dir: PathBuf,
+    weather_path: PathBuf,
+    weather: Weather,
+    patches: SkyPatches,
+    year: Vec<HourSky>,
+    /// The year's hours with sun.
+    sunny: Vec<usize>,
+}
+
+/// The grid points as one list of receivers (point, normal), each grid's range in it, and
+/// each grid's layout.
+struct Receivers {
+    grids: Vec<GridLayout>,
+    points: Vec<(Vec3, Vec3)>,
+    ranges: Vec<Range<usize>>,
+}
+
+/// The view's camera and settings, with its sky coefficients.
+struct ViewSky {
+    camera: Camera,
+    settings: ViewSettings,
+    matrix: ViewMatrix,
+}
+
+/// The world lit by one sun of 1 lx alone (moved to each sun in turn), and the year's suns.
+struct SunHours {
+    world: World,
+    frame: SiteFrame,
+    latitude_deg: f64,
+    /// The direction (east, north, up) to the sun of each of the year's hours with sun.
+    to_sun: Vec<[f64; 3]>,
+}
+
+/// The hourly illuminances of the grid points and the metrics drawn from them.
+struct YearMetrics {
+    occupied: Schedule,
+    /// Hours with the sun above the horizon (EN 17037's daylight hours).
+    daylight: Schedule,
+    hourly: Hourly,
+    results: Vec<GridResult>,
+    /// Seed of the replicate years.
+    seed: u64,
+}
+
 /// Runs the annual calculation of the scene at `scene_path`.
 pub fn run(
     scene_path: &Path,
     settings: &AnnualSettings,
     progress: &mut dyn FnMut(Stage, usize, usize),
 ) -> Result<AnnualRun> {
-    let mut scene = crate::scene::load(scene_path)?;
+    let mut input = read_input(scene_path, settings)?;
+    let (world, frame) = unit_sky_world(&mut input.scene, &input.sky, scene_path, settings.seed)?;
+    let receivers = receivers(&world);
+    let view = view_camera_of(&world, settings)?;
+    check_resources(scene_path, settings, &input, &receivers, view.as_ref())?;
+
+    let t0 = Instant::now();
+    let sky_c = grid_sky(&world, &receivers, &input.patches, settings, progress)?;
+    let t1 = Instant::now();
+    let view = view_sky(&world, view, &input.patches, progress)?;
+    let view_sky_s = t1.elapsed().as_secs_f64();
+
+    let mut sun = sun_hours(world, frame, scene_path, &input)?;
+    let sun_c = grid_sun(&mut sun, &receivers, settings, progress)?;
+    let t2 = Instant::now();
+
+    let seed = settings.seed.unwrap_or(sun.world.settings.seed);
+    let m = year_metrics(&sky_c, &sun_c, &input, &receivers, settings, seed, progress);
+    let t3 = Instant::now();
+
+    let view = view.map(|v| {
+        let since = (view_sky_s, t3);
+        view_glare(v, &mut sun, &input, &m, settings, since, progress)
+    });
+
+    Ok(AnnualRun {
+        scene: scene_path.to_path_buf(),
+        weather: input.weather_path,
+        site: input.weather.site.clone(),
+        settings: AnnualSettings {
+            sky_samples: sky_c.samples,
+            sun_samples: sun_c.samples,
+            direct_samples: sun_c.direct_samples,
+            ..settings.clone()
+        },
+        patches: input.patches.len(),
+        grids: receivers.grids,
+        results: m.results,
+        hourly: m.hourly,
+        occupied_hours: m.occupied.hours.len(),
+        daylight_hours: m.daylight.hours.len(),
+        sunny_hours: sun.to_sun.len(),
+        sun_nodes: sun_c.nodes,
+        year: input.year,
+        seconds: (
+            (t1 - t0).as_secs_f64(),
+            (t2 - t1).as_secs_f64() - view_sky_s,
+            (t3 - t2).as_secs_f64(),
+        ),
+        view,
+        coefficients: settings.keep_coefficients.then_some((sky_c, sun_c)),
+        notes: notes(input.electric),
+    })
+}
+
+/// Reads the scene and its weather file, checks the settings, and derives the year's skies.
+fn read_input(scene_path: &Path, settings: &AnnualSettings) -> Result<Input> {
+    let scene = crate::scene::load(scene_path)?;
     let (sky, electric) = scene_sky(&scene);
     let dir = scene_path.parent().unwrap_or(Path::new("")).to_path_buf();
     let weather_path = match (&settings.weather, &sky.weather) {
@@ -218,6 +332,26 @@ pub fn run(
             scene_path.display()
         );
     }
+    check_settings(settings)?;
+    let patches = SkyPatches::new(settings.mf).map_err(|e| anyhow!(e))?;
+    let year = hourly_skies(&weather, &patches, sky.ground_reflectance)
+        .map_err(|e| anyhow!("{}: {e}", weather_path.display()))?;
+    let sunny = (0..year.len()).filter(|&h| year[h].has_sun()).collect();
+    Ok(Input {
+        scene,
+        sky,
+        electric,
+        dir,
+        weather_path,
+        weather,
+        patches,
+        year,
+        sunny,
+    })
+}
+
+/// The sky subdivision and the occupied hours, checked.
+fn check_settings(settings: &AnnualSettings) -> Result<()> {
     if !(1..=8).contains(&settings.mf) {
         return Err(crate::job::invalid_option(format!(
             "--mf {} must be 1 to 8",
@@ -230,11 +364,17 @@ pub fn run(
             settings.occupied.0, settings.occupied.1
         )));
     }
-    let patches = SkyPatches::new(settings.mf).map_err(|e| anyhow!(e))?;
-    let year = hourly_skies(&weather, &patches, sky.ground_reflectance)
-        .map_err(|e| anyhow!("{}: {e}", weather_path.display()))?;
+    Ok(())
+}
 
-    // The geometry lit by the unit sky.
+/// The scene's geometry lit by the unit sky alone (with the scene's sky spectrum and
+/// portals), and the sky's site frame.
+fn unit_sky_world(
+    scene: &mut SceneFile,
+    sky: &SceneSky,
+    scene_path: &Path,
+    seed: Option<u64>,
+) -> Result<(World, SiteFrame)> {
     scene.lights = vec![LightDesc::Sky {
         model: SkyModelDesc::Uniform,
         sun: None,
@@ -246,59 +386,91 @@ pub fn run(
     }];
     scene.meters.clear();
     let overrides = Overrides {
-        seed: settings.seed,
+        seed,
         ..Default::default()
     };
-    let world = crate::scene::build::build(&scene, scene_path, &overrides)?;
+    let world = crate::scene::build::build(scene, scene_path, &overrides)?;
     let frame = match world.lights.as_slice() {
         [Light::Sky(s)] => s.frame,
         _ => bail!("internal error: the unit-sky world has no sky"),
     };
+    Ok((world, frame))
+}
+
+/// The points of the world's grids, grid after grid, each grid's row after row.
+fn receivers(world: &World) -> Receivers {
     let mut grids = Vec::new();
-    let mut receivers = Vec::new();
+    let mut points = Vec::new();
     let mut ranges = Vec::new();
     for g in &world.grids {
-        let start = receivers.len();
-        let mut points = Vec::with_capacity(g.nx as usize * g.ny as usize);
+        let start = points.len();
+        let mut layout = Vec::with_capacity(g.nx as usize * g.ny as usize);
         for j in 0..g.ny {
             for i in 0..g.nx {
-                points.push(g.point(i, j));
-                receivers.push((g.point(i, j), g.normal));
+                layout.push(g.point(i, j));
+                points.push((g.point(i, j), g.normal));
             }
         }
-        ranges.push(start..receivers.len());
+        ranges.push(start..points.len());
         grids.push(GridLayout {
             name: g.name.clone(),
             nx: g.nx,
             ny: g.ny,
-            points,
+            points: layout,
             normal: g.normal,
             size_m: (g.edge_u.length() as f64, g.edge_v.length() as f64),
         });
     }
-    let sunny: Vec<usize> = (0..year.len()).filter(|&h| year[h].has_sun()).collect();
+    Receivers {
+        grids,
+        points,
+        ranges,
+    }
+}
+
+/// The camera of the view's hourly images, with the view's settings (checked), when a view
+/// is asked for.
+fn view_camera_of(
+    world: &World,
+    settings: &AnnualSettings,
+) -> Result<Option<(Camera, ViewSettings)>> {
+    let Some(v) = settings.view else {
+        return Ok(None);
+    };
+    let camera = view_camera(&world.camera, v.resolution);
+    if !(8..=1024).contains(&v.resolution) {
+        return Err(crate::job::invalid_option(format!(
+            "--view-resolution {} must be 8 to 1024",
+            v.resolution
+        )));
+    }
+    Ok(Some((camera, v)))
+}
+
+/// Checks, before the computation, that its coefficients and hourly values fit in memory
+/// and that the output's directory has room for the files.
+fn check_resources(
+    scene_path: &Path,
+    settings: &AnnualSettings,
+    input: &Input,
+    receivers: &Receivers,
+    view: Option<&(Camera, ViewSettings)>,
+) -> Result<()> {
+    let (patches, year, sunny) = (&input.patches, &input.year, &input.sunny);
     let daylight_n = year.iter().filter(|h| h.is_daylight()).count();
     let n_p = patches.len() as u64;
-    let view_cam = settings
-        .view
-        .map(|v| view_camera(&world.camera, v.resolution));
-    let view_need = match (&view_cam, &settings.view) {
-        (Some(c), Some(v)) => {
-            if !(8..=1024).contains(&v.resolution) {
-                return Err(crate::job::invalid_option(format!(
-                    "--view-resolution {} must be 8 to 1024",
-                    v.resolution
-                )));
-            }
-            // Nodes are at most one per sunny hour.
+    let n_r = receivers.points.len();
+    let view_need = match view {
+        // Nodes are at most one per sunny hour.
+        Some((c, _)) => {
             view_bytes(c.width * c.height, patches.len(), sunny.len(), sunny.len())
                 + year.len() as u64 * 160
         }
-        _ => 0,
+        None => 0,
     };
-    let need = receivers.len() as u64 * n_p * crate::meter::BATCHES as u64 * 8
-        + sun_coefficient_bytes(sunny.len(), receivers.len())
-        + hourly_bytes(year.len(), daylight_n, receivers.len())
+    let need = n_r as u64 * n_p * crate::meter::BATCHES as u64 * 8
+        + sun_coefficient_bytes(sunny.len(), n_r)
+        + hourly_bytes(year.len(), daylight_n, n_r)
         + view_need;
     crate::limits::check_memory(
         need,
@@ -309,70 +481,120 @@ pub fn run(
         super::room::check_room(
             stem,
             &super::room::Planned {
-                points: receivers.len(),
+                points: n_r,
                 hours: year.len(),
                 sunny_hours: sunny.len(),
                 patches: patches.len(),
-                grids: grids.len(),
+                grids: receivers.grids.len(),
                 glare: settings.view.is_some(),
                 coefficients: settings.keep_coefficients,
             },
         )?;
     }
+    Ok(())
+}
 
-    let t0 = std::time::Instant::now();
+/// The grid points' sky coefficients.
+fn grid_sky(
+    world: &World,
+    receivers: &Receivers,
+    patches: &SkyPatches,
+    settings: &AnnualSettings,
+    progress: &mut dyn FnMut(Stage, usize, usize),
+) -> Result<Coefficients> {
     progress(Stage::Sky, 0, 1);
-    let sky_c: Coefficients = sky_coefficients(&world, &receivers, &patches, settings.sky_samples)?;
+    let sky_c = sky_coefficients(world, &receivers.points, patches, settings.sky_samples)?;
     progress(Stage::Sky, 1, 1);
-    let view_t = std::time::Instant::now();
-    let view_m = match (&view_cam, &settings.view) {
-        (Some(camera), Some(v)) => {
-            progress(Stage::View, 0, 1);
-            Some(view_coefficients(&world, camera, &patches, v)?)
-        }
-        _ => None,
-    };
-    let view_sky_s = view_t.elapsed().as_secs_f64();
-    let t1 = view_t;
+    Ok(sky_c)
+}
 
-    let sun_light = {
-        let ctx = crate::description::context::Context {
-            path: scene_path,
-            dir: dir.clone(),
-            sources: Default::default(),
-        };
-        let desc = SunDesc {
-            altitude_deg: Some(45.0),
-            azimuth_deg: Some(180.0),
-            ..Default::default()
-        };
-        let (s, _) = crate::light::SunLight::build(
-            &ctx,
-            "annual sun",
-            &desc,
-            Amount::NormalIlluminance(1.0),
-            None,
-            &frame,
-        )?;
-        s
+/// The view's sky coefficients, when there is a view.
+fn view_sky(
+    world: &World,
+    view: Option<(Camera, ViewSettings)>,
+    patches: &SkyPatches,
+    progress: &mut dyn FnMut(Stage, usize, usize),
+) -> Result<Option<ViewSky>> {
+    let Some((camera, settings)) = view else {
+        return Ok(None);
     };
-    let mut sun_world = world.relit(vec![Light::Sun(sun_light)]);
-    let to_sun: Vec<[f64; 3]> = sunny.iter().map(|&h| year[h].to_sun_enu).collect();
-    let n_sunny = to_sun.len();
-    progress(Stage::Sun, 0, 1);
-    let sun_c: SunCoefficients = sun_coefficients(
-        &mut sun_world,
-        &receivers,
-        &to_sun,
+    progress(Stage::View, 0, 1);
+    let matrix = view_coefficients(world, &camera, patches, &settings)?;
+    Ok(Some(ViewSky {
+        camera,
+        settings,
+        matrix,
+    }))
+}
+
+/// The unit-sky world relit by a sun of 1 lx normal illuminance, and the year's suns.
+fn sun_hours(world: World, frame: SiteFrame, scene_path: &Path, input: &Input) -> Result<SunHours> {
+    let ctx = crate::description::context::Context {
+        path: scene_path,
+        dir: input.dir.clone(),
+        sources: Default::default(),
+    };
+    let desc = SunDesc {
+        altitude_deg: Some(45.0),
+        azimuth_deg: Some(180.0),
+        ..Default::default()
+    };
+    let (sun_light, _) = crate::light::SunLight::build(
+        &ctx,
+        "annual sun",
+        &desc,
+        Amount::NormalIlluminance(1.0),
+        None,
         &frame,
-        weather.site.latitude_deg,
+    )?;
+    let world = world.relit(vec![Light::Sun(sun_light)]);
+    let to_sun = input
+        .sunny
+        .iter()
+        .map(|&h| input.year[h].to_sun_enu)
+        .collect();
+    Ok(SunHours {
+        world,
+        frame,
+        latitude_deg: input.weather.site.latitude_deg,
+        to_sun,
+    })
+}
+
+/// The grid points' sun coefficients: inter-reflected at the sun grid's nodes, direct for
+/// each sunny hour.
+fn grid_sun(
+    sun: &mut SunHours,
+    receivers: &Receivers,
+    settings: &AnnualSettings,
+    progress: &mut dyn FnMut(Stage, usize, usize),
+) -> Result<SunCoefficients> {
+    progress(Stage::Sun, 0, 1);
+    let sun_c = sun_coefficients(
+        &mut sun.world,
+        &receivers.points,
+        &sun.to_sun,
+        &sun.frame,
+        sun.latitude_deg,
         settings.sun_samples,
         settings.direct_samples,
         &mut |d, n| progress(Stage::Sun, d, n),
     )?;
-    let t2 = std::time::Instant::now();
+    Ok(sun_c)
+}
 
+/// The year's hourly illuminances and each grid's metrics, with their replicate years.
+fn year_metrics(
+    sky_c: &Coefficients,
+    sun_c: &SunCoefficients,
+    input: &Input,
+    receivers: &Receivers,
+    settings: &AnnualSettings,
+    seed: u64,
+    progress: &mut dyn FnMut(Stage, usize, usize),
+) -> YearMetrics {
     progress(Stage::Metrics, 0, 1);
+    let year = &input.year;
     let days = year.len() / 24;
     let occupied = Schedule::daily(days, settings.occupied.0, settings.occupied.1);
     let daylight = Schedule {
@@ -380,11 +602,10 @@ pub fn run(
             .filter(|&h| year[h].sun_altitude_deg > 0.0)
             .collect(),
     };
-    let hourly = hourly(&sky_c, &sun_c, &year);
-    let seed = settings.seed.unwrap_or(sun_world.settings.seed);
+    let hourly = hourly(sky_c, sun_c, year);
     let results = metrics(
         &hourly,
-        &ranges,
+        &receivers.ranges,
         &occupied,
         &daylight,
         &settings.thresholds,
@@ -392,76 +613,72 @@ pub fn run(
         seed,
     );
     progress(Stage::Metrics, 1, 1);
-    let t3 = std::time::Instant::now();
+    YearMetrics {
+        occupied,
+        daylight,
+        hourly,
+        results,
+        seed,
+    }
+}
 
-    let view = match (&view_cam, &settings.view, view_m) {
-        (Some(camera), Some(v), Some(mut vm)) => {
-            vm.add_sun(
-                &mut sun_world,
-                camera,
-                &frame,
-                &to_sun,
-                weather.site.latitude_deg,
-                v,
-                &mut |d, n| progress(Stage::View, 1 + d, n + 2),
-            );
-            let t4 = std::time::Instant::now();
-            let mut sun_index = vec![usize::MAX; year.len()];
-            for (i, &h) in sunny.iter().enumerate() {
-                sun_index[h] = i;
-            }
-            let hours = vm.glare(&year, &occupied.hours, &sun_index, &settings.glare);
-            let result = view_metrics(&hours, &occupied, &settings.glare, settings.draws, seed);
-            progress(Stage::View, 1, 1);
-            Some(ViewRun {
-                width: camera.width,
-                height: camera.height,
-                projection: crate::camera::describe(camera.projection()),
-                sky_samples: vm.sky_samples,
-                sun_samples: vm.sun_samples,
-                hours,
-                result,
-                seconds: (
-                    view_sky_s + (t4 - t3).as_secs_f64(),
-                    t4.elapsed().as_secs_f64(),
-                ),
-            })
-        }
-        _ => None,
-    };
+/// The view's sun coefficients, then the glare of its occupied daylight hours and the glare
+/// metrics. `since`: the seconds of the view's sky coefficients, and when this step starts.
+fn view_glare(
+    view: ViewSky,
+    sun: &mut SunHours,
+    input: &Input,
+    m: &YearMetrics,
+    settings: &AnnualSettings,
+    since: (f64, Instant),
+    progress: &mut dyn FnMut(Stage, usize, usize),
+) -> ViewRun {
+    let (view_sky_s, t3) = since;
+    let ViewSky {
+        camera,
+        settings: v,
+        matrix: mut vm,
+    } = view;
+    vm.add_sun(
+        &mut sun.world,
+        &camera,
+        &sun.frame,
+        &sun.to_sun,
+        sun.latitude_deg,
+        &v,
+        &mut |d, n| progress(Stage::View, 1 + d, n + 2),
+    );
+    let t4 = Instant::now();
+    let year = &input.year;
+    let mut sun_index = vec![usize::MAX; year.len()];
+    for (i, &h) in input.sunny.iter().enumerate() {
+        sun_index[h] = i;
+    }
+    let hours = vm.glare(year, &m.occupied.hours, &sun_index, &settings.glare);
+    let result = view_metrics(&hours, &m.occupied, &settings.glare, settings.draws, m.seed);
+    progress(Stage::View, 1, 1);
+    ViewRun {
+        width: camera.width,
+        height: camera.height,
+        projection: crate::camera::describe(camera.projection()),
+        sky_samples: vm.sky_samples,
+        sun_samples: vm.sun_samples,
+        hours,
+        result,
+        seconds: (
+            view_sky_s + (t4 - t3).as_secs_f64(),
+            t4.elapsed().as_secs_f64(),
+        ),
+    }
+}
 
+/// Notes on what the annual results leave out.
+fn notes(electric: usize) -> Vec<String> {
     let mut notes = Vec::new();
     if electric > 0 {
         notes.push(format!(
             "{electric} electric light(s) of the scene are left out: annual results are daylight alone"
         ));
     }
-    Ok(AnnualRun {
-        scene: scene_path.to_path_buf(),
-        weather: weather_path,
-        site: weather.site.clone(),
-        settings: AnnualSettings {
-            sky_samples: sky_c.samples,
-            sun_samples: sun_c.samples,
-            direct_samples: sun_c.direct_samples,
-            ..settings.clone()
-        },
-        patches: patches.len(),
-        grids,
-        results,
-        hourly,
-        occupied_hours: occupied.hours.len(),
-        daylight_hours: daylight.hours.len(),
-        sunny_hours: n_sunny,
-        sun_nodes: sun_c.nodes,
-        year,
-        seconds: (
-            (t1 - t0).as_secs_f64(),
-            (t2 - t1).as_secs_f64() - view_sky_s,
-            (t3 - t2).as_secs_f64(),
-        ),
-        view,
-        coefficients: settings.keep_coefficients.then_some((sky_c, sun_c)),
-        notes,
-    })
+    notes
 }

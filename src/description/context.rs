@@ -3,7 +3,7 @@
 //! radiometric spectra. Every type that builds itself from its description uses it.
 
 use super::schema::{SpectrumDesc, V3};
-use crate::colour::sd::SpectralDistribution;
+use crate::colour::sd::{Interpolation, SpectralDistribution};
 use crate::colour::{planck::planck_law, tables};
 use crate::photometry::photometric_scale;
 use crate::spectrum::rgb_upsample::fit_linear_srgb;
@@ -183,120 +183,158 @@ impl Context<'_> {
                 let v = self.finite(field, *v)?;
                 DenseSpectrum::constant(v as f32)
             }
-            SpectrumDesc::Blackbody(t) => {
-                if role == Role::Reflectance {
-                    return Err(self.err(
-                        field,
-                        "a blackbody spectrum describes emission, not a reflectance",
-                    ));
-                }
-                let t = self.positive(field, *t)?;
-                // Relative shape only: normalise to 1 at 560 nm to keep f32 in range.
-                let norm = planck_law(560e-9, t);
-                DenseSpectrum::from_fn(|nm| planck_law(nm * 1e-9, t) / norm)
-            }
-            SpectrumDesc::Daylight(cct) => {
-                if role == Role::Reflectance {
-                    return Err(self.err(
-                        field,
-                        "a daylight spectrum describes emission, not a reflectance",
-                    ));
-                }
-                let t = self.finite(field, *cct)?;
-                if !(4000.0..=25_000.0).contains(&t) {
-                    return Err(self.err(
-                        field,
-                        format!("CIE daylight is defined from 4000 K to 25 000 K, not {t} K"),
-                    ));
-                }
-                let sd = crate::colour::illuminants::sd_cie_daylight(t);
-                DenseSpectrum::from_fn(|nm| {
-                    let x = (nm - 360.0).clamp(0.0, (sd.len() - 1) as f64);
-                    let (i, f) = (x.floor() as usize, x.fract());
-                    let j = (i + 1).min(sd.len() - 1);
-                    sd[i] * (1.0 - f) + sd[j] * f
-                })
-            }
-            SpectrumDesc::Named(name) => {
-                let sd = tables::named_spectrum(name).ok_or_else(|| {
-                    self.err(
-                        field,
-                        format!(
-                            "unknown spectrum name {name:?}; known names: {}",
-                            tables::named_spectrum_names().join(", ")
-                        ),
-                    )
-                })?;
-                DenseSpectrum::from_fn(|nm| sd.value(nm))
-            }
-            SpectrumDesc::Tabulated(pairs) => {
-                let (w, v): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
-                let sd =
-                    SpectralDistribution::new(w, v).map_err(|e| self.err(field, e.to_string()))?;
-                in_range(self, field, &sd, "the table")?;
-                DenseSpectrum::from_fn(|nm| sd.value(nm))
-            }
-            SpectrumDesc::Csv(rel, interpolation) => {
-                let p = self.resolve(rel);
-                let sd = SpectralDistribution::from_csv_path(&p)
-                    .map_err(|e| self.err(field, e.to_string()))?;
-                in_range(self, field, &sd, &format!("{}", p.display()))?;
-                // CIE 167's interpolants can ring below 0 next to a sharp line (and a
-                // reflectance above 1): held at those bounds, valid samples stay valid and
-                // invalid ones are still refused below.
-                let t = sd.to_table_with(*interpolation);
-                let max = sd.values.iter().fold(f64::NEG_INFINITY, |m, &v| v.max(m));
-                let lo = sd.min_value().min(0.0);
-                let hi = if role == Role::Reflectance {
-                    max.max(1.0)
-                } else {
-                    f64::INFINITY
-                };
-                let start = crate::colour::grid::START_NM as f64;
-                DenseSpectrum::from_fn(|nm| t[(nm - start) as usize].clamp(lo, hi))
-            }
+            SpectrumDesc::Blackbody(t) => self.blackbody(field, *t, role)?,
+            SpectrumDesc::Daylight(cct) => self.daylight(field, *cct, role)?,
+            SpectrumDesc::Named(name) => self.named(field, name)?,
+            SpectrumDesc::Tabulated(pairs) => self.tabulated(field, pairs)?,
+            SpectrumDesc::Csv(rel, interpolation) => self.csv(field, rel, *interpolation, role)?,
             SpectrumDesc::Texture { .. } => {
                 return Err(self.err(
                     field,
                     "an image texture can only be a `Diffuse` material's reflectance or an object's emission spectrum",
                 ));
             }
-            SpectrumDesc::Rgb(..) | SpectrumDesc::Srgb(..) => {
-                let (rgb, encoded) = match *desc {
-                    SpectrumDesc::Rgb(r, g, b) => ([r, g, b], false),
-                    SpectrumDesc::Srgb(r, g, b) => ([r, g, b], true),
-                    _ => unreachable!(),
-                };
-                for (k, c) in rgb.iter().enumerate() {
-                    self.finite(field, *c)?;
-                    if !(0.0..=1.0).contains(c) {
-                        return Err(self.err(
-                            field,
-                            format!(
-                                "RGB component {} is {c}; sRGB components must lie in [0, 1]",
-                                ["r", "g", "b"][k]
-                            ),
-                        ));
-                    }
-                }
-                let rgb = if encoded {
-                    rgb.map(crate::colour::rgb::srgb_decode)
-                } else {
-                    rgb
-                };
-                let (sig, _residual) =
-                    fit_linear_srgb(rgb).map_err(|e| self.err(field, e.to_string()))?;
-                match role {
-                    Role::Reflectance => DenseSpectrum::from_fn(|nm| sig.value(nm)),
-                    Role::Emission => {
-                        // An RGB emitter is the smooth reflectance-like shape times D65, so that
-                        // white (1,1,1) emits D65 (pbrt-v4's RGBIlluminantSpectrum).
-                        let d65 = tables::named_spectrum("D65").expect("D65 ships with candela");
-                        DenseSpectrum::from_fn(|nm| sig.value(nm) * d65.value(nm))
-                    }
-                }
-            }
+            SpectrumDesc::Rgb(r, g, b) => self.rgb(field, [*r, *g, *b], false, role)?,
+            SpectrumDesc::Srgb(r, g, b) => self.rgb(field, [*r, *g, *b], true, role)?,
         };
+        self.valid_spectrum(field, dense, role)
+    }
+
+    /// A blackbody's relative spectrum at `t` K (emission only).
+    fn blackbody(&self, field: &str, t: f64, role: Role) -> Result<DenseSpectrum, SceneError> {
+        if role == Role::Reflectance {
+            return Err(self.err(
+                field,
+                "a blackbody spectrum describes emission, not a reflectance",
+            ));
+        }
+        let t = self.positive(field, t)?;
+        // Relative shape only: normalise to 1 at 560 nm to keep f32 in range.
+        let norm = planck_law(560e-9, t);
+        Ok(DenseSpectrum::from_fn(|nm| planck_law(nm * 1e-9, t) / norm))
+    }
+
+    /// CIE daylight of correlated colour temperature `cct` K (emission only).
+    fn daylight(&self, field: &str, cct: f64, role: Role) -> Result<DenseSpectrum, SceneError> {
+        if role == Role::Reflectance {
+            return Err(self.err(
+                field,
+                "a daylight spectrum describes emission, not a reflectance",
+            ));
+        }
+        let t = self.finite(field, cct)?;
+        if !(4000.0..=25_000.0).contains(&t) {
+            return Err(self.err(
+                field,
+                format!("CIE daylight is defined from 4000 K to 25 000 K, not {t} K"),
+            ));
+        }
+        let sd = crate::colour::illuminants::sd_cie_daylight(t);
+        Ok(DenseSpectrum::from_fn(|nm| {
+            let x = (nm - 360.0).clamp(0.0, (sd.len() - 1) as f64);
+            let (i, f) = (x.floor() as usize, x.fract());
+            let j = (i + 1).min(sd.len() - 1);
+            sd[i] * (1.0 - f) + sd[j] * f
+        }))
+    }
+
+    /// A spectrum candela ships, by name.
+    fn named(&self, field: &str, name: &str) -> Result<DenseSpectrum, SceneError> {
+        let sd = tables::named_spectrum(name).ok_or_else(|| {
+            self.err(
+                field,
+                format!(
+                    "unknown spectrum name {name:?}; known names: {}",
+                    tables::named_spectrum_names().join(", ")
+                ),
+            )
+        })?;
+        Ok(DenseSpectrum::from_fn(|nm| sd.value(nm)))
+    }
+
+    /// A spectrum given as (wavelength nm, value) pairs.
+    fn tabulated(&self, field: &str, pairs: &[(f64, f64)]) -> Result<DenseSpectrum, SceneError> {
+        let (w, v): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
+        let sd = SpectralDistribution::new(w, v).map_err(|e| self.err(field, e.to_string()))?;
+        in_range(self, field, &sd, "the table")?;
+        Ok(DenseSpectrum::from_fn(|nm| sd.value(nm)))
+    }
+
+    /// A spectrum read from the CSV file `rel` (relative to the scene), interpolated by
+    /// `interpolation`.
+    fn csv(
+        &self,
+        field: &str,
+        rel: &str,
+        interpolation: Interpolation,
+        role: Role,
+    ) -> Result<DenseSpectrum, SceneError> {
+        let p = self.resolve(rel);
+        let sd =
+            SpectralDistribution::from_csv_path(&p).map_err(|e| self.err(field, e.to_string()))?;
+        in_range(self, field, &sd, &format!("{}", p.display()))?;
+        // CIE 167's interpolants can ring below 0 next to a sharp line (and a reflectance
+        // above 1): held at those bounds, valid samples stay valid and invalid ones are still
+        // refused by the checks of every spectrum.
+        let t = sd.to_table_with(interpolation);
+        let max = sd.values.iter().fold(f64::NEG_INFINITY, |m, &v| v.max(m));
+        let lo = sd.min_value().min(0.0);
+        let hi = if role == Role::Reflectance {
+            max.max(1.0)
+        } else {
+            f64::INFINITY
+        };
+        let start = crate::colour::grid::START_NM as f64;
+        Ok(DenseSpectrum::from_fn(|nm| {
+            t[(nm - start) as usize].clamp(lo, hi)
+        }))
+    }
+
+    /// The smooth spectrum of linear (or, `encoded`, sRGB-encoded) RGB components in [0, 1]:
+    /// a reflectance, or for emission that shape times D65.
+    fn rgb(
+        &self,
+        field: &str,
+        rgb: [f64; 3],
+        encoded: bool,
+        role: Role,
+    ) -> Result<DenseSpectrum, SceneError> {
+        for (k, c) in rgb.iter().enumerate() {
+            self.finite(field, *c)?;
+            if !(0.0..=1.0).contains(c) {
+                return Err(self.err(
+                    field,
+                    format!(
+                        "RGB component {} is {c}; sRGB components must lie in [0, 1]",
+                        ["r", "g", "b"][k]
+                    ),
+                ));
+            }
+        }
+        let rgb = if encoded {
+            rgb.map(crate::colour::rgb::srgb_decode)
+        } else {
+            rgb
+        };
+        let (sig, _residual) = fit_linear_srgb(rgb).map_err(|e| self.err(field, e.to_string()))?;
+        Ok(match role {
+            Role::Reflectance => DenseSpectrum::from_fn(|nm| sig.value(nm)),
+            Role::Emission => {
+                // An RGB emitter is the smooth reflectance-like shape times D65, so that
+                // white (1,1,1) emits D65 (pbrt-v4's RGBIlluminantSpectrum).
+                let d65 = tables::named_spectrum("D65").expect("D65 ships with candela");
+                DenseSpectrum::from_fn(|nm| sig.value(nm) * d65.value(nm))
+            }
+        })
+    }
+
+    /// `dense`, refused unless finite and ≥ 0 (and, a reflectance, ≤ 1).
+    fn valid_spectrum(
+        &self,
+        field: &str,
+        dense: DenseSpectrum,
+        role: Role,
+    ) -> Result<DenseSpectrum, SceneError> {
         if dense.values.iter().any(|v| !v.is_finite()) {
             return Err(self.err(field, "the spectrum has non-finite values"));
         }

@@ -11,8 +11,12 @@
 //! ([`SkyMap`]), or through the scene's portals when it has them.
 
 use super::portal::Portals;
+use super::sun::{SunLight, SunPlacement};
 use super::{LightFlags, LightSample};
+use crate::daylight::perez::{SkyCondition, DEFAULT_DEW_POINT_C};
 use crate::daylight::{horizontal_integral, CieSky, PerezSky, SkyMap};
+use crate::description::context::{Context, SceneError};
+use crate::description::schema::{Amount, SkyModelDesc, SpectrumDesc};
 use crate::photometry::luminous_integral;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{DVec3, Vec2, Vec3};
@@ -278,35 +282,18 @@ impl SkyLight {
     /// horizontal irradiance (W·m⁻²·nm⁻¹) of the scene's `Sun` lights, which the ground
     /// reflects. A Perez sky also returns its sun's disk (unless `sun_disk: false`).
     pub fn build(
-        ctx: &crate::description::context::Context,
+        ctx: &Context,
         field: &str,
         d: &SkyDesc,
         frame: &SiteFrame,
         suns_horizontal: &DenseSpectrum,
-    ) -> Result<(Self, Option<super::SunLight>), crate::description::context::SceneError> {
-        use super::sun::{place_sun, SunLight};
-        use crate::daylight::perez::{SkyCondition, DEFAULT_DEW_POINT_C};
-        use crate::description::schema::{Amount, SkyModelDesc, SpectrumDesc};
+    ) -> Result<(Self, Option<SunLight>), SceneError> {
         let afield = format!("{field}.amount");
-        let mfield = format!("{field}.model");
-        let place = match d.sun {
-            Some(s) => Some(place_sun(ctx, &format!("{field}.sun"), s)?),
+        let sun_place = match d.sun {
+            Some(s) => Some(locate_sun(ctx, &format!("{field}.sun"), s)?),
             None => None,
         };
-        let sun_local = place.map(|p| {
-            let (alt, az) = (p.altitude_deg.to_radians(), p.azimuth_deg.to_radians());
-            DVec3::new(alt.cos() * az.sin(), alt.cos() * az.cos(), alt.sin())
-        });
-        let need_sun = |what: &str| {
-            ctx.err(
-                format!("{field}.sun"),
-                format!("{what} depends on where the sun is: give `sun: (altitude_deg: …, azimuth_deg: …)` or a place and time"),
-            )
-        };
-        let mut perez_sun = None;
-        let (distribution, sky_lx) = match d.model {
-            // Given by illuminance (lx, as `gendaylit -L`) or by irradiance (W/m², as
-            // `gendaylit -W`).
+        let (distribution, sky_lx, perez_sun) = match d.model {
             SkyModelDesc::Perez {
                 direct_normal_lx: direct,
                 diffuse_horizontal_lx: diffuse,
@@ -317,145 +304,20 @@ impl SkyLight {
                 diffuse_horizontal_w_m2: diffuse,
                 dew_point_c,
             } => {
-                let by_irradiance = matches!(d.model, SkyModelDesc::PerezIrradiance { .. });
-                let (dfield, hfield) = if by_irradiance {
-                    ("direct_normal_w_m2", "diffuse_horizontal_w_m2")
-                } else {
-                    ("direct_normal_lx", "diffuse_horizontal_lx")
-                };
-                let direct = ctx.nonneg(&format!("{mfield}.{dfield}"), *direct)?;
-                let diffuse = ctx.nonneg(&format!("{mfield}.{hfield}"), *diffuse)?;
-                let dew = match dew_point_c {
-                    Some(t) => ctx.finite(&format!("{mfield}.dew_point_c"), *t)?,
-                    None => DEFAULT_DEW_POINT_C,
-                };
-                let (Some(p), Some(s)) = (place, sun_local) else {
-                    return Err(need_sun("the Perez sky"));
-                };
-                if d.amount.is_some() {
-                    return Err(ctx.err(
-                        &afield,
-                        format!("a Perez sky's amount is its {hfield}; remove `amount`"),
-                    ));
-                }
-                // A sun below the horizon (its direct light then absent) shapes the sky from
-                // the horizon, as in gendaymtx and `candela annual`.
-                let zenith = s.z.clamp(-1.0, 1.0).acos().min(std::f64::consts::FRAC_PI_2);
-                let (cond, dn, dh) = if by_irradiance {
-                    SkyCondition::illuminance_from_irradiance(
-                        diffuse,
-                        direct,
-                        zenith,
-                        p.eccentricity,
-                        dew,
-                    )
-                } else {
-                    SkyCondition::from_illuminance(diffuse, direct, zenith, p.eccentricity, dew)
-                        .map(|(cond, _)| (cond, direct, diffuse))
-                }
-                .map_err(|e| ctx.err(&mfield, e.to_string()))?;
-
-                if dn > 0.0 && d.sun_disk.unwrap_or(true) {
-                    let d50 = SpectrumDesc::Named("D50".into());
-                    let radiance = ctx.emission(
-                        &format!("{field}.sun"),
-                        &format!("{mfield}.{dfield}"),
-                        &d50,
-                        SunLight::luminance_for(dn),
-                    )?;
-                    perez_sun = Some(SunLight::new(frame.to_world(s).as_vec3(), radiance, dn));
-                }
-                (SkyDistribution::Perez(PerezSky::new(cond)), Some(dh))
+                let given = (*direct, *diffuse, *dew_point_c);
+                perez_sky(ctx, field, d, frame, sun_place, given)?
             }
-            m => {
-                let cie = match m {
-                    SkyModelDesc::CieGeneral(k) => CieSky::general(*k).ok_or_else(|| {
-                        ctx.err(
-                            &mfield,
-                            format!("CIE general sky {k}: the standard defines types 1 to 15"),
-                        )
-                    })?,
-                    SkyModelDesc::CieOvercast => CieSky::Overcast,
-                    SkyModelDesc::Uniform => CieSky::Uniform,
-                    SkyModelDesc::CieClear => CieSky::Clear,
-                    SkyModelDesc::Perez { .. } | SkyModelDesc::PerezIrradiance { .. } => {
-                        unreachable!("handled above")
-                    }
-                };
-                if cie.needs_sun() {
-                    match place {
-                        None => return Err(need_sun("this sky")),
-                        Some(p) if p.altitude_deg < 0.0 => {
-                            return Err(ctx.err(
-                                format!("{field}.sun"),
-                                format!(
-                                    "the sun is {:.2}° below the horizon: the CIE skies that depend on it are defined for a sun above it",
-                                    -p.altitude_deg
-                                ),
-                            ))
-                        }
-                        _ => {}
-                    }
-                }
-                (SkyDistribution::Cie(cie), None)
-            }
+            m => (cie_sky(ctx, field, m, sun_place)?, None, None),
         };
-        // The sun's direction only shapes sun-dependent skies; any will do for the others.
-        let sun = match (sun_local, &distribution) {
-            (Some(s), SkyDistribution::Perez(_)) if s.z < 0.0 => DVec3::new(s.x, s.y, 0.0)
-                .try_normalize()
-                .unwrap_or(DVec3::X),
-            (Some(s), _) => s,
-            (None, _) => DVec3::Z,
-        };
+        let sun = reference_sun(sun_place.map(|p| p.1), &distribution);
         let integral = distribution.horizontal_integral(sun);
-        let k = match (d.amount, sky_lx) {
-            (None, Some(lx)) => lx / integral,
-            (Some(Amount::HorizontalIlluminance(e)), None) => ctx.nonneg(&afield, e)? / integral,
-            (Some(Amount::ZenithLuminance(l)), None) => {
-                ctx.nonneg(&afield, l)? / distribution.relative(DVec3::Z, sun)
-            }
-            (Some(a), _) => {
-                return Err(super::wrong_amount(
-                    ctx,
-                    &afield,
-                    &a,
-                    "HorizontalIlluminance(lx) or ZenithLuminance(cd/m²)",
-                ))
-            }
-            (None, None) => {
-                return Err(ctx.err(
-                    &afield,
-                    "missing: give HorizontalIlluminance(lx) or ZenithLuminance(cd/m²)",
-                ))
-            }
-        };
+        let k = luminance_scale(ctx, &afield, d.amount, sky_lx, &distribution, sun, integral)?;
         let sfield = format!("{field}.spectrum");
         let daylight = SpectrumDesc::Daylight(DEFAULT_SKY_CCT_K);
         let radiance = ctx.emission(&sfield, &afield, d.spectrum.unwrap_or(&daylight), k)?;
-        let rho = match d.ground_reflectance {
-            Some(r) => {
-                let gfield = format!("{field}.ground_reflectance");
-                let r = ctx.nonneg(&gfield, r)?;
-                if r > 1.0 {
-                    return Err(ctx.err(gfield, format!("{r} is more than 1")));
-                }
-                r
-            }
-            None => DEFAULT_GROUND_REFLECTANCE,
-        };
-        // The ground reflects the sky's and the suns' horizontal irradiance: L = ρ E_h / π.
-        let mut e_h = radiance.scaled(integral as f32);
-        let mut add = |s: &DenseSpectrum| {
-            for (a, b) in e_h.values.iter_mut().zip(s.values.iter()) {
-                *a += *b;
-            }
-        };
-        add(suns_horizontal);
-        if let Some(s) = &perez_sun {
-            add(&s.horizontal_irradiance(frame));
-        }
-        let ground = e_h.scaled((rho / std::f64::consts::PI) as f32);
+        let rho = ground_reflectance(ctx, field, d.ground_reflectance)?;
+        let lit_by = (suns_horizontal, perez_sun.as_ref());
+        let ground = ground_radiance(&radiance, integral, lit_by, frame, rho);
         let portals = super::environment::build_portals(ctx, field, d.portals)?;
         let mut sky = Self::new(
             *frame,
@@ -467,14 +329,235 @@ impl SkyLight {
             rho,
             portals,
         );
-        sky.model = match d.model {
-            SkyModelDesc::CieGeneral(k) => format!("CieGeneral({k})"),
-            SkyModelDesc::CieOvercast => "CieOvercast".into(),
-            SkyModelDesc::Uniform => "Uniform".into(),
-            SkyModelDesc::CieClear => "CieClear".into(),
-            SkyModelDesc::Perez { .. } | SkyModelDesc::PerezIrradiance { .. } => "Perez".into(),
-        };
+        sky.model = model_name(d.model);
         Ok((sky, perez_sun))
+    }
+}
+
+/// The sun's placement and its direction (site frame), when the sky has a sun.
+type SunPlace = Option<(SunPlacement, DVec3)>;
+
+/// Where the sun of `SkyDesc::sun` (`field.sun`) is: its placement and its direction in the
+/// site frame.
+fn locate_sun(
+    ctx: &Context,
+    sun_field: &str,
+    s: &crate::description::schema::SunDesc,
+) -> Result<(SunPlacement, DVec3), SceneError> {
+    let p = super::sun::place_sun(ctx, sun_field, s)?;
+    let (alt, az) = (p.altitude_deg.to_radians(), p.azimuth_deg.to_radians());
+    let local = DVec3::new(alt.cos() * az.sin(), alt.cos() * az.cos(), alt.sin());
+    Ok((p, local))
+}
+
+/// The error of a sky (`what`) that depends on the sun given without one.
+fn need_sun(ctx: &Context, field: &str, what: &str) -> SceneError {
+    ctx.err(
+        format!("{field}.sun"),
+        format!("{what} depends on where the sun is: give `sun: (altitude_deg: …, azimuth_deg: …)` or a place and time"),
+    )
+}
+
+/// A Perez sky from its direct-normal and diffuse-horizontal amounts and dew point
+/// (`given`, by illuminance in lx as `gendaylit -L`, or by irradiance in W/m² as
+/// `gendaylit -W`): its distribution, its diffuse horizontal illuminance (lx) and its sun's
+/// disk (with direct light, unless `sun_disk: false`).
+fn perez_sky(
+    ctx: &Context,
+    field: &str,
+    d: &SkyDesc,
+    frame: &SiteFrame,
+    sun_place: SunPlace,
+    given: (f64, f64, Option<f64>),
+) -> Result<(SkyDistribution, Option<f64>, Option<SunLight>), SceneError> {
+    let mfield = format!("{field}.model");
+    let afield = format!("{field}.amount");
+    let (direct, diffuse, dew_point_c) = given;
+    let by_irradiance = matches!(d.model, SkyModelDesc::PerezIrradiance { .. });
+    let (dfield, hfield) = if by_irradiance {
+        ("direct_normal_w_m2", "diffuse_horizontal_w_m2")
+    } else {
+        ("direct_normal_lx", "diffuse_horizontal_lx")
+    };
+    let direct = ctx.nonneg(&format!("{mfield}.{dfield}"), direct)?;
+    let diffuse = ctx.nonneg(&format!("{mfield}.{hfield}"), diffuse)?;
+    let dew = match dew_point_c {
+        Some(t) => ctx.finite(&format!("{mfield}.dew_point_c"), t)?,
+        None => DEFAULT_DEW_POINT_C,
+    };
+    let Some((p, s)) = sun_place else {
+        return Err(need_sun(ctx, field, "the Perez sky"));
+    };
+    if d.amount.is_some() {
+        return Err(ctx.err(
+            &afield,
+            format!("a Perez sky's amount is its {hfield}; remove `amount`"),
+        ));
+    }
+    // A sun below the horizon (its direct light then absent) shapes the sky from the
+    // horizon, as in gendaymtx and `candela annual`.
+    let zenith = s.z.clamp(-1.0, 1.0).acos().min(std::f64::consts::FRAC_PI_2);
+    let (cond, dn, dh) = if by_irradiance {
+        SkyCondition::illuminance_from_irradiance(diffuse, direct, zenith, p.eccentricity, dew)
+    } else {
+        SkyCondition::from_illuminance(diffuse, direct, zenith, p.eccentricity, dew)
+            .map(|(cond, _)| (cond, direct, diffuse))
+    }
+    .map_err(|e| ctx.err(&mfield, e.to_string()))?;
+
+    let mut perez_sun = None;
+    if dn > 0.0 && d.sun_disk.unwrap_or(true) {
+        let d50 = SpectrumDesc::Named("D50".into());
+        let radiance = ctx.emission(
+            &format!("{field}.sun"),
+            &format!("{mfield}.{dfield}"),
+            &d50,
+            SunLight::luminance_for(dn),
+        )?;
+        perez_sun = Some(SunLight::new(frame.to_world(s).as_vec3(), radiance, dn));
+    }
+    Ok((
+        SkyDistribution::Perez(PerezSky::new(cond)),
+        Some(dh),
+        perez_sun,
+    ))
+}
+
+/// The CIE distribution of `model` (not a Perez sky), checked to have the sun above the
+/// horizon when it depends on it.
+fn cie_sky(
+    ctx: &Context,
+    field: &str,
+    model: &SkyModelDesc,
+    sun_place: SunPlace,
+) -> Result<SkyDistribution, SceneError> {
+    let mfield = format!("{field}.model");
+    let cie = match model {
+        SkyModelDesc::CieGeneral(k) => CieSky::general(*k).ok_or_else(|| {
+            ctx.err(
+                &mfield,
+                format!("CIE general sky {k}: the standard defines types 1 to 15"),
+            )
+        })?,
+        SkyModelDesc::CieOvercast => CieSky::Overcast,
+        SkyModelDesc::Uniform => CieSky::Uniform,
+        SkyModelDesc::CieClear => CieSky::Clear,
+        SkyModelDesc::Perez { .. } | SkyModelDesc::PerezIrradiance { .. } => {
+            unreachable!("handled by perez_sky")
+        }
+    };
+    if cie.needs_sun() {
+        match sun_place {
+            None => return Err(need_sun(ctx, field, "this sky")),
+            Some((p, _)) if p.altitude_deg < 0.0 => {
+                return Err(ctx.err(
+                    format!("{field}.sun"),
+                    format!(
+                        "the sun is {:.2}° below the horizon: the CIE skies that depend on it are defined for a sun above it",
+                        -p.altitude_deg
+                    ),
+                ))
+            }
+            _ => {}
+        }
+    }
+    Ok(SkyDistribution::Cie(cie))
+}
+
+/// The direction toward the sun (site frame) the distribution is drawn for. It only shapes
+/// sun-dependent skies; any will do for the others.
+fn reference_sun(sun_local: Option<DVec3>, distribution: &SkyDistribution) -> DVec3 {
+    match (sun_local, distribution) {
+        (Some(s), SkyDistribution::Perez(_)) if s.z < 0.0 => DVec3::new(s.x, s.y, 0.0)
+            .try_normalize()
+            .unwrap_or(DVec3::X),
+        (Some(s), _) => s,
+        (None, _) => DVec3::Z,
+    }
+}
+
+/// k, the luminance (cd/m²) of relative luminance 1: from the sky's own horizontal
+/// illuminance `sky_lx` (a Perez sky) or from its `amount` (`afield`); `integral` is
+/// ∫ r cos Z dω of `distribution` with the sun toward `sun`.
+fn luminance_scale(
+    ctx: &Context,
+    afield: &str,
+    amount: Option<Amount>,
+    sky_lx: Option<f64>,
+    distribution: &SkyDistribution,
+    sun: DVec3,
+    integral: f64,
+) -> Result<f64, SceneError> {
+    Ok(match (amount, sky_lx) {
+        (None, Some(lx)) => lx / integral,
+        (Some(Amount::HorizontalIlluminance(e)), None) => ctx.nonneg(afield, e)? / integral,
+        (Some(Amount::ZenithLuminance(l)), None) => {
+            ctx.nonneg(afield, l)? / distribution.relative(DVec3::Z, sun)
+        }
+        (Some(a), _) => {
+            return Err(super::wrong_amount(
+                ctx,
+                afield,
+                &a,
+                "HorizontalIlluminance(lx) or ZenithLuminance(cd/m²)",
+            ))
+        }
+        (None, None) => {
+            return Err(ctx.err(
+                afield,
+                "missing: give HorizontalIlluminance(lx) or ZenithLuminance(cd/m²)",
+            ))
+        }
+    })
+}
+
+/// The ground's reflectance (`field.ground_reflectance`), checked to be within 0–1.
+fn ground_reflectance(ctx: &Context, field: &str, given: Option<f64>) -> Result<f64, SceneError> {
+    match given {
+        Some(r) => {
+            let gfield = format!("{field}.ground_reflectance");
+            let r = ctx.nonneg(&gfield, r)?;
+            if r > 1.0 {
+                return Err(ctx.err(gfield, format!("{r} is more than 1")));
+            }
+            Ok(r)
+        }
+        None => Ok(DEFAULT_GROUND_REFLECTANCE),
+    }
+}
+
+/// The ground's radiance (W·m⁻²·sr⁻¹·nm⁻¹): it reflects the sky's horizontal irradiance
+/// (`radiance` × `integral`) and the suns' (`lit_by`: the scene's `Sun` lights' and the
+/// Perez sky's disk), L = ρ E_h / π.
+fn ground_radiance(
+    radiance: &DenseSpectrum,
+    integral: f64,
+    lit_by: (&DenseSpectrum, Option<&SunLight>),
+    frame: &SiteFrame,
+    rho: f64,
+) -> DenseSpectrum {
+    let (suns_horizontal, perez_sun) = lit_by;
+    let mut e_h = radiance.scaled(integral as f32);
+    let mut add = |s: &DenseSpectrum| {
+        for (a, b) in e_h.values.iter_mut().zip(s.values.iter()) {
+            *a += *b;
+        }
+    };
+    add(suns_horizontal);
+    if let Some(s) = perez_sun {
+        add(&s.horizontal_irradiance(frame));
+    }
+    e_h.scaled((rho / std::f64::consts::PI) as f32)
+}
+
+/// The model as the scene names it, for reports.
+fn model_name(model: &SkyModelDesc) -> String {
+    match model {
+        SkyModelDesc::CieGeneral(k) => format!("CieGeneral({k})"),
+        SkyModelDesc::CieOvercast => "CieOvercast".into(),
+        SkyModelDesc::Uniform => "Uniform".into(),
+        SkyModelDesc::CieClear => "CieClear".into(),
+        SkyModelDesc::Perez { .. } | SkyModelDesc::PerezIrradiance { .. } => "Perez".into(),
     }
 }
 
