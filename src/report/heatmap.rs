@@ -230,13 +230,45 @@ fn render_heatmap(
         None => stats_si.in_units(units),
     };
 
-    let (nx, ny) = (grid.nx, grid.ny);
-    let cell = cell_px(nx, ny);
-    let value_px = (cell as f32 * 0.30).min(16.0);
+    let title_lines = title_lines(grid, metric, &stats, unit, units);
+    let subtitle = describe_scale(&cs, unit);
+    let (layout, legend) = Layout::new(grid, units, &title_lines, &subtitle, &cs, unit, &shown)?;
+    let mut img = RgbImage::from_pixel(layout.width, layout.height, WHITE);
+    draw_title(&mut img, &title_lines, &subtitle);
+    draw_cells(&mut img, &layout, grid, &shown, &cs);
+    draw_axes(&mut img, &layout, grid, units);
+    legend.draw(
+        &mut img,
+        (layout.gx + layout.gw + 24) as i32,
+        layout.gy as i32,
+    );
 
+    let info = HeatmapInfo {
+        stats_si,
+        stats,
+        unit: unit.to_string(),
+        title_lines,
+        scale: cs,
+        cell_px: layout.cell,
+        grid_origin: (layout.gx, layout.gy),
+        image_size: (layout.width, layout.height),
+    };
+    Ok((img, info))
+}
+
+/// The title: the grid's name and quantity, its statistics, and its size (with the largest
+/// standard error if known).
+fn title_lines(
+    grid: &GridValues,
+    metric: Option<&GridMetric>,
+    stats: &GridStats,
+    unit: &str,
+    units: UnitSystem,
+) -> Vec<String> {
+    let (nx, ny) = (grid.nx, grid.ny);
     let ratio = |r: Option<f64>| r.map_or("–".to_string(), |r| format!("{r:.2}"));
     let name = printable(&grid.name, MAX_GRID_NAME_CHARS);
-    let title_lines = vec![
+    vec![
         match metric {
             Some(m) => format!("{name} — {} ({unit})", m.name),
             None => format!("{name} — illuminance ({unit})"),
@@ -269,53 +301,92 @@ fn render_heatmap(
             }
             s
         },
-    ];
-    let subtitle = describe_scale(&cs, unit);
+    ]
+}
 
+/// Where the parts of a heat map go, pixels: the cells' rectangle (top-left `gx`, `gy`, size
+/// `gw` × `gh`, cells of side `cell`) and the whole image.
+struct Layout {
+    cell: u32,
+    gx: u32,
+    gy: u32,
+    gw: u32,
+    gh: u32,
+    width: u32,
+    height: u32,
+}
+
+impl Layout {
+    /// Lays the heat map out around its title, cells and legend (returned with it), and
+    /// refuses an image past [`MAX_HEATMAP_PIXELS`] or the memory available.
+    fn new<'a>(
+        grid: &GridValues,
+        units: UnitSystem,
+        title_lines: &[String],
+        subtitle: &str,
+        cs: &'a ColourScale,
+        unit: &'a str,
+        shown: &[f64],
+    ) -> Result<(Layout, Legend<'a>), String> {
+        let cell = cell_px(grid.nx, grid.ny);
+        let lh_title = draw::line_height(TITLE_PX);
+        let lh = draw::line_height(LABEL_PX);
+        let header_h = PAD + lh_title + 4 + (lh + 2) * 3 + 12 + lh + 6;
+        let axis_label_w = [0.0, grid.size_m.1 / 2.0, grid.size_m.1]
+            .iter()
+            .map(|&m| draw::text_width(LABEL_PX, &format_sig(units.length_from_m(m), 3)))
+            .max()
+            .unwrap_or(0)
+            .max(draw::text_width(LABEL_PX, "v (m)"));
+        let (gw, gh) = (grid.nx as u32 * cell, grid.ny as u32 * cell);
+        let gx = PAD + axis_label_w + 10;
+        let gy = header_h;
+        let clipped = (
+            shown.iter().any(|&v| v < cs.min),
+            shown.iter().any(|&v| v > cs.max),
+        );
+        let legend = Legend::new(cs, unit, None, clipped, gh.max(260));
+        let footer_h = 8 + lh * 2 + PAD;
+        let body_h = gh.max(legend.height);
+        let mut width = gx + gw + 24 + legend.width + PAD;
+        for (t, px) in title_lines
+            .iter()
+            .map(|t| (t.as_str(), LABEL_PX))
+            .chain([(subtitle, LABEL_PX)])
+        {
+            width = width.max(2 * PAD + draw::text_width(px, t));
+        }
+        width = width.max(2 * PAD + draw::text_width(TITLE_PX, &title_lines[0]));
+        let height = header_h + body_h + footer_h;
+        if width as u64 * height as u64 > MAX_HEATMAP_PIXELS {
+            return Err(format!(
+                "the heat map of grid {:?} would be {width}×{height} pixels, more than the limit of {MAX_HEATMAP_PIXELS} pixels",
+                printable(&grid.name, 40)
+            ));
+        }
+        check_memory(
+            width as u64 * height as u64 * 3,
+            &format!("the heat map of grid {:?}", printable(&grid.name, 40)),
+        )?;
+        let layout = Layout {
+            cell,
+            gx,
+            gy,
+            gw,
+            gh,
+            width,
+            height,
+        };
+        Ok((layout, legend))
+    }
+}
+
+/// The title block: the title lines, then the colour scale's description in grey.
+fn draw_title(img: &mut RgbImage, title_lines: &[String], subtitle: &str) {
     let lh_title = draw::line_height(TITLE_PX);
     let lh = draw::line_height(LABEL_PX);
-    let header_h = PAD + lh_title + 4 + (lh + 2) * 3 + 12 + lh + 6;
-    let axis_label_w = [0.0, grid.size_m.1 / 2.0, grid.size_m.1]
-        .iter()
-        .map(|&m| draw::text_width(LABEL_PX, &format_sig(units.length_from_m(m), 3)))
-        .max()
-        .unwrap_or(0)
-        .max(draw::text_width(LABEL_PX, "v (m)"));
-    let (gw, gh) = (nx as u32 * cell, ny as u32 * cell);
-    let gx = PAD + axis_label_w + 10;
-    let gy = header_h;
-    let clipped = (
-        shown.iter().any(|&v| v < cs.min),
-        shown.iter().any(|&v| v > cs.max),
-    );
-    let legend = Legend::new(&cs, unit, None, clipped, gh.max(260));
-    let footer_h = 8 + lh * 2 + PAD;
-    let body_h = gh.max(legend.height);
-    let mut width = gx + gw + 24 + legend.width + PAD;
-    for (t, px) in title_lines
-        .iter()
-        .map(|t| (t, LABEL_PX))
-        .chain([(&subtitle, LABEL_PX)])
-    {
-        width = width.max(2 * PAD + draw::text_width(px, t));
-    }
-    width = width.max(2 * PAD + draw::text_width(TITLE_PX, &title_lines[0]));
-    let height = header_h + body_h + footer_h;
-    if width as u64 * height as u64 > MAX_HEATMAP_PIXELS {
-        return Err(format!(
-            "the heat map of grid {:?} would be {width}×{height} pixels, more than the limit of {MAX_HEATMAP_PIXELS} pixels",
-            printable(&grid.name, 40)
-        ));
-    }
-    check_memory(
-        width as u64 * height as u64 * 3,
-        &format!("the heat map of grid {:?}", printable(&grid.name, 40)),
-    )?;
-    let mut img = RgbImage::from_pixel(width, height, WHITE);
-
-    // Title block.
     draw::draw_text(
-        &mut img,
+        img,
         PAD as i32,
         PAD as i32,
         TITLE_PX,
@@ -324,14 +395,30 @@ fn render_heatmap(
     );
     let mut y = PAD + lh_title + 4;
     for line in &title_lines[1..] {
-        draw::draw_text(&mut img, PAD as i32, y as i32, LABEL_PX, line, BLACK);
+        draw::draw_text(img, PAD as i32, y as i32, LABEL_PX, line, BLACK);
         y += lh + 2;
     }
-    draw::draw_text(
-        &mut img, PAD as i32, y as i32, LABEL_PX, &subtitle, DARK_GREY,
-    );
+    draw::draw_text(img, PAD as i32, y as i32, LABEL_PX, subtitle, DARK_GREY);
+}
 
-    // Cells, row 0 at the bottom.
+/// The cells, row 0 at the bottom, each with its value if it fits, and a frame around them.
+fn draw_cells(
+    img: &mut RgbImage,
+    layout: &Layout,
+    grid: &GridValues,
+    shown: &[f64],
+    cs: &ColourScale,
+) {
+    let Layout {
+        cell,
+        gx,
+        gy,
+        gw,
+        gh,
+        ..
+    } = *layout;
+    let (nx, ny) = (grid.nx, grid.ny);
+    let value_px = (cell as f32 * 0.30).min(16.0);
     let separator = Rgb([255, 255, 255]);
     for j in 0..ny {
         for i in 0..nx {
@@ -339,10 +426,10 @@ fn render_heatmap(
             let c = Rgb(cs.colour(v));
             let x0 = (gx + i as u32 * cell) as i32;
             let y0 = (gy + (ny - 1 - j) as u32 * cell) as i32;
-            draw::fill_rect(&mut img, x0, y0, cell, cell, c);
+            draw::fill_rect(img, x0, y0, cell, cell, c);
             // Small cells (large grids) would be all separator.
             if cell >= 8 {
-                draw::stroke_rect(&mut img, x0, y0, cell, cell, separator);
+                draw::stroke_rect(img, x0, y0, cell, cell, separator);
             }
             if value_px <= 7.0 {
                 continue; // no room for the value in the cells of a large grid
@@ -354,7 +441,7 @@ fn render_heatmap(
             }
             if px > 7.0 {
                 draw::draw_text_centred(
-                    &mut img,
+                    img,
                     x0 + cell as i32 / 2,
                     y0 + cell as i32 / 2,
                     px,
@@ -364,33 +451,30 @@ fn render_heatmap(
             }
         }
     }
-    draw::stroke_rect(
-        &mut img,
-        gx as i32 - 1,
-        gy as i32 - 1,
-        gw + 2,
-        gh + 2,
-        DARK_GREY,
-    );
+    draw::stroke_rect(img, gx as i32 - 1, gy as i32 - 1, gw + 2, gh + 2, DARK_GREY);
+}
 
-    // Axes: ticks at 0, half and full extent.
+/// The axes: ticks at 0, half and full extent of each edge, and the axis labels.
+fn draw_axes(img: &mut RgbImage, layout: &Layout, grid: &GridValues, units: UnitSystem) {
+    let Layout { gx, gy, gw, gh, .. } = *layout;
+    let lh = draw::line_height(LABEL_PX);
     let len = units.length_symbol();
     for f in [0.0, 0.5, 1.0] {
         let tx = gx as f32 + f * gw as f32;
         let by = (gy + gh + 1) as f32;
-        draw::draw_line(&mut img, tx, by, tx, by + 4.0, BLACK);
+        draw::draw_line(img, tx, by, tx, by + 4.0, BLACK);
         let label = format_sig(units.length_from_m(f as f64 * grid.size_m.0), 3);
         let w = draw::text_width(LABEL_PX, &label) as f32;
         let lx = (tx - w / 2.0).max(gx as f32 - 4.0);
-        draw::draw_text(&mut img, lx as i32, by as i32 + 5, LABEL_PX, &label, BLACK);
+        draw::draw_text(img, lx as i32, by as i32 + 5, LABEL_PX, &label, BLACK);
 
         let ty = (gy + gh) as f32 - f * gh as f32;
         let ax = gx as f32 - 2.0;
-        draw::draw_line(&mut img, ax - 4.0, ty, ax, ty, BLACK);
+        draw::draw_line(img, ax - 4.0, ty, ax, ty, BLACK);
         let label = format_sig(units.length_from_m(f as f64 * grid.size_m.1), 3);
         let w = draw::text_width(LABEL_PX, &label) as i32;
         draw::draw_text(
-            &mut img,
+            img,
             ax as i32 - 6 - w,
             ty as i32 - lh as i32 / 2,
             LABEL_PX,
@@ -400,7 +484,7 @@ fn render_heatmap(
     }
     let xlabel = format!("u ({len}) along edge_u, row 0 at the bottom");
     draw::draw_text(
-        &mut img,
+        img,
         gx as i32,
         (gy + gh + 6 + lh) as i32,
         LABEL_PX,
@@ -409,27 +493,13 @@ fn render_heatmap(
     );
     let ylabel = format!("v ({len}) along edge_v");
     draw::draw_text(
-        &mut img,
+        img,
         PAD as i32,
         gy as i32 - lh as i32 - 4,
         LABEL_PX,
         &ylabel,
         DARK_GREY,
     );
-
-    legend.draw(&mut img, (gx + gw + 24) as i32, gy as i32);
-
-    let info = HeatmapInfo {
-        stats_si,
-        stats,
-        unit: unit.to_string(),
-        title_lines,
-        scale: cs,
-        cell_px: cell,
-        grid_origin: (gx, gy),
-        image_size: (width, height),
-    };
-    Ok((img, info))
 }
 
 /// Writes the heat map of `grid` to `path` (PNG, atomically). `settings.quantity` and

@@ -4,8 +4,8 @@
 use crate::meter::{grid_non_finite, grid_stats, Estimate, Measurements};
 use crate::output::{write_atomic, OutputError};
 use crate::render::RenderResult;
-use crate::world::MeterKind;
 use crate::world::World;
+use crate::world::{Grid, Meter, MeterKind};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -132,121 +132,13 @@ pub fn report_json(r: &ReportInput) -> Value {
         .meters
         .iter()
         .zip(&r.measurements.meters)
-        .map(|(m, e)| match &m.kind {
-            MeterKind::Illuminance { position, normal } => {
-                let mut v = estimate(e, ke);
-                v["name"] = json!(m.name);
-                v["kind"] = json!("illuminance");
-                v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
-                v["position"] = v3(*position);
-                v["normal"] = v3(*normal);
-                if let Some(k) = kdf {
-                    v["daylight_factor_percent"] = estimate(e, k);
-                }
-                v
-            }
-            MeterKind::Luminance {
-                position,
-                direction,
-                half_angle_rad,
-            } => {
-                let mut v = estimate(e, kl);
-                v["name"] = json!(m.name);
-                v["kind"] = json!("luminance");
-                v["unit"] = json!(r.units.symbol(Quantity::Luminance));
-                v["position"] = v3(*position);
-                v["direction"] = v3(*direction);
-                v["half_angle_deg"] = json!(half_angle_rad.to_degrees());
-                v
-            }
-            MeterKind::Ugr {
-                position,
-                direction,
-                up,
-            } => {
-                // The estimate is the vertical illuminance at the eye; UGR is unitless.
-                let mut v = estimate(e, ke);
-                v["name"] = json!(m.name);
-                v["kind"] = json!("ugr");
-                v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
-                v["position"] = v3(*position);
-                v["direction"] = v3(*direction);
-                v["up"] = v3(*up);
-                v["ugr"] = json!(m.ugr(w, e));
-                v
-            }
-            MeterKind::Melanopic {
-                position,
-                direction,
-            } => {
-                // The estimate is the vertical illuminance at the eye.
-                let mut v = estimate(e, ke);
-                v["name"] = json!(m.name);
-                v["kind"] = json!("melanopic");
-                v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
-                v["position"] = v3(*position);
-                v["direction"] = v3(*direction);
-                let k = w.meters.iter().position(|x| std::ptr::eq(x, m));
-                let mel = k.and_then(|k| r.measurements.melanopic.get(k).copied().flatten());
-                v["melanopic"] = match mel {
-                    Some(me) => json!({
-                        "illuminance": estimate(&me.illuminance_lx, ke),
-                        "m_edi": estimate(&me.m_edi_lx, ke),
-                        "m_edi_over_illuminance": {
-                            "value": me.ratio,
-                            "stderr": me.ratio_stderr,
-                            "ci95_half_width": crate::meter::t95(crate::meter::BATCHES - 1) * me.ratio_stderr,
-                        },
-                        "equivalent_melanopic_lux": crate::colour::alpha_opic::equivalent_melanopic_lux(me.m_edi_lx.mean) * ke,
-                    }),
-                    None => Value::Null,
-                };
-                v
-            }
-        })
+        .map(|(m, e)| meter_json(r, m, e, ke, kl, kdf))
         .collect();
     let grids: Vec<Value> = w
         .grids
         .iter()
         .zip(&r.measurements.grids)
-        .map(|(g, est)| {
-            let s = grid_stats(est);
-            let df = kdf.map(|k| {
-                json!({
-                    "values": (0..g.ny as usize)
-                        .map(|j| (0..g.nx as usize).map(|i| est[j * g.nx as usize + i].mean * k).collect::<Vec<_>>())
-                        .collect::<Vec<_>>(),
-                    "stderr": (0..g.ny as usize)
-                        .map(|j| (0..g.nx as usize).map(|i| est[j * g.nx as usize + i].stderr * k).collect::<Vec<_>>())
-                        .collect::<Vec<_>>(),
-                    "DF_min": s.min * k, "DF_avg": s.avg * k, "DF_max": s.max * k,
-                })
-            });
-            let rows = |f: &dyn Fn(&Estimate) -> Value| -> Value {
-                (0..g.ny as usize)
-                    .map(|j| {
-                        (0..g.nx as usize)
-                            .map(|i| f(&est[j * g.nx as usize + i]))
-                            .collect::<Vec<_>>()
-                    })
-                    .collect::<Vec<_>>()
-                    .into()
-            };
-            json!({
-                "name": g.name,
-                "unit": r.units.symbol(Quantity::Illuminance),
-                "nx": g.nx, "ny": g.ny,
-                "origin": v3(g.origin), "edge_u": v3(g.edge_u), "edge_v": v3(g.edge_v), "normal": v3(g.normal),
-                "values": rows(&|e| json!(e.mean * ke)),
-                "stderr": rows(&|e| json!(e.stderr * ke)),
-                "samples": rows(&|e| json!(e.samples)),
-                "batches": crate::meter::BATCHES,
-                "non_finite_samples": grid_non_finite(est),
-                "E_min": s.min * ke, "E_avg": s.avg * ke, "E_max": s.max * ke,
-                "U0": s.u0, "E_min_over_E_max": s.min_over_max,
-                "daylight_factor_percent": df,
-            })
-        })
+        .map(|(g, est)| grid_json(r, g, est, ke, kdf))
         .collect();
     let mut stats_all = r.render.stats;
     stats_all.merge(&r.measurements.stats);
@@ -293,6 +185,136 @@ pub fn report_json(r: &ReportInput) -> Value {
         "outputs": r.outputs,
         "progressive": r.progressive,
         "warnings": warnings(w, r.render, r.measurements),
+    })
+}
+
+/// One meter's entry: its estimate `e` in display units (`ke` per lx, `kl` per cd/m²), where
+/// it is and what its kind adds (daylight factor at `kdf` % per lx, UGR, melanopic values).
+fn meter_json(
+    r: &ReportInput,
+    m: &Meter,
+    e: &Estimate,
+    ke: f64,
+    kl: f64,
+    kdf: Option<f64>,
+) -> Value {
+    match &m.kind {
+        MeterKind::Illuminance { position, normal } => {
+            let mut v = estimate(e, ke);
+            v["name"] = json!(m.name);
+            v["kind"] = json!("illuminance");
+            v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
+            v["position"] = v3(*position);
+            v["normal"] = v3(*normal);
+            if let Some(k) = kdf {
+                v["daylight_factor_percent"] = estimate(e, k);
+            }
+            v
+        }
+        MeterKind::Luminance {
+            position,
+            direction,
+            half_angle_rad,
+        } => {
+            let mut v = estimate(e, kl);
+            v["name"] = json!(m.name);
+            v["kind"] = json!("luminance");
+            v["unit"] = json!(r.units.symbol(Quantity::Luminance));
+            v["position"] = v3(*position);
+            v["direction"] = v3(*direction);
+            v["half_angle_deg"] = json!(half_angle_rad.to_degrees());
+            v
+        }
+        MeterKind::Ugr {
+            position,
+            direction,
+            up,
+        } => {
+            // The estimate is the vertical illuminance at the eye; UGR is unitless.
+            let mut v = estimate(e, ke);
+            v["name"] = json!(m.name);
+            v["kind"] = json!("ugr");
+            v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
+            v["position"] = v3(*position);
+            v["direction"] = v3(*direction);
+            v["up"] = v3(*up);
+            v["ugr"] = json!(m.ugr(r.world, e));
+            v
+        }
+        MeterKind::Melanopic {
+            position,
+            direction,
+        } => {
+            // The estimate is the vertical illuminance at the eye.
+            let mut v = estimate(e, ke);
+            v["name"] = json!(m.name);
+            v["kind"] = json!("melanopic");
+            v["unit"] = json!(r.units.symbol(Quantity::Illuminance));
+            v["position"] = v3(*position);
+            v["direction"] = v3(*direction);
+            v["melanopic"] = melanopic_json(r, m, ke);
+            v
+        }
+    }
+}
+
+/// The melanopic quantities of meter `m` (one of the world's), illuminances `ke` per lx.
+fn melanopic_json(r: &ReportInput, m: &Meter, ke: f64) -> Value {
+    let k = r.world.meters.iter().position(|x| std::ptr::eq(x, m));
+    let mel = k.and_then(|k| r.measurements.melanopic.get(k).copied().flatten());
+    match mel {
+        Some(me) => json!({
+            "illuminance": estimate(&me.illuminance_lx, ke),
+            "m_edi": estimate(&me.m_edi_lx, ke),
+            "m_edi_over_illuminance": {
+                "value": me.ratio,
+                "stderr": me.ratio_stderr,
+                "ci95_half_width": crate::meter::t95(crate::meter::BATCHES - 1) * me.ratio_stderr,
+            },
+            "equivalent_melanopic_lux": crate::colour::alpha_opic::equivalent_melanopic_lux(me.m_edi_lx.mean) * ke,
+        }),
+        None => Value::Null,
+    }
+}
+
+/// One grid's entry: where it is, its values by row (`ke` per lx), statistics, and its
+/// daylight factors (`kdf` % per lx) under a daylight sky.
+fn grid_json(r: &ReportInput, g: &Grid, est: &[Estimate], ke: f64, kdf: Option<f64>) -> Value {
+    let s = grid_stats(est);
+    let df = kdf.map(|k| {
+        json!({
+            "values": (0..g.ny as usize)
+                .map(|j| (0..g.nx as usize).map(|i| est[j * g.nx as usize + i].mean * k).collect::<Vec<_>>())
+                .collect::<Vec<_>>(),
+            "stderr": (0..g.ny as usize)
+                .map(|j| (0..g.nx as usize).map(|i| est[j * g.nx as usize + i].stderr * k).collect::<Vec<_>>())
+                .collect::<Vec<_>>(),
+            "DF_min": s.min * k, "DF_avg": s.avg * k, "DF_max": s.max * k,
+        })
+    });
+    let rows = |f: &dyn Fn(&Estimate) -> Value| -> Value {
+        (0..g.ny as usize)
+            .map(|j| {
+                (0..g.nx as usize)
+                    .map(|i| f(&est[j * g.nx as usize + i]))
+                    .collect::<Vec<_>>()
+            })
+            .collect::<Vec<_>>()
+            .into()
+    };
+    json!({
+        "name": g.name,
+        "unit": r.units.symbol(Quantity::Illuminance),
+        "nx": g.nx, "ny": g.ny,
+        "origin": v3(g.origin), "edge_u": v3(g.edge_u), "edge_v": v3(g.edge_v), "normal": v3(g.normal),
+        "values": rows(&|e| json!(e.mean * ke)),
+        "stderr": rows(&|e| json!(e.stderr * ke)),
+        "samples": rows(&|e| json!(e.samples)),
+        "batches": crate::meter::BATCHES,
+        "non_finite_samples": grid_non_finite(est),
+        "E_min": s.min * ke, "E_avg": s.avg * ke, "E_max": s.max * ke,
+        "U0": s.u0, "E_min_over_E_max": s.min_over_max,
+        "daylight_factor_percent": df,
     })
 }
 

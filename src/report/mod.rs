@@ -1,6 +1,7 @@
-//! Photometric reports (issue 5): the JSON report and grid CSVs, false-colour maps, grid heat
-//! maps, the pixel probe and the self-contained HTML report. See `docs/report-json.md`,
-//! `docs/reports.md` and `docs/report-html.md`.
+//! Photometric reports: what a run's images and calculation grids show, in forms a reader checks
+//! — the JSON report and grid CSVs, false-colour maps, grid heat maps, the pixel probe and the
+//! self-contained HTML report. See `docs/report-json.md`, `docs/reports.md` and
+//! `docs/report-html.md`.
 
 pub mod falsecolour;
 pub mod heatmap;

@@ -111,6 +111,54 @@ pub fn probe(
     radius: Option<f64>,
     units: UnitSystem,
 ) -> Result<ProbeResult, String> {
+    let (lum, x, y) = check_request(layers, x, y, radius)?;
+    let idx = probed_pixels(layers.width, layers.height, x, y, radius)?;
+    let samples = Samples::of(layers);
+    let lq = Quantity::Luminance;
+    let y_se = layers.channel(CHANNEL_Y_STDERR);
+    let luminance = Estimate {
+        mean: units.from_si(lq, mean_of(lum, &idx)),
+        stderr: y_se
+            .filter(|_| !samples.too_few)
+            .map(|c| units.from_si(lq, se_of(c, &idx))),
+        t95: y_se.map_or(Z95, |c| samples.t95_of(c, &idx)),
+    };
+    let illuminance = probe_illuminance(layers, &idx, units, &samples);
+
+    let xyz_si = match (layers.channel(CHANNEL_X), layers.channel(CHANNEL_Z)) {
+        (Some(cx), Some(cz)) => Some([mean_of(cx, &idx), mean_of(lum, &idx), mean_of(cz, &idx)]),
+        _ => None,
+    };
+    let positive = xyz_si.filter(|v| v[1] > 0.0 && v.iter().all(|c| c.is_finite()));
+    let srgb_linear = positive.map(|v| xyz_to_linear_srgb(v.map(|c| c / v[1])));
+    let cct_duv = positive
+        .map(xyz_to_cct_ohno2013)
+        .filter(|c| c.iter().all(|v| v.is_finite()));
+    Ok(ProbeResult {
+        x,
+        y,
+        radius,
+        pixels: idx.len(),
+        units,
+        luminance,
+        illuminance,
+        xyz: xyz_si.map(|v| v.map(|c| units.from_si(lq, c))),
+        xy: xyz_si.map(xyz_to_xy),
+        upvp: xyz_si.map(xyz_to_upvp),
+        cct_duv,
+        srgb_linear,
+        srgb_encoded: srgb_linear.map(|v| v.map(srgb_encode)),
+    })
+}
+
+/// Refuses a probe of an inconsistent image, of one without luminance, of a pixel outside it
+/// or with a bad radius; returns the luminance channel and the pixel.
+fn check_request(
+    layers: &Layers,
+    x: i64,
+    y: i64,
+    radius: Option<f64>,
+) -> Result<(&[f32], usize, usize), String> {
     let (w, h) = (layers.width, layers.height);
     let channels = || {
         layers
@@ -143,7 +191,6 @@ pub fn probe(
             h as i64 - 1
         ));
     }
-    let (x, y) = (x as usize, y as usize);
     if let Some(r) = radius {
         if !r.is_finite() || r < 0.0 {
             return Err(format!(
@@ -151,9 +198,18 @@ pub fn probe(
             ));
         }
     }
+    Ok((lum, x as usize, y as usize))
+}
 
-    // The probed pixels: a radius beyond the image covers the image (and no more), and their
-    // indices must fit in memory.
+/// Indices of the probed pixels of a `w` × `h` image, row by row: a radius beyond the image
+/// covers the image (and no more), and the indices must fit in memory.
+fn probed_pixels(
+    w: usize,
+    h: usize,
+    x: usize,
+    y: usize,
+    radius: Option<f64>,
+) -> Result<Vec<usize>, String> {
     let mut idx = Vec::new();
     match radius {
         None => idx.push(y * w + x),
@@ -176,129 +232,128 @@ pub fn probe(
             }
         }
     }
-    let mean_of =
-        |c: &[f32], ids: &[usize]| ids.iter().map(|&i| c[i] as f64).sum::<f64>() / ids.len() as f64;
-    // SE of a mean of independent pixel means: √(Σ SEᵢ²) / n.
-    let se_of = |c: &[f32], ids: &[usize]| {
-        ids.iter()
-            .map(|&i| (c[i] as f64).powi(2))
-            .sum::<f64>()
-            .sqrt()
-            / ids.len() as f64
-    };
-    // With fewer than 2 samples per pixel a pixel's sample variance is undefined (the render
-    // writes 0 for it): its standard error is unknown, not zero. candela's EXRs carry their
-    // mean samples per pixel, and all pixels have the same count until the passes that
-    // already give every pixel 2 or more, so the mean decides.
-    let spp = layers
-        .attribute("spp")
-        .and_then(|v| v.trim().parse::<f64>().ok());
-    let too_few_samples = spp.is_some_and(|spp| spp < 2.0);
-    // A pixel's standard error comes from min(n, batches) independent batches of its n
-    // samples (the mean spp stands for n); images that do not state their batches get the
-    // normal quantile.
-    let batches = layers
-        .attribute(crate::film::STDERR_BATCHES_ATTRIBUTE)
-        .and_then(|v| v.trim().parse::<u32>().ok());
-    let dof = batches.map(|k| (spp.unwrap_or(k as f64).floor().clamp(1.0, k as f64) as u32) - 1);
-    let t95_of = |c: &[f32], ids: &[usize]| match dof {
-        None => Z95,
-        Some(0) => f64::INFINITY,
-        Some(d) => {
-            // Welch–Satterthwaite: ν = (Σ seᵢ²)² / Σ (seᵢ⁴ / dᵢ), at least one pixel's dof.
-            let (s2, s4) = ids.iter().fold((0.0, 0.0), |(a, b), &i| {
-                let v = (c[i] as f64).powi(2);
-                (a + v, b + v * v)
-            });
-            let nu = if s4 > 0.0 {
-                (s2 * s2 / s4 * d as f64).min(u32::MAX as f64 / 2.0) as u32
-            } else {
-                d
-            };
-            crate::sampling::t95(nu.max(d))
-        }
-    };
-    let lq = Quantity::Luminance;
-    let y_se = layers.channel(CHANNEL_Y_STDERR);
-    let luminance = Estimate {
-        mean: units.from_si(lq, mean_of(lum, &idx)),
-        stderr: y_se
-            .filter(|_| !too_few_samples)
-            .map(|c| units.from_si(lq, se_of(c, &idx))),
-        t95: y_se.map_or(Z95, |c| t95_of(c, &idx)),
-    };
+    Ok(idx)
+}
 
-    let eq = Quantity::Illuminance;
-    let illuminance = match layers.channel(CHANNEL_E) {
-        None => IlluminanceProbe::NoChannel,
-        Some(e) => {
-            let mask = layers.channel(CHANNEL_E_MASK);
-            let defined: Vec<usize> = idx
-                .iter()
-                .copied()
-                .filter(|&i| {
-                    let v = e[i];
-                    v.is_finite()
-                        && v != ILLUMINANCE_SENTINEL
-                        && v >= 0.0
-                        && mask.is_none_or(|m| m[i] > 0.0)
-                })
-                .collect();
-            let mask_mean = mask.map(|m| mean_of(m, &idx));
-            // A pixel's illuminance samples are its samples that saw a receiving surface,
-            // mask.E × spp of them: with fewer than 2 its E has no sample variance either.
-            // In an adaptive render pixels stop at different counts, so the mean spp can hide
-            // a pixel with 0 or 1 illuminance samples; its stderr.E is then 0 while only some
-            // of its samples saw a surface (0 < mask < 1), which a real estimate with a
-            // sample variance practically never gives.
-            let e_se = layers.channel(CHANNEL_E_STDERR);
-            let too_few_e = defined.iter().any(|&i| {
-                let m = mask.map_or(1.0, |m| m[i]);
-                spp.is_some_and(|spp| m as f64 * spp < 1.5)
-                    || (e_se.is_some_and(|se| se[i] == 0.0) && m > 0.0 && m < 1.0)
-            });
-            if defined.is_empty() {
-                IlluminanceProbe::Undefined { mask_mean }
-            } else {
-                IlluminanceProbe::Defined {
-                    estimate: Estimate {
-                        mean: units.from_si(eq, mean_of(e, &defined)),
-                        stderr: e_se
-                            .filter(|_| !too_few_samples && !too_few_e)
-                            .map(|c| units.from_si(eq, se_of(c, &defined))),
-                        t95: e_se.map_or(Z95, |c| t95_of(c, &defined)),
-                    },
-                    pixels: defined.len(),
-                    mask_mean,
-                }
+/// Mean of channel `c` over the pixels `ids`.
+fn mean_of(c: &[f32], ids: &[usize]) -> f64 {
+    ids.iter().map(|&i| c[i] as f64).sum::<f64>() / ids.len() as f64
+}
+
+/// SE of a mean of independent pixel means, from their standard errors `c`: √(Σ SEᵢ²) / n.
+fn se_of(c: &[f32], ids: &[usize]) -> f64 {
+    ids.iter()
+        .map(|&i| (c[i] as f64).powi(2))
+        .sum::<f64>()
+        .sqrt()
+        / ids.len() as f64
+}
+
+/// What the image says about the samples behind its standard errors.
+struct Samples {
+    /// Mean samples per pixel, if the image states it.
+    spp: Option<f64>,
+    /// Fewer than 2 samples a pixel: standard errors are unknown.
+    too_few: bool,
+    /// Degrees of freedom of one pixel's standard error, if the image states its batches.
+    dof: Option<u32>,
+}
+
+impl Samples {
+    fn of(layers: &Layers) -> Samples {
+        // With fewer than 2 samples per pixel a pixel's sample variance is undefined (the
+        // render writes 0 for it): its standard error is unknown, not zero. candela's EXRs
+        // carry their mean samples per pixel, and all pixels have the same count until the
+        // passes that already give every pixel 2 or more, so the mean decides.
+        let spp = layers
+            .attribute("spp")
+            .and_then(|v| v.trim().parse::<f64>().ok());
+        let too_few = spp.is_some_and(|spp| spp < 2.0);
+        // A pixel's standard error comes from min(n, batches) independent batches of its n
+        // samples (the mean spp stands for n); images that do not state their batches get the
+        // normal quantile.
+        let batches = layers
+            .attribute(crate::film::STDERR_BATCHES_ATTRIBUTE)
+            .and_then(|v| v.trim().parse::<u32>().ok());
+        let dof =
+            batches.map(|k| (spp.unwrap_or(k as f64).floor().clamp(1.0, k as f64) as u32) - 1);
+        Samples { spp, too_few, dof }
+    }
+
+    /// The 95 % interval's multiple of the standard error of the mean over `ids`, whose
+    /// standard errors are `c`.
+    fn t95_of(&self, c: &[f32], ids: &[usize]) -> f64 {
+        match self.dof {
+            None => Z95,
+            Some(0) => f64::INFINITY,
+            Some(d) => {
+                // Welch–Satterthwaite: ν = (Σ seᵢ²)² / Σ (seᵢ⁴ / dᵢ), at least one pixel's dof.
+                let (s2, s4) = ids.iter().fold((0.0, 0.0), |(a, b), &i| {
+                    let v = (c[i] as f64).powi(2);
+                    (a + v, b + v * v)
+                });
+                let nu = if s4 > 0.0 {
+                    (s2 * s2 / s4 * d as f64).min(u32::MAX as f64 / 2.0) as u32
+                } else {
+                    d
+                };
+                crate::sampling::t95(nu.max(d))
             }
         }
-    };
+    }
+}
 
-    let xyz_si = match (layers.channel(CHANNEL_X), layers.channel(CHANNEL_Z)) {
-        (Some(cx), Some(cz)) => Some([mean_of(cx, &idx), mean_of(lum, &idx), mean_of(cz, &idx)]),
-        _ => None,
+/// Illuminance over the probed pixels `idx` where it is defined.
+fn probe_illuminance(
+    layers: &Layers,
+    idx: &[usize],
+    units: UnitSystem,
+    samples: &Samples,
+) -> IlluminanceProbe {
+    let eq = Quantity::Illuminance;
+    let Some(e) = layers.channel(CHANNEL_E) else {
+        return IlluminanceProbe::NoChannel;
     };
-    let positive = xyz_si.filter(|v| v[1] > 0.0 && v.iter().all(|c| c.is_finite()));
-    let srgb_linear = positive.map(|v| xyz_to_linear_srgb(v.map(|c| c / v[1])));
-    let cct_duv = positive
-        .map(xyz_to_cct_ohno2013)
-        .filter(|c| c.iter().all(|v| v.is_finite()));
-    Ok(ProbeResult {
-        x,
-        y,
-        radius,
-        pixels: idx.len(),
-        units,
-        luminance,
-        illuminance,
-        xyz: xyz_si.map(|v| v.map(|c| units.from_si(lq, c))),
-        xy: xyz_si.map(xyz_to_xy),
-        upvp: xyz_si.map(xyz_to_upvp),
-        cct_duv,
-        srgb_linear,
-        srgb_encoded: srgb_linear.map(|v| v.map(srgb_encode)),
-    })
+    let mask = layers.channel(CHANNEL_E_MASK);
+    let defined: Vec<usize> = idx
+        .iter()
+        .copied()
+        .filter(|&i| {
+            let v = e[i];
+            v.is_finite()
+                && v != ILLUMINANCE_SENTINEL
+                && v >= 0.0
+                && mask.is_none_or(|m| m[i] > 0.0)
+        })
+        .collect();
+    let mask_mean = mask.map(|m| mean_of(m, idx));
+    // A pixel's illuminance samples are its samples that saw a receiving surface,
+    // mask.E × spp of them: with fewer than 2 its E has no sample variance either.
+    // In an adaptive render pixels stop at different counts, so the mean spp can hide
+    // a pixel with 0 or 1 illuminance samples; its stderr.E is then 0 while only some
+    // of its samples saw a surface (0 < mask < 1), which a real estimate with a
+    // sample variance practically never gives.
+    let e_se = layers.channel(CHANNEL_E_STDERR);
+    let too_few_e = defined.iter().any(|&i| {
+        let m = mask.map_or(1.0, |m| m[i]);
+        samples.spp.is_some_and(|spp| m as f64 * spp < 1.5)
+            || (e_se.is_some_and(|se| se[i] == 0.0) && m > 0.0 && m < 1.0)
+    });
+    if defined.is_empty() {
+        IlluminanceProbe::Undefined { mask_mean }
+    } else {
+        IlluminanceProbe::Defined {
+            estimate: Estimate {
+                mean: units.from_si(eq, mean_of(e, &defined)),
+                stderr: e_se
+                    .filter(|_| !samples.too_few && !too_few_e)
+                    .map(|c| units.from_si(eq, se_of(c, &defined))),
+                t95: e_se.map_or(Z95, |c| samples.t95_of(c, &defined)),
+            },
+            pixels: defined.len(),
+            mask_mean,
+        }
+    }
 }
 
 /// Reads `path` and probes it; every error names the file.
