@@ -399,6 +399,19 @@ fn bad_input_is_refused_with_a_message() {
             "--view-resolution",
         ),
         (
+            vec![
+                "annual",
+                s,
+                "--weather",
+                "w.epw",
+                "--view",
+                "--view-resolution",
+                "18446744073709551615",
+            ],
+            2,
+            "--view-resolution",
+        ),
+        (
             vec!["annual", s, "--weather", "w.epw", "--sky-samples", "0"],
             2,
             "--sky-samples",

@@ -437,14 +437,14 @@ fn view_camera_of(
     let Some(v) = settings.view else {
         return Ok(None);
     };
-    let camera = view_camera(&world.camera, v.resolution);
+    // Checked before the camera is sized from it (a huge value would overflow its pixel count).
     if !(8..=1024).contains(&v.resolution) {
         return Err(crate::job::invalid_option(format!(
             "--view-resolution {} must be 8 to 1024",
             v.resolution
         )));
     }
-    Ok(Some((camera, v)))
+    Ok(Some((view_camera(&world.camera, v.resolution), v)))
 }
 
 /// Checks, before the computation, that its coefficients and hourly values fit in memory
