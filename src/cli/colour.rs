@@ -12,10 +12,13 @@ use health::SpectrumOptions;
 
 use candela::colour::tables::Observer;
 
+use candela::colour::cri::Cri;
 use candela::colour::grid::{END_NM, START_NM};
 use candela::colour::sd::Interpolation;
 use candela::photometry::{Quantity, UNITS};
-use candela::report::spectrum::{resolve_source_with, spectrum_colorimetry};
+use candela::report::spectrum::{
+    resolve_source_with, spectrum_colorimetry, ObjectColour, SpectrumColorimetry, SpectrumSource,
+};
 
 fn observer_name(o: Observer) -> &'static str {
     match o {
@@ -53,6 +56,37 @@ pub fn spectrum_command_with(
     let src = resolve_source_with(source, opts.interpolation)?;
     let c = spectrum_colorimetry(&src, observer)?;
     let extras = health::extras(&src.table, src.reflectance, observer, opts)?;
+    let warnings = spectrum_warnings(source, &src, &extras, opts);
+    for w in &warnings {
+        eprintln!("warning: {}", candela::limits::printable(w, 4096));
+    }
+    if json {
+        return spectrum_json(source, &src, observer, &c, &extras, &warnings);
+    }
+    let mut out = String::new();
+    let mut line = |k: &str, v: String| out.push_str(&format!("{k:<34} {v}\n"));
+    colorimetry_text(&mut line, &src, observer, &c);
+    if let Some(cri) = &c.cri {
+        cri_text(&mut line, cri);
+    }
+    if let Some(o) = &c.object_under_d65 {
+        object_text(&mut line, o);
+    }
+    health::add_text(&mut line, &extras);
+    for n in &c.notes {
+        line("note", n.clone());
+    }
+    Ok(out)
+}
+
+/// The source's own warnings, and one when colour rendition is computed from samples coarser
+/// than 5 nm.
+fn spectrum_warnings(
+    source: &str,
+    src: &SpectrumSource,
+    extras: &health::Extras,
+    opts: &SpectrumOptions,
+) -> Vec<String> {
     let mut warnings = src.warnings.clone();
     if let (Some(step), true) = (src.coarse_nm, extras.has_rendition()) {
         // colour-science refuses such data; interpolated to 1 nm it computes them, as here.
@@ -66,57 +100,66 @@ pub fn spectrum_command_with(
             }
         ));
     }
-    for w in &warnings {
-        eprintln!("warning: {}", candela::limits::printable(w, 4096));
+    warnings
+}
+
+/// `candela spectrum --json`: the keys documented in `docs/colour.md`.
+fn spectrum_json(
+    source: &str,
+    src: &SpectrumSource,
+    observer: Observer,
+    c: &SpectrumColorimetry,
+    extras: &health::Extras,
+    warnings: &[String],
+) -> anyhow::Result<String> {
+    let (ohno, rob) = (c.cct_duv_ohno, c.cct_duv_robertson);
+    let mut j = json!({
+        "source": source,
+        "description": src.description,
+        "observer": match observer { Observer::Cie1931_2 => "1931", Observer::Cie1964_10 => "1964" },
+        "xyz": c.xyz_y100,
+        "xyz_absolute": c.xyz_absolute,
+        "luminance_cd_m2_if_radiance": c.xyz_absolute[1],
+        "xy": c.xy,
+        "upvp": c.upvp,
+        "uv_1960": c.uv_1960,
+        "cct_k": ohno[0],
+        "duv": ohno[1],
+        "cct_robertson_k": rob[0],
+        "duv_robertson": rob[1],
+        "luminous_efficacy_lm_per_w": c.luminous_efficacy_lm_per_w,
+        "sp_ratio": c.sp_ratio,
+        "srgb_linear": c.srgb_linear,
+        "srgb_encoded": c.srgb_encoded,
+        "notes": c.notes,
+        "warnings": warnings,
+    });
+    if let Some(e) = c.blackbody_luminous_efficacy_lm_per_w {
+        j["blackbody_luminous_efficacy_lm_per_w"] = json!(e);
     }
+    if let Some(cri) = &c.cri {
+        j["cri"] = json!({"ra": cri.ra, "r": cri.r, "cct_k": cri.cct_k,
+            "reference": if cri.reference_is_blackbody { "blackbody" } else { "CIE daylight" }});
+    }
+    if let Some(o) = &c.object_under_d65 {
+        j["object_under_d65"] = json!({"xyz": o.xyz, "lab": o.lab, "srgb_linear": o.srgb_linear,
+            "srgb_encoded": o.srgb_encoded});
+    }
+    health::add_json(&mut j, extras);
+    Ok(serde_json::to_string_pretty(&j)? + "\n")
+}
+
+/// The text lines of the colorimetry every spectrum gets: XYZ to sRGB.
+fn colorimetry_text(
+    line: &mut dyn FnMut(&str, String),
+    src: &SpectrumSource,
+    observer: Observer,
+    c: &SpectrumColorimetry,
+) {
     let (xyz_n, xyz_abs, xy, upvp, uv) = (c.xyz_y100, c.xyz_absolute, c.xy, c.upvp, c.uv_1960);
     let (ohno, rob) = (c.cct_duv_ohno, c.cct_duv_robertson);
     let (efficacy, sp) = (c.luminous_efficacy_lm_per_w, c.sp_ratio);
     let (srgb_lin, srgb_enc) = (c.srgb_linear, c.srgb_encoded);
-    let (cri, bb_eff, notes) = (c.cri, c.blackbody_luminous_efficacy_lm_per_w, c.notes);
-    let object = c
-        .object_under_d65
-        .map(|o| (o.xyz, o.lab, o.srgb_linear, o.srgb_encoded));
-
-    if json {
-        let mut j = json!({
-            "source": source,
-            "description": src.description,
-            "observer": match observer { Observer::Cie1931_2 => "1931", Observer::Cie1964_10 => "1964" },
-            "xyz": xyz_n,
-            "xyz_absolute": xyz_abs,
-            "luminance_cd_m2_if_radiance": xyz_abs[1],
-            "xy": xy,
-            "upvp": upvp,
-            "uv_1960": uv,
-            "cct_k": ohno[0],
-            "duv": ohno[1],
-            "cct_robertson_k": rob[0],
-            "duv_robertson": rob[1],
-            "luminous_efficacy_lm_per_w": efficacy,
-            "sp_ratio": sp,
-            "srgb_linear": srgb_lin,
-            "srgb_encoded": srgb_enc,
-            "notes": notes,
-            "warnings": warnings,
-        });
-        if let Some(e) = bb_eff {
-            j["blackbody_luminous_efficacy_lm_per_w"] = json!(e);
-        }
-        if let Some(c) = &cri {
-            j["cri"] = json!({"ra": c.ra, "r": c.r, "cct_k": c.cct_k,
-                "reference": if c.reference_is_blackbody { "blackbody" } else { "CIE daylight" }});
-        }
-        if let Some((xyz_o, lab, lin, enc)) = object {
-            j["object_under_d65"] =
-                json!({"xyz": xyz_o, "lab": lab, "srgb_linear": lin, "srgb_encoded": enc});
-        }
-        health::add_json(&mut j, &extras);
-        return Ok(serde_json::to_string_pretty(&j)? + "\n");
-    }
-
-    let mut out = String::new();
-    let mut line = |k: &str, v: String| out.push_str(&format!("{k:<34} {v}\n"));
     line("source", src.description.clone());
     line(
         "observer",
@@ -152,7 +195,7 @@ pub fn spectrum_command_with(
         "luminous efficacy of radiation",
         format!("{efficacy:.3} lm/W (radiant power over {START_NM}–{END_NM} nm)"),
     );
-    if let Some(e) = bb_eff {
+    if let Some(e) = c.blackbody_luminous_efficacy_lm_per_w {
         line(
             "  of the whole blackbody spectrum",
             format!("{e:.3} lm/W (total radiance σT⁴/π)"),
@@ -167,50 +210,50 @@ pub fn spectrum_command_with(
         "sRGB encoded (IEC 61966-2-1)",
         format!("{:.6} {:.6} {:.6}", srgb_enc[0], srgb_enc[1], srgb_enc[2]),
     );
-    if let Some(c) = &cri {
-        line(
-            "CRI (CIE 13.3) Ra",
-            format!(
-                "{:.2} (reference: {} at {:.0} K)",
-                c.ra,
-                if c.reference_is_blackbody {
-                    "blackbody"
-                } else {
-                    "CIE daylight"
-                },
-                c.cct_k
-            ),
-        );
-        let r: Vec<String> =
-            c.r.iter()
-                .enumerate()
-                .map(|(i, v)| format!("R{}={v:.2}", i + 1))
-                .collect();
-        line("  R1–R7", r[..7].join(" "));
-        line("  R8–R14", r[7..].join(" "));
-    }
-    if let Some((xyz_o, lab, lin, enc)) = object {
-        line(
-            "reflectance under D65: XYZ",
-            format!("{:.6} {:.6} {:.6}", xyz_o[0], xyz_o[1], xyz_o[2]),
-        );
-        line(
-            "  CIELAB (D65 white)",
-            format!("{:.4} {:.4} {:.4}", lab[0], lab[1], lab[2]),
-        );
-        line(
-            "  sRGB linear / encoded",
-            format!(
-                "{:.6} {:.6} {:.6} / {:.6} {:.6} {:.6}",
-                lin[0], lin[1], lin[2], enc[0], enc[1], enc[2]
-            ),
-        );
-    }
-    health::add_text(&mut line, &extras);
-    for n in &notes {
-        line("note", n.clone());
-    }
-    Ok(out)
+}
+
+/// The text lines of the CIE 13.3 colour rendering index.
+fn cri_text(line: &mut dyn FnMut(&str, String), c: &Cri) {
+    line(
+        "CRI (CIE 13.3) Ra",
+        format!(
+            "{:.2} (reference: {} at {:.0} K)",
+            c.ra,
+            if c.reference_is_blackbody {
+                "blackbody"
+            } else {
+                "CIE daylight"
+            },
+            c.cct_k
+        ),
+    );
+    let r: Vec<String> =
+        c.r.iter()
+            .enumerate()
+            .map(|(i, v)| format!("R{}={v:.2}", i + 1))
+            .collect();
+    line("  R1–R7", r[..7].join(" "));
+    line("  R8–R14", r[7..].join(" "));
+}
+
+/// The text lines of a reflectance's colour under D65.
+fn object_text(line: &mut dyn FnMut(&str, String), o: &ObjectColour) {
+    let (xyz_o, lab, lin, enc) = (o.xyz, o.lab, o.srgb_linear, o.srgb_encoded);
+    line(
+        "reflectance under D65: XYZ",
+        format!("{:.6} {:.6} {:.6}", xyz_o[0], xyz_o[1], xyz_o[2]),
+    );
+    line(
+        "  CIELAB (D65 white)",
+        format!("{:.4} {:.4} {:.4}", lab[0], lab[1], lab[2]),
+    );
+    line(
+        "  sRGB linear / encoded",
+        format!(
+            "{:.6} {:.6} {:.6} / {:.6} {:.6} {:.6}",
+            lin[0], lin[1], lin[2], enc[0], enc[1], enc[2]
+        ),
+    );
 }
 
 /// `candela convert VALUE FROM TO`: photometric unit conversion (see

@@ -2,7 +2,9 @@
 //! closing summary; the work is [`candela::job::run`] and [`candela::job::merge`].
 
 use anyhow::{Context, Result};
-use candela::job::{self, ImageDone, Outcome, Progress, RenderJob};
+use candela::job::{
+    self, GridResult, ImageDone, MeterResult, Outcome, Progress, RenderJob, RenderOutputs,
+};
 use candela::photometry::Quantity;
 use candela::render::{StopReason, TargetError};
 use candela::report::units::UnitSystem;
@@ -301,8 +303,30 @@ pub fn render(a: &RenderOpts) -> Result<()> {
     // Cleared before any message, error or not.
     bar.bar.finish_and_clear();
     let out = out?;
+    exit_if_interrupted(&out);
+    print_meters(&out.meters, job.units);
+    print_grids(&out.grids, job.units);
+    print_summary(&out);
+    // One glare evaluation (its draws are the costly part) serves the printout and the page.
+    let glare_json = if a.glare {
+        Some(print_glare(&out)?)
+    } else {
+        None
+    };
+    if a.report_html {
+        write_report_html(&out, glare_json.as_deref())?;
+    }
+    Ok(())
+}
+
+/// An output path as printed: control characters escaped.
+fn shown(p: &Path) -> String {
+    super::printable_lines(&p.display().to_string())
+}
+
+/// Says what an interrupted job wrote and exits with code 130; returns if the job finished.
+fn exit_if_interrupted(out: &RenderOutputs) {
     let elapsed = out.render.elapsed.as_secs_f64();
-    let shown = |p: &Path| super::printable_lines(&p.display().to_string());
     match out.outcome {
         Outcome::Finished => {}
         Outcome::InterruptedBeforeFirstPass => {
@@ -328,8 +352,11 @@ pub fn render(a: &RenderOpts) -> Result<()> {
             std::process::exit(130);
         }
     }
-    let units = job.units;
-    for m in &out.meters {
+}
+
+/// Each meter's estimate (with its UGR and melanopic values), in `units`.
+fn print_meters(meters: &[MeterResult], units: UnitSystem) {
+    for m in meters {
         let q = match m.kind {
             MeterKind::Illuminance { .. } | MeterKind::Ugr { .. } | MeterKind::Melanopic { .. } => {
                 Quantity::Illuminance
@@ -375,7 +402,11 @@ pub fn render(a: &RenderOpts) -> Result<()> {
             );
         }
     }
-    for g in &out.grids {
+}
+
+/// Each grid's illuminance statistics, in `units`.
+fn print_grids(grids: &[GridResult], units: UnitSystem) {
+    for g in grids {
         let s = &g.stats;
         let (k, u) = (
             units.from_si(Quantity::Illuminance, 1.0),
@@ -398,13 +429,17 @@ pub fn render(a: &RenderOpts) -> Result<()> {
             );
         }
     }
+}
+
+/// The render's size, speed and files, and its warnings.
+fn print_summary(out: &RenderOutputs) {
     let r = &out.render;
     say!(
         "rendered {}×{} at {:.1} spp (image samples) in {:.2} s on {} threads: {:.3} M samples/s, {:.3} M rays/s; mean luminance {:.4} cd/m²; wrote {} and {}",
         r.film.width,
         r.film.height,
         r.film.samples_per_pixel(),
-        elapsed,
+        r.elapsed.as_secs_f64(),
         r.threads,
         out.samples_per_second() / 1e6,
         r.rays_per_second() / 1e6,
@@ -421,29 +456,32 @@ pub fn render(a: &RenderOpts) -> Result<()> {
     if let Some(w) = &out.truncation {
         eprintln!("warning: {w}");
     }
-    // One glare evaluation (its draws are the costly part) serves the printout and the page.
-    let mut glare_json = None;
-    if a.glare {
-        let args = super::glare::GlareArgs::defaults_for(out.exr_path.clone());
-        let (report, json) = super::glare::run_text_and_json(&args)?;
-        say!("glare of {}:\n{}", shown(&out.exr_path), report.trim_end());
-        glare_json = Some(json);
-    }
-    if a.report_html {
-        let glare = match &glare_json {
-            Some(j) => Some(serde_json::from_str(j)?),
-            None => None,
-        };
-        let html = out.exr_path.with_extension("html");
-        let r = candela::report::html::write_html_report(
-            &out.exr_path,
-            // A shard's render writes no report: its page has the image only.
-            Some(out.report_path.as_path()).filter(|p| p.is_file()),
-            glare.as_ref(),
-            &html,
-        )?;
-        say!("wrote {} ({:.2} MB)", shown(&r.path), r.bytes as f64 / 1e6);
-    }
+}
+
+/// `--glare`: evaluates the image as `candela glare` does with its defaults and prints the
+/// report; returns the evaluation as JSON.
+fn print_glare(out: &RenderOutputs) -> Result<String> {
+    let args = super::glare::GlareArgs::defaults_for(out.exr_path.clone());
+    let (report, json) = super::glare::run_text_and_json(&args)?;
+    say!("glare of {}:\n{}", shown(&out.exr_path), report.trim_end());
+    Ok(json)
+}
+
+/// `--report-html`: writes NAME.html, with the glare evaluation if there is one.
+fn write_report_html(out: &RenderOutputs, glare_json: Option<&str>) -> Result<()> {
+    let glare = match glare_json {
+        Some(j) => Some(serde_json::from_str(j)?),
+        None => None,
+    };
+    let html = out.exr_path.with_extension("html");
+    let r = candela::report::html::write_html_report(
+        &out.exr_path,
+        // A shard's render writes no report: its page has the image only.
+        Some(out.report_path.as_path()).filter(|p| p.is_file()),
+        glare.as_ref(),
+        &html,
+    )?;
+    say!("wrote {} ({:.2} MB)", shown(&r.path), r.bytes as f64 / 1e6);
     Ok(())
 }
 

@@ -98,75 +98,25 @@ fn render<'py>(
     cancel: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     // The command line's checks, with the messages naming the arguments.
-    let spp = args::opt_int_in(&spp, "spp", 1, u32::MAX as u64)?.map(|n| n as u32);
-    let seed = args::opt_int_in(&seed, "seed", 0, u64::MAX)?;
-    let max_depth =
-        args::opt_int_in(&max_depth, "max_depth", 0, u32::MAX as u64)?.map(|n| n as u32);
-    let threads =
-        args::opt_int_in(&threads, "threads", 1, job::max_threads() as u64)?.map(|n| n as usize);
-    let max_spp = args::opt_int_in(&max_spp, "max_spp", 1, u32::MAX as u64)?.map(|n| n as u32);
-    let spectral_bands = args::opt_int_in(
-        &spectral_bands,
-        "spectral_bands",
-        0,
-        crate::film::MAX_SPECTRAL_BANDS as u64,
-    )?
-    .unwrap_or(0) as usize;
+    let n = Counts::check(&spp, &seed, &max_depth, &threads, &max_spp, &spectral_bands)?;
     check_exposure(exposure_ev)?;
-    args::number(
-        "target_fraction",
-        target_fraction,
-        "a fraction in (0, 1]",
-        |f| f > 0.0 && f <= 1.0,
-    )?;
-    if let Some(f) = target_floor_cd_m2 {
-        args::number(
-            "target_floor_cd_m2",
-            f,
-            "a luminance ≥ 0 in cd/m²",
-            |f| f >= 0.0,
-        )?;
-    }
+    check_target_limits(target_fraction, target_floor_cd_m2)?;
     args::callbacks(&progress, &cancel)?;
-    let caustics = match caustics {
-        None => None,
-        Some("light-tracing") => Some(crate::world::Caustics::LightTracing),
-        Some("path-tracing") => Some(crate::world::Caustics::PathTracing),
-        Some(c) => {
-            return Err(error_msg(format!(
-                "caustics must be \"light-tracing\" or \"path-tracing\", got {c:?}"
-            )))
-        }
-    };
-    let units = match units {
-        "si" => UnitSystem::Si,
-        "imperial" => UnitSystem::Imperial,
-        u => {
-            return Err(error_msg(format!(
-                "units must be \"si\" or \"imperial\", got {u:?}"
-            )))
-        }
-    };
-    if let Some(t) = target_error {
-        args::number(
-            "target_error",
-            t,
-            "strictly between 0 and 1 (a fraction: 0.01 = 1 %)",
-            |t| t > 0.0 && t < 1.0,
-        )?;
-    }
+    let caustics = caustics_of(caustics)?;
+    let units = units_of(units)?;
+    check_target_error(target_error)?;
     let job = RenderJob {
         scene,
         overrides: Overrides {
-            spp,
-            seed,
-            max_depth,
+            spp: n.spp,
+            seed: n.seed,
+            max_depth: n.max_depth,
             illuminance,
             caustics,
             ..Default::default()
         },
         out: Some(out),
-        threads,
+        threads: n.threads,
         exposure_ev,
         units,
         target: target_error.map(|relative| TargetError {
@@ -174,7 +124,7 @@ fn render<'py>(
             fraction: target_fraction,
             floor_cd_m2: target_floor_cd_m2,
         }),
-        max_spp,
+        max_spp: n.max_spp,
         max_time: seconds("max_time_s", max_time_s)?,
         checkpoint_interval: seconds("checkpoint_interval_s", checkpoint_interval_s)?
             .filter(|d| !d.is_zero()),
@@ -190,55 +140,199 @@ fn render<'py>(
         health: crate::film::HealthChannels {
             melanopic: alpha_opic,
             mesopic,
-            spectral_bands,
+            spectral_bands: n.spectral_bands,
         },
     };
+    let (outputs, warnings) = run_watched(py, &job, &progress, &cancel)?;
+    result_dict(py, &job, &outputs, warnings)
+}
+
+/// The integer arguments of `render`, checked in the command line's ranges.
+struct Counts {
+    spp: Option<u32>,
+    seed: Option<u64>,
+    max_depth: Option<u32>,
+    threads: Option<usize>,
+    max_spp: Option<u32>,
+    spectral_bands: usize,
+}
+
+impl Counts {
+    fn check(
+        spp: &Option<Bound<'_, PyAny>>,
+        seed: &Option<Bound<'_, PyAny>>,
+        max_depth: &Option<Bound<'_, PyAny>>,
+        threads: &Option<Bound<'_, PyAny>>,
+        max_spp: &Option<Bound<'_, PyAny>>,
+        spectral_bands: &Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Counts> {
+        let spp = args::opt_int_in(spp, "spp", 1, u32::MAX as u64)?.map(|n| n as u32);
+        let seed = args::opt_int_in(seed, "seed", 0, u64::MAX)?;
+        let max_depth =
+            args::opt_int_in(max_depth, "max_depth", 0, u32::MAX as u64)?.map(|n| n as u32);
+        let threads =
+            args::opt_int_in(threads, "threads", 1, job::max_threads() as u64)?.map(|n| n as usize);
+        let max_spp = args::opt_int_in(max_spp, "max_spp", 1, u32::MAX as u64)?.map(|n| n as u32);
+        let spectral_bands = args::opt_int_in(
+            spectral_bands,
+            "spectral_bands",
+            0,
+            crate::film::MAX_SPECTRAL_BANDS as u64,
+        )?
+        .unwrap_or(0) as usize;
+        Ok(Counts {
+            spp,
+            seed,
+            max_depth,
+            threads,
+            max_spp,
+            spectral_bands,
+        })
+    }
+}
+
+/// `target_fraction` in (0, 1] and `target_floor_cd_m2`, when given, ≥ 0.
+fn check_target_limits(target_fraction: f64, target_floor_cd_m2: Option<f64>) -> PyResult<()> {
+    args::number(
+        "target_fraction",
+        target_fraction,
+        "a fraction in (0, 1]",
+        |f| f > 0.0 && f <= 1.0,
+    )?;
+    if let Some(f) = target_floor_cd_m2 {
+        args::number(
+            "target_floor_cd_m2",
+            f,
+            "a luminance ≥ 0 in cd/m²",
+            |f| f >= 0.0,
+        )?;
+    }
+    Ok(())
+}
+
+/// `target_error`, when given, strictly between 0 and 1.
+fn check_target_error(target_error: Option<f64>) -> PyResult<()> {
+    if let Some(t) = target_error {
+        args::number(
+            "target_error",
+            t,
+            "strictly between 0 and 1 (a fraction: 0.01 = 1 %)",
+            |t| t > 0.0 && t < 1.0,
+        )?;
+    }
+    Ok(())
+}
+
+/// The `caustics` argument as the scene setting it overrides.
+fn caustics_of(caustics: Option<&str>) -> PyResult<Option<crate::world::Caustics>> {
+    match caustics {
+        None => Ok(None),
+        Some("light-tracing") => Ok(Some(crate::world::Caustics::LightTracing)),
+        Some("path-tracing") => Ok(Some(crate::world::Caustics::PathTracing)),
+        Some(c) => Err(error_msg(format!(
+            "caustics must be \"light-tracing\" or \"path-tracing\", got {c:?}"
+        ))),
+    }
+}
+
+/// The `units` argument: "si" or "imperial".
+fn units_of(units: &str) -> PyResult<UnitSystem> {
+    match units {
+        "si" => Ok(UnitSystem::Si),
+        "imperial" => Ok(UnitSystem::Imperial),
+        u => Err(error_msg(format!(
+            "units must be \"si\" or \"imperial\", got {u:?}"
+        ))),
+    }
+}
+
+/// What the calling thread keeps while it watches the job.
+struct Watch<'a, 'py> {
+    progress: &'a Option<Bound<'py, PyAny>>,
+    cancel: &'a Option<Bound<'py, PyAny>>,
+    t0: Instant,
+    /// The job's most samples, from its start.
+    total: u64,
+    warnings: Vec<String>,
+    /// Why the caller stopped the job: a Python exception to raise (Ctrl-C, a failing
+    /// callback) or a cancellation.
+    raised: Option<PyErr>,
+    cancelled: bool,
+}
+
+impl Watch<'_, '_> {
+    /// Handles one event (`None`: the wait timed out), then asks the cancel event and Python's
+    /// signal handlers whether to stop; a stop request sets `stop`.
+    fn step(&mut self, py: Python<'_>, event: Option<Event>, stop: &AtomicBool) {
+        let ask_stop = match event {
+            Some(Event::Start(n)) => {
+                self.total = n;
+                call(self.progress, 0, self.total, self.t0)
+            }
+            Some(Event::Pass(st)) => call(
+                self.progress,
+                st.samples,
+                self.total.max(st.max_samples),
+                self.t0,
+            ),
+            Some(Event::Rendered) => Ok(false),
+            Some(Event::Warning(w)) => {
+                self.warnings.push(w);
+                Ok(false)
+            }
+            None => Ok(false),
+        };
+        let ask_stop = ask_stop.and_then(|s| Ok(s || is_set(self.cancel)?));
+        let ask_stop = ask_stop.and_then(|s| py.check_signals().map(|()| s));
+        match ask_stop {
+            Ok(false) => {}
+            Ok(true) => {
+                self.cancelled = true;
+                stop.store(true, Ordering::SeqCst);
+            }
+            Err(e) => {
+                self.raised.get_or_insert(e);
+                stop.store(true, Ordering::SeqCst);
+            }
+        }
+    }
+}
+
+/// Runs `job` on a worker thread while this thread forwards its progress and watches for a
+/// stop request. Returns its outputs and warnings, or why it did not finish.
+fn run_watched(
+    py: Python<'_>,
+    job: &RenderJob,
+    progress: &Option<Bound<'_, PyAny>>,
+    cancel: &Option<Bound<'_, PyAny>>,
+) -> PyResult<(job::RenderOutputs, Vec<String>)> {
     let stop = AtomicBool::new(false);
     let (tx, rx) = mpsc::channel();
     // A Mutex makes the receiver shareable with the interpreter released (it is never contended).
     let rx = Mutex::new(rx);
-    let t0 = Instant::now();
-    let mut warnings: Vec<String> = Vec::new();
-    // Why the caller stopped the job: a Python exception to raise (Ctrl-C, a failing callback)
-    // or a cancellation.
-    let mut raised: Option<PyErr> = None;
-    let mut cancelled = false;
+    let mut watch = Watch {
+        progress,
+        cancel,
+        t0: Instant::now(),
+        total: 0,
+        warnings: Vec::new(),
+        raised: None,
+        cancelled: false,
+    };
     let result = std::thread::scope(|s| {
-        let worker = s.spawn(|| job::run(&job, &mut Forward(tx), &stop));
-        let mut total = 0u64;
+        let worker = s.spawn(|| job::run(job, &mut Forward(tx), &stop));
         loop {
             let event = py.detach(|| {
                 rx.lock()
                     .expect("only this thread locks it")
                     .recv_timeout(POLL)
             });
-            let ask_stop = match event {
-                Ok(Event::Start(n)) => {
-                    total = n;
-                    call(&progress, 0, total, t0)
-                }
-                Ok(Event::Pass(st)) => call(&progress, st.samples, total.max(st.max_samples), t0),
-                Ok(Event::Rendered) => Ok(false),
-                Ok(Event::Warning(w)) => {
-                    warnings.push(w);
-                    Ok(false)
-                }
-                Err(mpsc::RecvTimeoutError::Timeout) => Ok(false),
+            let event = match event {
+                Ok(e) => Some(e),
+                Err(mpsc::RecvTimeoutError::Timeout) => None,
                 Err(mpsc::RecvTimeoutError::Disconnected) => break,
             };
-            let ask_stop = ask_stop.and_then(|s| Ok(s || is_set(&cancel)?));
-            let ask_stop = ask_stop.and_then(|s| py.check_signals().map(|()| s));
-            match ask_stop {
-                Ok(false) => {}
-                Ok(true) => {
-                    cancelled = true;
-                    stop.store(true, Ordering::SeqCst);
-                }
-                Err(e) => {
-                    raised.get_or_insert(e);
-                    stop.store(true, Ordering::SeqCst);
-                }
-            }
+            watch.step(py, event, &stop);
         }
         // The job ends soon after a stop request: at the end of its pass or measurement.
         py.detach(|| worker.join())
@@ -258,28 +352,34 @@ fn render<'py>(
             )));
         }
     };
-    if let Some(e) = raised {
+    if let Some(e) = watch.raised {
         return Err(e);
     }
-    if outputs.outcome != Outcome::Finished {
-        let what = match outputs.outcome {
-            Outcome::InterruptedBeforeFirstPass => {
-                "before its first pass ended: nothing was written".to_string()
-            }
-            Outcome::InterruptedRender => format!(
-                "during the render: a checkpoint was written ({}, {})",
-                outputs.exr_path.display(),
-                outputs.state_path.display()
-            ),
-            _ => format!(
-                "during the meters and grids: the images were written ({}), no report",
-                outputs.exr_path.display()
-            ),
-        };
-        let why = if cancelled { "cancelled" } else { "stopped" };
-        return Err(Cancelled::new_err(format!("render {why} {what}")));
+    check_finished(&outputs, watch.cancelled)?;
+    Ok((outputs, watch.warnings))
+}
+
+/// A [`Cancelled`] error saying what a stopped job wrote; `Ok` if it finished.
+fn check_finished(outputs: &job::RenderOutputs, cancelled: bool) -> PyResult<()> {
+    if outputs.outcome == Outcome::Finished {
+        return Ok(());
     }
-    result_dict(py, &job, &outputs, warnings)
+    let what = match outputs.outcome {
+        Outcome::InterruptedBeforeFirstPass => {
+            "before its first pass ended: nothing was written".to_string()
+        }
+        Outcome::InterruptedRender => format!(
+            "during the render: a checkpoint was written ({}, {})",
+            outputs.exr_path.display(),
+            outputs.state_path.display()
+        ),
+        _ => format!(
+            "during the meters and grids: the images were written ({}), no report",
+            outputs.exr_path.display()
+        ),
+    };
+    let why = if cancelled { "cancelled" } else { "stopped" };
+    Err(Cancelled::new_err(format!("render {why} {what}")))
 }
 
 /// Calls `progress(samples_done, samples_total, elapsed_s)`; true if it returned False.

@@ -19,6 +19,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
+mod tables;
+use tables::{print_agreement, print_bvh_table, print_full_hit_throughput, print_throughput};
+
 /// Options of `candela bench traversal`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct TraversalArgs {
@@ -459,6 +462,38 @@ fn mrays(rays: usize, seconds: f64) -> f64 {
 }
 
 pub fn run(args: &TraversalArgs) -> Result<()> {
+    check_args(args)?;
+    let (file, source) = load_rays(args)?;
+    if let Some(path) = &args.export {
+        return export(path, &file);
+    }
+    let bvh = CandelaBvh::build(&file.mesh, args.build_reps)?;
+    let mut embrees = Vec::new();
+    if let (Some(program), Some(rays)) = (&args.embree, &args.rays) {
+        for q in &args.embree_quality {
+            eprintln!("starting embree_trace (quality {q})…");
+            embrees.push(Embree::spawn(program, rays, q, args.build_reps)?);
+        }
+    }
+    let times = time_batches(args, &file, &bvh.geo, &mut embrees)?;
+    if let Some(path) = &args.hits_out {
+        let bytes = super::rayfile::hits_to_bytes(&times.candela_hits);
+        candela::output::write_atomic(path, |w| w.write_all(&bytes))
+            .with_context(|| format!("cannot write the hit file '{}'", path.display()))?;
+    }
+    print_throughput(args, &file, &source, &times, &embrees);
+    if args.record == Record::Both {
+        print_full_hit_throughput(args, &file, &times, &embrees);
+    }
+    print_bvh_table(args, &file, &bvh, &embrees);
+    if let Some(rays) = &args.rays {
+        print_agreement(rays, &file, &times, &mut embrees)?;
+    }
+    Ok(())
+}
+
+/// The options' own checks, and room in memory for what a generated benchmark holds.
+fn check_args(args: &TraversalArgs) -> Result<()> {
     if args.threads.is_empty() {
         bail!("--threads needs thread counts of at least 1, e.g. 1,2");
     }
@@ -469,7 +504,6 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
     super::check_resolution(args.resolution)?;
     super::check_positive("--reps", args.reps as u64)?;
     super::check_positive("--build-reps", args.build_reps as u64)?;
-    let reps = args.reps;
     if args.rays.is_none() {
         let rays = (args.resolution as u64).pow(2) * super::BYTES_PER_RAY;
         super::check_memory_for(
@@ -483,7 +517,13 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
             super::mesh_bytes(args.triangles) + rays,
         )?;
     }
-    let (file, source) = match &args.rays {
+    Ok(())
+}
+
+/// The mesh and rays: read from --rays, or generated. Returns them and where they came from
+/// (for the report's first line).
+fn load_rays(args: &TraversalArgs) -> Result<(RayFile, String)> {
+    match &args.rays {
         Some(path) => {
             let t0 = Instant::now();
             let f = RayFile::read(path)?;
@@ -500,84 +540,114 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
                 path.display(),
                 t0.elapsed().as_secs_f64()
             );
-            (f, path.display().to_string())
+            Ok((f, path.display().to_string()))
         }
         None => {
             let mesh = bench_mesh(args.triangles);
             let (geo, _) = build_geometry(&mesh)?;
             let batches = generate_batches(&geo, args.resolution);
-            (
+            Ok((
                 RayFile { mesh, batches },
                 format!(
                     "generated ({} triangles, {}² primary rays)",
                     args.triangles, args.resolution
                 ),
-            )
-        }
-    };
-    let n_tris = file.mesh.indices.len();
-    if let Some(path) = &args.export {
-        file.write(path)?;
-        println!(
-            "wrote {}: {} triangles, {}",
-            path.display(),
-            n_tris,
-            file.batches
-                .iter()
-                .map(|b| format!("{} {} rays", b.rays.len(), b.name))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-        return Ok(());
-    }
-
-    // candela's BVH (median of build_reps builds).
-    let mut builds = Vec::new();
-    let mut geo = None;
-    for _ in 0..args.build_reps.max(1) {
-        drop(geo.take()); // free the previous build first
-        let (g, s) = build_geometry(&file.mesh)?;
-        builds.push(s);
-        geo = Some(g);
-    }
-    let geo = geo.expect("at least one build");
-    let candela_build = median(&mut builds);
-    let candela_bytes = geo.memory_bytes() as f64;
-
-    let mut embrees = Vec::new();
-    if let (Some(program), Some(rays)) = (&args.embree, &args.rays) {
-        for q in &args.embree_quality {
-            eprintln!("starting embree_trace (quality {q})…");
-            embrees.push(Embree::spawn(program, rays, q, args.build_reps)?);
+            ))
         }
     }
+}
 
+/// `--export`: writes the ray file and says what it holds.
+fn export(path: &Path, file: &RayFile) -> Result<()> {
+    file.write(path)?;
+    println!(
+        "wrote {}: {} triangles, {}",
+        path.display(),
+        file.mesh.indices.len(),
+        file.batches
+            .iter()
+            .map(|b| format!("{} {} rays", b.rays.len(), b.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(())
+}
+
+/// candela's BVH over the benchmark mesh, with its median build time.
+struct CandelaBvh {
+    geo: SceneGeometry,
+    /// Median of the build times, seconds.
+    build_seconds: f64,
+    bytes: f64,
+}
+
+impl CandelaBvh {
+    /// Builds the BVH `build_reps` times (at least once), keeping the last build.
+    fn build(mesh: &TriangleMesh, build_reps: usize) -> Result<CandelaBvh> {
+        let mut builds = Vec::new();
+        let mut geo = None;
+        for _ in 0..build_reps.max(1) {
+            drop(geo.take()); // free the previous build first
+            let (g, s) = build_geometry(mesh)?;
+            builds.push(s);
+            geo = Some(g);
+        }
+        let geo = geo.expect("at least one build");
+        let build_seconds = median(&mut builds);
+        let bytes = geo.memory_bytes() as f64;
+        Ok(CandelaBvh {
+            geo,
+            build_seconds,
+            bytes,
+        })
+    }
+}
+
+/// The timings of every repetition, indexed `[batch][threads index]` (and then, for Embree,
+/// by process), and candela's hits.
+struct Times {
+    candela: Vec<Vec<Vec<Timing>>>,
+    embree: Vec<Vec<Vec<Vec<Timing>>>>,
+    /// With --record both: the full-Hit timings of the closest-hit batches.
+    candela_full: Vec<Vec<Vec<Timing>>>,
+    /// Per batch, the hit `t` of candela's first repetition.
+    candela_hits: Vec<Vec<f32>>,
+}
+
+/// Traces every batch at every thread count, `--reps` times, with candela and each Embree
+/// process alternating.
+fn time_batches(
+    args: &TraversalArgs,
+    file: &RayFile,
+    geo: &SceneGeometry,
+    embrees: &mut [Embree],
+) -> Result<Times> {
+    let reps = args.reps;
     let nb = file.batches.len();
     let nt = args.threads.len();
-    // times[batch][threads index] = timings of candela / of each Embree process.
-    let mut candela_t: Vec<Vec<Vec<Timing>>> = vec![vec![Vec::new(); nt]; nb];
-    let mut embree_t: Vec<Vec<Vec<Vec<Timing>>>> =
-        vec![vec![vec![Vec::new(); embrees.len()]; nt]; nb];
-    // With --record both: the full-Hit timings of the closest-hit batches.
-    let mut candela_full_t: Vec<Vec<Vec<Timing>>> = vec![vec![Vec::new(); nt]; nb];
-    let mut candela_hits: Vec<Vec<f32>> = vec![Vec::new(); nb];
+    let mut t = Times {
+        candela: vec![vec![Vec::new(); nt]; nb],
+        embree: vec![vec![vec![Vec::new(); embrees.len()]; nt]; nb],
+        candela_full: vec![vec![Vec::new(); nt]; nb],
+        candela_hits: vec![Vec::new(); nb],
+    };
     let main_full = args.record == Record::Full;
     for rep in 0..reps {
         eprintln!("repetition {}/{reps}…", rep + 1);
         for (b, batch) in file.batches.iter().enumerate() {
             for (k, &threads) in args.threads.iter().enumerate() {
-                let (s, hits) = trace_batch_record(&geo, batch, threads, main_full);
-                candela_t[b][k].push(s);
-                if candela_hits[b].is_empty() {
-                    candela_hits[b] = hits;
+                let (s, hits) = trace_batch_record(geo, batch, threads, main_full);
+                t.candela[b][k].push(s);
+                if t.candela_hits[b].is_empty() {
+                    t.candela_hits[b] = hits;
                 }
                 for (e, emb) in embrees.iter_mut().enumerate() {
-                    embree_t[b][k][e].push(emb.trace(&batch.name, threads)?);
+                    t.embree[b][k][e].push(emb.trace(&batch.name, threads)?);
                 }
                 if args.record == Record::Both && batch.kind == RayKind::Closest {
-                    let (s, hits) = trace_batch_record(&geo, batch, threads, true);
-                    candela_full_t[b][k].push(s);
-                    if hits != candela_hits[b] {
+                    let (s, hits) = trace_batch_record(geo, batch, threads, true);
+                    t.candela_full[b][k].push(s);
+                    if hits != t.candela_hits[b] {
                         bail!(
                             "intersect and intersect_basic disagree on batch {}",
                             batch.name
@@ -587,141 +657,7 @@ pub fn run(args: &TraversalArgs) -> Result<()> {
             }
         }
     }
-
-    if let Some(path) = &args.hits_out {
-        let bytes = super::rayfile::hits_to_bytes(&candela_hits);
-        candela::output::write_atomic(path, |w| w.write_all(&bytes))
-            .with_context(|| format!("cannot write the hit file '{}'", path.display()))?;
-    }
-
-    // Report.
-    println!(
-        "Traversal: {} ({} triangles), medians of {} repetitions (candela and Embree alternating); threads take chunks of {CHUNK} rays from a shared counter.",
-        source, n_tris, reps
-    );
-    type Metric = fn(&Timing) -> f64;
-    let tables: [(&str, Metric); 2] = [
-        ("Wall clock: Mrays/s; ratio = candela time ÷ Embree time (≤ 1.3 is the goal).", |t| t.wall),
-        ("CPU time (summed over the tracing threads, so not inflated by other processes): Mrays per CPU-second; ratio = candela CPU time ÷ Embree CPU time.", |t| t.cpu),
-    ];
-    for (title, metric) in tables {
-        let mut head = "| rays | kind | count | threads | candela |".to_string();
-        let mut rule = "|---|---|---:|---:|---:|".to_string();
-        for e in &embrees {
-            head += &format!(" Embree {q} | ratio vs {q} |", q = e.quality);
-            rule += "---:|---:|";
-        }
-        println!("\n{title}\n\n{head}\n{rule}");
-        for (b, batch) in file.batches.iter().enumerate() {
-            for (k, &threads) in args.threads.iter().enumerate() {
-                let c = median(&mut candela_t[b][k].iter().map(metric).collect::<Vec<_>>());
-                let mut row = format!(
-                    "| {} | {} | {} | {threads} | {} |",
-                    batch.name,
-                    match batch.kind {
-                        RayKind::Closest => "closest hit",
-                        RayKind::Occluded => "any hit",
-                    },
-                    batch.rays.len(),
-                    super::cell(mrays(batch.rays.len(), c), 2)
-                );
-                for times in &embree_t[b][k] {
-                    let s = median(&mut times.iter().map(metric).collect::<Vec<_>>());
-                    row += &format!(
-                        " {} | {} |",
-                        super::cell(mrays(batch.rays.len(), s), 2),
-                        super::cell(c / s, 2)
-                    );
-                }
-                println!("{row}");
-            }
-        }
-    }
-    if args.record == Record::Both {
-        let mut head = "| rays | threads | candela, full Hit |".to_string();
-        let mut rule = "|---|---:|---:|".to_string();
-        for e in &embrees {
-            head += &format!(" ratio vs {q} |", q = e.quality);
-            rule += "---:|";
-        }
-        println!("\nCPU time with the full `Hit` record (`SceneGeometry::intersect`, what the renderer calls: adds the hit point, unit normals, shading normal and error bounds): Mrays per CPU-second; ratio = candela CPU time ÷ Embree CPU time (Embree as above).\n\n{head}\n{rule}");
-        for (b, batch) in file.batches.iter().enumerate() {
-            if batch.kind != RayKind::Closest {
-                continue;
-            }
-            for (k, &threads) in args.threads.iter().enumerate() {
-                let c = median(
-                    &mut candela_full_t[b][k]
-                        .iter()
-                        .map(|t| t.cpu)
-                        .collect::<Vec<_>>(),
-                );
-                let mut row = format!(
-                    "| {} | {threads} | {} |",
-                    batch.name,
-                    super::cell(mrays(batch.rays.len(), c), 2)
-                );
-                for times in &embree_t[b][k] {
-                    let s = median(&mut times.iter().map(|t| t.cpu).collect::<Vec<_>>());
-                    row += &format!(" {} |", super::cell(c / s, 2));
-                }
-                println!("{row}");
-            }
-        }
-    }
-    println!(
-        "\n| BVH | build s (median of {}) | bytes/triangle | total MB |\n|---|---:|---:|---:|",
-        args.build_reps.max(1)
-    );
-    println!(
-        "| candela (obvhs PLOC binary tree, medium build, collapsed to 8-wide float nodes, leaves ≤ 6; {} nodes, depth {}) | {:.3} | {:.1} | {:.1} |",
-        geo.node_count(),
-        geo.bvh_depth(),
-        candela_build,
-        candela_bytes / n_tris as f64,
-        candela_bytes / 1e6
-    );
-    for e in &embrees {
-        println!(
-            "| Embree {} ({}) | {:.3} | {:.1} (BVH {:.1} + vertex/index buffers {:.1}) | {:.1} |",
-            e.version,
-            e.quality,
-            e.build_seconds,
-            e.bytes_total / n_tris as f64,
-            (e.bytes_total - e.bytes_buffers) / n_tris as f64,
-            e.bytes_buffers / n_tris as f64,
-            e.bytes_total / 1e6
-        );
-    }
-    if let Some(rays) = &args.rays {
-        for e in &mut embrees {
-            let hit_path = rays.with_extension(format!("embree-{}-hits.bin", e.quality));
-            let embree_hits = e.hits(&hit_path)?;
-            if embree_hits.len() != nb {
-                bail!(
-                    "embree_trace wrote {} batches of hits for {nb} batches of rays",
-                    embree_hits.len()
-                );
-            }
-            println!(
-                "\nHit agreement, candela vs Embree {} (same t: within 10⁻⁴·max(t, 1)):\n\n| rays | hit/miss agree | candela only | Embree only | both hit, t differs | max rel. Δt |\n|---|---:|---:|---:|---:|---:|",
-                e.quality
-            );
-            for (b, batch) in file.batches.iter().enumerate() {
-                let g = agreement(&candela_hits[b], &embree_hits[b]);
-                println!(
-                    "| {} | {:.4} % | {} | {} | {} | {:.1e} |",
-                    batch.name,
-                    100.0 * g.agree as f64 / g.rays.max(1) as f64,
-                    g.only_a,
-                    g.only_b,
-                    g.t_differs,
-                    g.max_rel_dt
-                );
-            }
-        }
-    }
-    Ok(())
+    Ok(t)
 }
 
 #[cfg(test)]
