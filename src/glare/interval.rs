@@ -209,69 +209,140 @@ pub fn evaluate_uncertain(
         Some(se) => membership(img, &img.luminance_cd_m2, se, &base_det, &base, opt),
         None => Membership::default(),
     };
-    let glare_flag = |r: &GlareResult, lum: &[f64]| -> Vec<bool> {
-        // Pixels of the detected sources, recovered from the threshold (sources are exactly
-        // the valid pixels above it).
-        (0..img.len())
-            .map(|i| img.valid(i) && lum[i] > r.threshold_cd_m2)
-            .collect()
-    };
-    let base_flag = glare_flag(&base, &img.luminance_cd_m2);
-    let base_significant = significant_sources(&base);
-    let lw = |i: usize| img.luminance_cd_m2[i] * img.solid_angle_sr[i];
-    let base_lw: f64 = (0..img.len()).filter(|&i| base_flag[i]).map(lw).sum();
     let k = if img.stderr_cd_m2.is_some() {
         u.draws
     } else {
         0
     };
-    let mut series: [Vec<f64>; 6] = Default::default();
-    let (mut count_changes, mut flip_sum) = (0usize, 0.0);
-    let mut lum = img.luminance_cd_m2.clone();
-    for d in 0..k {
-        let se = img.stderr_cd_m2.as_ref().expect("draws only with errors");
-        for i in 0..img.len() {
-            lum[i] = img.luminance_cd_m2[i] + se[i] * normal(u.seed, d as u64, i as u64);
-        }
-        let (r, det) = evaluate_detected(img, &lum, opt);
-        // A draw adds the image's noise again, so its bias from the noise-free image is
-        // twice the image's: less 2b, the draws centre on the image's corrected value.
-        let b = bias(img, &lum, se, &det, &r, opt);
-        if significant_sources(&r) != base_significant {
-            count_changes += 1;
-        }
-        let flag = glare_flag(&r, &lum);
-        let flipped: f64 = (0..img.len())
-            .filter(|&i| flag[i] != base_flag[i])
-            .map(lw)
-            .sum();
-        flip_sum += if base_lw > 0.0 {
-            flipped / base_lw
-        } else if flipped > 0.0 {
-            1.0
-        } else {
-            0.0
-        };
-        let values = [
-            r.dgp - 2.0 * b[0],
-            r.dgi - 2.0 * b[1],
-            r.ugr - 2.0 * b[2],
-            r.vcp,
-            r.cgi - 2.0 * b[3],
-            r.ev_lx,
-        ];
-        for (s, v) in series.iter_mut().zip(values) {
-            s.push(v);
-        }
-    }
-    let [mut a, mut b, mut c, mut e, mut f, mut g] = series;
+    let draws = Draws::simulate(img, opt, u.seed, &base, k);
+    let (changes, flip) = draws.shares(k);
+    let [mut a, mut b, mut c, mut e, mut f, mut g] = draws.series;
     let out_dgp = interval(base.dgp, base.dgp - base_bias[0], &mut a);
     let out_ugr = interval(base.ugr, base.ugr - base_bias[2], &mut c);
-    let (changes, flip) = if k > 0 {
-        (count_changes as f64 / k as f64, flip_sum / k as f64)
-    } else {
-        (0.0, 0.0)
-    };
+    let mut warnings = noise_warnings(u, &base, &out_dgp, &out_ugr, changes, flip);
+    let out_dgi = interval(base.dgi, base.dgi - base_bias[1], &mut b);
+    let out_cgi = interval(base.cgi, base.cgi - base_bias[3], &mut f);
+    let out_vcp = interval(base.vcp, base.vcp, &mut e);
+    let corrected = [&out_dgp, &out_dgi, &out_ugr, &out_cgi];
+    let untrusted = selection_untrusted(u, &member, &base, corrected, &mut warnings);
+    Ok(UncertainGlare {
+        dgi: out_dgi,
+        vcp: out_vcp,
+        cgi: out_cgi,
+        ev_lx: interval(base.ev_lx, base.ev_lx, &mut g),
+        dgp: out_dgp,
+        ugr: out_ugr,
+        result: base,
+        source_count_changes: changes,
+        membership_flip: flip,
+        membership: member,
+        untrusted,
+        trustworthy: warnings.is_empty(),
+        warnings,
+    })
+}
+
+/// Pixels of the detected sources of `r` (evaluated from `lum`), recovered from the
+/// threshold: sources are exactly the valid pixels above it.
+fn glare_pixels(img: &GlareImage, r: &GlareResult, lum: &[f64]) -> Vec<bool> {
+    (0..img.len())
+        .map(|i| img.valid(i) && lum[i] > r.threshold_cd_m2)
+        .collect()
+}
+
+/// The perturbed images' indices, bias-corrected, and how their detection differed from the
+/// image's own.
+struct Draws {
+    /// Per draw: DGP, DGI, UGR, VCP, CGI and E_v (lx).
+    series: [Vec<f64>; 6],
+    /// Draws whose number of significant sources differs from the image's.
+    count_changes: usize,
+    /// Sum over the draws of the share of the image's glare L·ω that changed sides.
+    flip_sum: f64,
+}
+
+impl Draws {
+    /// `k` images L + se·N(0, 1) drawn from `seed`, each detected and evaluated again.
+    fn simulate(
+        img: &GlareImage,
+        opt: &GlareOptions,
+        seed: u64,
+        base: &GlareResult,
+        k: usize,
+    ) -> Draws {
+        let base_flag = glare_pixels(img, base, &img.luminance_cd_m2);
+        let base_significant = significant_sources(base);
+        let lw = |i: usize| img.luminance_cd_m2[i] * img.solid_angle_sr[i];
+        let base_lw: f64 = (0..img.len()).filter(|&i| base_flag[i]).map(lw).sum();
+        let mut draws = Draws {
+            series: Default::default(),
+            count_changes: 0,
+            flip_sum: 0.0,
+        };
+        let mut lum = img.luminance_cd_m2.clone();
+        for d in 0..k {
+            let se = img.stderr_cd_m2.as_ref().expect("draws only with errors");
+            for i in 0..img.len() {
+                lum[i] = img.luminance_cd_m2[i] + se[i] * normal(seed, d as u64, i as u64);
+            }
+            let (r, det) = evaluate_detected(img, &lum, opt);
+            // A draw adds the image's noise again, so its bias from the noise-free image is
+            // twice the image's: less 2b, the draws centre on the image's corrected value.
+            let b = bias(img, &lum, se, &det, &r, opt);
+            if significant_sources(&r) != base_significant {
+                draws.count_changes += 1;
+            }
+            let flag = glare_pixels(img, &r, &lum);
+            let flipped: f64 = (0..img.len())
+                .filter(|&i| flag[i] != base_flag[i])
+                .map(lw)
+                .sum();
+            draws.flip_sum += if base_lw > 0.0 {
+                flipped / base_lw
+            } else if flipped > 0.0 {
+                1.0
+            } else {
+                0.0
+            };
+            let values = [
+                r.dgp - 2.0 * b[0],
+                r.dgi - 2.0 * b[1],
+                r.ugr - 2.0 * b[2],
+                r.vcp,
+                r.cgi - 2.0 * b[3],
+                r.ev_lx,
+            ];
+            for (s, v) in draws.series.iter_mut().zip(values) {
+                s.push(v);
+            }
+        }
+        draws
+    }
+
+    /// Share of the `k` draws whose number of significant sources changed, and the mean
+    /// share of the glare L·ω that changed sides (0 and 0 without draws).
+    fn shares(&self, k: usize) -> (f64, f64) {
+        if k > 0 {
+            (
+                self.count_changes as f64 / k as f64,
+                self.flip_sum / k as f64,
+            )
+        } else {
+            (0.0, 0.0)
+        }
+    }
+}
+
+/// The image-wide limits of `u` that the result passes, in words: the half-widths of DGP and
+/// (with sources) UGR, and the draws' changes of the `changes` and `flip` shares.
+fn noise_warnings(
+    u: &UncertainOptions,
+    base: &GlareResult,
+    out_dgp: &Interval,
+    out_ugr: &Interval,
+    changes: f64,
+    flip: f64,
+) -> Vec<String> {
     let mut warnings = Vec::new();
     if out_dgp.half_width > u.max_dgp_half_width {
         warnings.push(format!(
@@ -297,18 +368,25 @@ pub fn evaluate_uncertain(
             100.0 * flip
         ));
     }
-    let out_dgi = interval(base.dgi, base.dgi - base_bias[1], &mut b);
-    let out_cgi = interval(base.cgi, base.cgi - base_bias[3], &mut f);
-    let out_vcp = interval(base.vcp, base.vcp, &mut e);
+    warnings
+}
+
+/// The indices among DGI, UGR and CGI (`corrected`: the intervals of DGP, DGI, UGR, CGI)
+/// that the threshold's selection of noisy pixels could move by more than
+/// [`UncertainOptions::max_membership_reach`] times their half-width, when the pixels in
+/// doubt hold enough of the sources' solid angle; each adds a warning.
+fn selection_untrusted(
+    u: &UncertainOptions,
+    member: &Membership,
+    base: &GlareResult,
+    corrected: [&Interval; 4],
+    warnings: &mut Vec<String>,
+) -> Vec<&'static str> {
     let mut untrusted = Vec::new();
-    for (k, (name, i)) in [
-        ("DGP", &out_dgp),
-        ("DGI", &out_dgi),
-        ("UGR", &out_ugr),
-        ("CGI", &out_cgi),
-    ]
-    .into_iter()
-    .enumerate()
+    for (k, (name, i)) in ["DGP", "DGI", "UGR", "CGI"]
+        .into_iter()
+        .zip(corrected)
+        .enumerate()
     {
         let reach = member.reach[k];
         if k > 0
@@ -327,19 +405,5 @@ pub fn evaluate_uncertain(
             ));
         }
     }
-    Ok(UncertainGlare {
-        dgi: out_dgi,
-        vcp: out_vcp,
-        cgi: out_cgi,
-        ev_lx: interval(base.ev_lx, base.ev_lx, &mut g),
-        dgp: out_dgp,
-        ugr: out_ugr,
-        result: base,
-        source_count_changes: changes,
-        membership_flip: flip,
-        membership: member,
-        untrusted,
-        trustworthy: warnings.is_empty(),
-        warnings,
-    })
+    untrusted
 }

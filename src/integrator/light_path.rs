@@ -143,35 +143,17 @@ pub fn trace_light_path(
     splats: &mut Vec<Splat>,
     stats: &mut RayStats,
 ) {
-    let settings = &world.settings;
     let mut sampler = Sampler::new(seed, 0, index);
-    // Dimension sets led by their 2-D pairs: point on the light and direction; light choice,
-    // primitive, wavelengths, target cone; lens point. Bounces take one set each from dimension 12.
-    let [px, py, dx, dy] = sampler.get4();
-    let [u_light, u_prim, u_wl, u_dir] = sampler.get4();
-    let [lx, ly, _, _] = sampler.get4();
-    stats.light_paths += 1;
-    let (k, p_select) = pick_from_cdf(&caustics.cdf, u_light);
-    if p_select <= 0.0 {
-        return;
-    }
-    let light = &world.lights[caustics.lights[k] as usize];
-    let mut wl = SampledWavelengths::sample_visible(u_wl);
-    let u = (u_prim, u_dir, Vec2::new(px, py), Vec2::new(dx, dy));
-    let Some((origin, dir, mut beta)) = leave_light(world, caustics, light, p_select, u, &wl)
+    let Some((mut path, mut wl, u_lens)) = LightPath::start(world, caustics, &mut sampler, stats)
     else {
         return;
     };
-    // The BSDF factors alone, for Russian roulette.
-    let mut throughput = 1.0f32;
-    let (mut ray_o, mut ray_d) = (origin, dir);
-    // Scattering events so far, counting the surface being processed.
-    let mut depth = 0u32;
-    // Null events (straight through window panes) since the last scattering.
-    let mut straight_through = 0u32;
     loop {
         stats.light_rays += 1;
-        let Some(hit) = world.geometry.intersect(ray_o, ray_d, f32::INFINITY) else {
+        let Some(hit) = world
+            .geometry
+            .intersect(path.ray_o, path.ray_d, f32::INFINITY)
+        else {
             return;
         };
         let object = world.objects[hit.object as usize];
@@ -191,14 +173,22 @@ pub fn trace_light_path(
         };
         // A black surface ends the path, but still receives illuminance (below).
         let black = material.flags().contains(crate::bxdf::MaterialFlags::BLACK);
-        depth += 1;
+        path.depth += 1;
         material.prepare(&mut wl);
         let frame = Frame::from_normal(hit.ns);
-        let wo_world = -ray_d;
+        let wo_world = -path.ray_d;
         let wo = frame.to_local(wo_world);
         if wo.z == 0.0 {
             return;
         }
+        let at = Vertex {
+            material,
+            hit: &hit,
+            frame: &frame,
+            wo,
+            wo_world,
+            normal_mapped: normal_map.is_some(),
+        };
 
         // A surface after the first (which scattered specularly): connect to the camera, for
         // the luminance the surface sends toward it (non-specular surfaces) and, with the
@@ -208,91 +198,190 @@ pub fn trace_light_path(
             && !material
                 .flags()
                 .contains(crate::bxdf::MaterialFlags::ALL_DELTA);
-        let want_e = settings.illuminance && object.light.is_none();
-        if depth >= 2 && (want_l || want_e) {
-            let at = Vertex {
-                material,
-                hit: &hit,
-                frame: &frame,
-                wo,
-                wo_world,
-                normal_mapped: normal_map.is_some(),
-            };
+        let want_e = world.settings.illuminance && object.light.is_none();
+        if path.depth >= 2 && (want_l || want_e) {
             let want = (want_l, want_e);
-            let u_lens = Vec2::new(lx, ly);
-            connect_to_camera(world, &at, want, beta, &wl, u_lens, index, splats, stats);
+            connect_to_camera(
+                world, &at, want, path.beta, &wl, u_lens, index, splats, stats,
+            );
         }
 
-        // A window pane: passing straight through is a null event, as for the camera paths
-        // (not a scattering: the depth and the "first scattering is specular" rule are those
-        // of the path without it). The illuminance on the pane itself was recorded above, on
-        // arrival, whichever lobe is then chosen.
-        let mut chosen = None;
-        if material
+        let chosen = match path.pane(material, wo, &hit, &mut sampler, &mut wl) {
+            Pane::Absorbed => return,
+            Pane::Through => continue,
+            Pane::Scatter(chosen) => chosen,
+        };
+        if path.ends_at(world, material, black, stats) {
+            return;
+        }
+        if !path.scatter(world, &at, chosen, &mut sampler, &mut wl) {
+            return;
+        }
+    }
+}
+
+/// The state of a light path between its vertices: its flux, the ray it follows, and what
+/// Russian roulette and the depth limits need.
+struct LightPath {
+    /// Flux per path (W/nm at the path's wavelengths).
+    beta: SampledSpectrum,
+    /// The BSDF factors alone, for Russian roulette.
+    throughput: f32,
+    ray_o: Vec3,
+    ray_d: Vec3,
+    /// Scattering events so far, counting the surface being processed.
+    depth: u32,
+    /// Null events (straight through window panes) since the last scattering.
+    straight_through: u32,
+}
+
+/// What a window pane did with the path.
+enum Pane {
+    /// Nothing more comes along the path.
+    Absorbed,
+    /// Straight through: a null event, the ray goes on from the far side.
+    Through,
+    /// A lobe that scatters (reflection or a rough lobe), or None for another material.
+    Scatter(Option<crate::bxdf::BsdfSample>),
+}
+
+impl LightPath {
+    /// The path leaving its light, with its wavelengths and the lens point of its camera
+    /// connections; None when its sample carries nothing. Dimension sets led by their 2-D
+    /// pairs: point on the light and direction; light choice, primitive, wavelengths, target
+    /// cone; lens point. Bounces take one set each from dimension 12.
+    #[inline(always)]
+    fn start(
+        world: &World,
+        caustics: &CausticLights,
+        sampler: &mut Sampler,
+        stats: &mut RayStats,
+    ) -> Option<(Self, SampledWavelengths, Vec2)> {
+        let [px, py, dx, dy] = sampler.get4();
+        let [u_light, u_prim, u_wl, u_dir] = sampler.get4();
+        let [lx, ly, _, _] = sampler.get4();
+        stats.light_paths += 1;
+        let (k, p_select) = pick_from_cdf(&caustics.cdf, u_light);
+        if p_select <= 0.0 {
+            return None;
+        }
+        let light = &world.lights[caustics.lights[k] as usize];
+        let wl = SampledWavelengths::sample_visible(u_wl);
+        let u = (u_prim, u_dir, Vec2::new(px, py), Vec2::new(dx, dy));
+        let (origin, dir, beta) = leave_light(world, caustics, light, p_select, u, &wl)?;
+        let path = LightPath {
+            beta,
+            throughput: 1.0,
+            ray_o: origin,
+            ray_d: dir,
+            depth: 0,
+            straight_through: 0,
+        };
+        Some((path, wl, Vec2::new(lx, ly)))
+    }
+
+    /// A window pane: passing straight through is a null event, as for the camera paths
+    /// (not a scattering: the depth and the "first scattering is specular" rule are those of
+    /// the path without it). The illuminance on the pane itself is recorded on arrival,
+    /// whichever lobe is then chosen.
+    #[inline(always)]
+    fn pane(
+        &mut self,
+        material: &crate::bxdf::Material,
+        wo: Vec3,
+        hit: &crate::geometry::Hit,
+        sampler: &mut Sampler,
+        wl: &mut SampledWavelengths,
+    ) -> Pane {
+        if !material
             .flags()
             .contains(crate::bxdf::MaterialFlags::STRAIGHT_THROUGH)
         {
-            match choose_pane_lobe(material, wo, &mut sampler, &mut wl) {
-                None => return,
-                Some(PaneLobe::Straight(weight)) => {
-                    beta *= weight;
-                    depth -= 1;
-                    straight_through += 1;
-                    if beta.is_black() || straight_through > MAX_STRAIGHT_THROUGH {
-                        return;
-                    }
-                    ray_o = hit.spawn_origin(ray_d);
-                    continue;
+            return Pane::Scatter(None);
+        }
+        match choose_pane_lobe(material, wo, sampler, wl) {
+            None => Pane::Absorbed,
+            Some(PaneLobe::Straight(weight)) => {
+                self.beta *= weight;
+                self.depth -= 1;
+                self.straight_through += 1;
+                if self.beta.is_black() || self.straight_through > MAX_STRAIGHT_THROUGH {
+                    return Pane::Absorbed;
                 }
-                Some(PaneLobe::Scatter(bs)) => chosen = Some(bs),
+                self.ray_o = hit.spawn_origin(self.ray_d);
+                Pane::Through
             }
+            Some(PaneLobe::Scatter(bs)) => Pane::Scatter(Some(bs)),
         }
+    }
 
-        // Continue while a further surface is within the depth limit; the first scattering
-        // must be specular (the paths whose light-side end is non-specular are the camera
-        // paths' part).
+    /// Whether the path ends at this surface rather than scatter: it continues while a
+    /// further surface is within the depth limit, and its first scattering must be specular
+    /// (the paths whose light-side end is non-specular are the camera paths' part).
+    #[inline(always)]
+    fn ends_at(
+        &self,
+        world: &World,
+        material: &crate::bxdf::Material,
+        black: bool,
+        stats: &mut RayStats,
+    ) -> bool {
+        let depth = self.depth;
         if black || (depth == 1 && !material.flags().contains(crate::bxdf::MaterialFlags::DELTA)) {
-            return;
+            return true;
         }
-        if settings.max_depth.is_some_and(|max| depth >= max) {
+        if world.settings.max_depth.is_some_and(|max| depth >= max) {
             stats.truncated_paths += 1;
-            return;
+            return true;
         }
+        false
+    }
+
+    /// Continue the path by sampling the BSDF at `at` (or the pane's `chosen` lobe) with its
+    /// adjoint, then Russian roulette; false when the path ends.
+    #[inline(always)]
+    fn scatter(
+        &mut self,
+        world: &World,
+        at: &Vertex,
+        chosen: Option<crate::bxdf::BsdfSample>,
+        sampler: &mut Sampler,
+        wl: &mut SampledWavelengths,
+    ) -> bool {
+        let (material, hit, wo, wo_world) = (at.material, at.hit, at.wo, at.wo_world);
         let [ux, uy, uc, u_rr] = sampler.get4();
-        let Some(bs) = chosen.or_else(|| material.sample(wo, uc, Vec2::new(ux, uy), &mut wl))
-        else {
-            return;
+        let Some(bs) = chosen.or_else(|| material.sample(wo, uc, Vec2::new(ux, uy), wl)) else {
+            return false;
         };
-        if (depth == 1 && !bs.specular) || bs.pdf.is_nan() || bs.pdf <= 0.0 {
-            return;
+        if (self.depth == 1 && !bs.specular) || bs.pdf.is_nan() || bs.pdf <= 0.0 {
+            return false;
         }
-        let wi_world = frame.to_world(bs.wi);
-        if normal_map.is_some()
-            && crate::bxdf::normal_map::leaks(wo_world, wi_world, hit.ns, hit.ng)
-        {
-            return;
+        let wi_world = at.frame.to_world(bs.wi);
+        if at.normal_mapped && crate::bxdf::normal_map::leaks(wo_world, wi_world, hit.ns, hit.ng) {
+            return false;
         }
         // Adjoint BSDF: f·|cos|/pdf with the refraction's 1/η′² undone, and the
         // shading-normal correction.
         let k = bs.wi.z.abs() / bs.pdf
-            * material.eta_scale(wo, bs.wi, &wl)
+            * material.eta_scale(wo, bs.wi, wl)
             * shading_normal_correction(wo_world, wi_world, hit.ns, hit.ng);
-        beta *= bs.f * k;
-        throughput *= bs.f.max_component() * k;
-        if beta.is_black() || !k.is_finite() {
-            return;
+        self.beta *= bs.f * k;
+        self.throughput *= bs.f.max_component() * k;
+        if self.beta.is_black() || !k.is_finite() {
+            return false;
         }
-        if depth > settings.rr_depth {
-            let p = super::survival_probability(throughput);
+        if self.depth > world.settings.rr_depth {
+            let p = super::survival_probability(self.throughput);
             if u_rr < 1.0 - p {
-                return;
+                return false;
             }
-            beta = beta / p;
-            throughput /= p;
+            self.beta = self.beta / p;
+            self.throughput /= p;
         }
-        straight_through = 0;
-        ray_o = hit.spawn_origin(wi_world);
-        ray_d = wi_world.normalize();
+        self.straight_through = 0;
+        self.ray_o = hit.spawn_origin(wi_world);
+        self.ray_d = wi_world.normalize();
+        true
     }
 }
 

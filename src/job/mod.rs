@@ -4,11 +4,16 @@
 //! The command line, tests and other front ends call [`run`] and [`merge()`]; what they show
 //! while it runs comes through [`Progress`].
 
+mod checks;
 pub(crate) mod files;
 mod merge;
+mod resume;
 pub mod shard;
+mod writes;
 
 use crate::output::with_suffix;
+use checks::check_job;
+pub use checks::{check_target, check_threads, invalid_option, max_threads, InvalidOption};
 pub use files::would_replace;
 pub use files::{check_exposure, MAX_ABS_EXPOSURE_EV};
 use files::{
@@ -16,14 +21,16 @@ use files::{
     write_png, Planned,
 };
 pub use merge::{merge, merge_with, MergeOptions, MergeOutputs};
+use resume::start_film;
 pub use shard::Shard;
 pub use shard::ShardSummary;
+pub use writes::{error_text, Writes};
+use writes::{write_falsecolour, write_grids};
 
 use crate::film::Film;
-use crate::meter::{Estimate, GridStats};
-use crate::photometry::Quantity;
+use crate::meter::{Estimate, GridStats, Measurements, MeterSums};
 use crate::render::{PassStatus, Progressive, RenderResult, StopReason, TargetError};
-use crate::report::json::{grid_csv, report_json, write_text, ReportInput};
+use crate::report::json::{report_json, write_text, ReportInput};
 use crate::report::units::UnitSystem;
 use crate::scene::{self, Overrides};
 use crate::state::RenderState;
@@ -198,194 +205,6 @@ impl RenderOutputs {
     }
 }
 
-/// An option of a job with a value that no input can make valid (a thread count of 0, an
-/// exposure of NaN, …). The command line exits with code 2 for it, as for its other usage
-/// errors; the message names the command-line option.
-#[derive(Debug)]
-pub struct InvalidOption(pub String);
-
-impl std::fmt::Display for InvalidOption {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for InvalidOption {}
-
-/// An [`InvalidOption`] error.
-pub fn invalid_option(message: impl Into<String>) -> anyhow::Error {
-    InvalidOption(message.into()).into()
-}
-
-/// The error and its causes joined by ": ", like `{:#}`, but a cause whose text an outer
-/// message already contains (e.g. "cannot read scene file X: {source}" whose source is also
-/// the next cause in the chain) is not repeated.
-pub fn error_text(e: &anyhow::Error) -> String {
-    let mut msg = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if msg.is_empty() {
-            msg = text;
-        } else if !text.is_empty() && !msg.contains(&text) {
-            msg.push_str(": ");
-            msg.push_str(&text);
-        }
-    }
-    msg
-}
-
-/// Largest worker-thread count accepted: 16 per available core
-/// ([`std::thread::available_parallelism`]). More only adds contention and memory, and tens of
-/// thousands of threads make the process unresponsive.
-pub fn max_threads() -> usize {
-    16 * std::thread::available_parallelism().map_or(1, |n| n.get())
-}
-
-/// Refuses a thread count (named `flag` in the message) of 0 or above [`max_threads`].
-pub fn check_threads(flag: &str, n: usize) -> Result<()> {
-    if n == 0 {
-        return Err(invalid_option(format!("{flag} must be at least 1, got 0")));
-    }
-    let max = max_threads();
-    if n > max {
-        return Err(invalid_option(format!(
-            "{flag} {n} is too many: at most {max} threads are accepted (16 per available core, {} cores here)",
-            max / 16
-        )));
-    }
-    Ok(())
-}
-
-/// Refuses a target fraction outside (0, 1] or a luminance floor (cd/m²) that is negative or
-/// not finite; the messages name the command-line options.
-pub fn check_target(fraction: f64, floor_cd_m2: Option<f64>) -> Result<()> {
-    if !(fraction > 0.0 && fraction <= 1.0) {
-        return Err(invalid_option(format!(
-            "--target-fraction must lie in (0, 1], got {fraction}"
-        )));
-    }
-    if let Some(f) = floor_cd_m2 {
-        if !(f.is_finite() && f >= 0.0) {
-            return Err(invalid_option(format!(
-                "--target-floor must be a luminance ≥ 0 in cd/m², got {f}"
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// Checks the job's own settings (before the scene is read).
-fn check_job(job: &RenderJob) -> Result<()> {
-    if let Some(n) = job.threads {
-        check_threads("--threads", n)?;
-    }
-    check_exposure(job.exposure_ev)?;
-    if let Some(t) = &job.target {
-        check_target(t.fraction, t.floor_cd_m2)?;
-    }
-    if job.max_spp == Some(0) {
-        return Err(invalid_option("--max-spp must be at least 1"));
-    }
-    if job.overrides.spp == Some(0) {
-        return Err(invalid_option("--spp must be at least 1"));
-    }
-    if job.shard.is_some() && job.target.is_some() {
-        return Err(invalid_option(
-            "--shard splits a fixed number of samples per pixel among the shards; --target-error decides it pixel by pixel as the render goes, which separate shards cannot share: give --shard with --spp",
-        ));
-    }
-    if job.health.spectral_bands > crate::film::MAX_SPECTRAL_BANDS {
-        return Err(invalid_option(format!(
-            "--spectral-bands must be at most {}",
-            crate::film::MAX_SPECTRAL_BANDS
-        )));
-    }
-    if job.resume && job.overwrite {
-        return Err(invalid_option(
-            "--resume continues NAME.state and --overwrite replaces it: give one of them",
-        ));
-    }
-    Ok(())
-}
-
-/// The film to continue: from NAME.state with `resume` (refused if the scene, its settings or
-/// the adaptive mode changed), else a new one.
-fn initial_film(
-    job: &RenderJob,
-    world: &World,
-    hash: u64,
-    shard: Option<crate::state::ShardInfo>,
-    state_path: &Path,
-) -> Result<Film> {
-    let (w, h) = (world.camera.width, world.camera.height);
-    if !job.resume {
-        let mut film = if job.target.is_some() {
-            Film::new_adaptive(w, h)
-        } else {
-            Film::new(w, h)
-        };
-        film.pixel_batches = world.settings.pixel_batches;
-        return Ok(film);
-    }
-    let st = RenderState::load(state_path)?;
-
-    if st.scene_hash != hash || st.seed != world.settings.seed {
-        bail!(
-            "cannot resume from {}: the scene file {}, a file it refers to (mesh, spectrum, luminaire data) or its settings (seed, max depth, resolution, illuminance, caustics) changed since the state was written",
-            state_path.display(),
-            job.scene.display()
-        );
-    }
-    if st.shard != shard {
-        let what = |s: Option<crate::state::ShardInfo>| match s {
-            Some(s) => format!(
-                "shard {} of {} at {} samples per pixel",
-                s.index, s.count, s.spp
-            ),
-            None => "a whole render (no --shard)".to_string(),
-        };
-        bail!(
-            "cannot resume from {}: it holds {}, but this run asks for {}; rerun it as it was started, or start it again with --overwrite",
-            state_path.display(),
-            what(st.shard),
-            what(shard)
-        );
-    }
-    if (st.film.width, st.film.height) != (w, h) {
-        bail!(
-            "{} is corrupt: its film is {}×{} but the scene it was rendered from (whose hash it carries) renders {w}×{h}",
-            state_path.display(),
-            st.film.width,
-            st.film.height
-        );
-    }
-    if st.film.decision.is_some() != job.target.is_some() {
-        bail!(
-            "cannot resume from {}: it was {} a --target-error; resume it the same way",
-            state_path.display(),
-            if st.film.decision.is_some() {
-                "rendered with"
-            } else {
-                "rendered without"
-            }
-        );
-    }
-    let kept = st
-        .film
-        .health
-        .as_ref()
-        .map(|h| h.channels)
-        .unwrap_or_default();
-    if kept != job.health {
-        bail!(
-            "cannot resume from {}: it keeps the light-and-health channels {kept:?}, but this run asks for {:?}; resume it with the same --alpha-opic, --mesopic and --spectral-bands",
-            state_path.display(),
-            job.health
-        );
-    }
-    Ok(st.film)
-}
-
 /// Every file the job may write, with what it is (for messages): images, state, report, each
 /// grid's CSV and heat map, and the false-colour maps.
 fn planned_outputs(job: &RenderJob, world: &World, stem: &Path) -> Vec<Planned> {
@@ -442,6 +261,57 @@ pub fn run(
     stop: &AtomicBool,
 ) -> Result<RenderOutputs> {
     check_job(job)?;
+    let (world, hash) = load_scene(job)?;
+    let paths = JobPaths::new(job)?;
+    let plan = StatePlan::checked(job, &world, &paths)?;
+    let prog = progressive(job, &world);
+    let shard_info = job.shard.map(|s| s.info(prog.max_spp));
+    let mut film = start_film(job, &world, hash, shard_info, plan.resuming, &paths.state)?;
+    let resumed_samples = film.total_samples();
+    let files = JobFiles {
+        job,
+        world: &world,
+        hash,
+        shard_info,
+        paths: &paths,
+    };
+    progress.start(prog.max_spp as u64 * world.camera.inside_pixels() as u64)?;
+    let (result, done) = render(&files, &mut film, &prog, stop, progress)?;
+    let spp = result.film.samples_per_pixel();
+    let outputs = RenderOutputs::unmeasured(&paths, resumed_samples, result);
+    if done.reason == StopReason::Interrupted {
+        return interrupted_render(outputs, &files);
+    }
+    progress.rendered(&done);
+    let mut writes = Writes::default();
+    files.write_images(&outputs.render.film, &mut writes);
+    let (measured, measure_seconds) = measure(job, &world, stop);
+    let Some((measurements, meter_sums)) = measured else {
+        return interrupted_measuring(outputs, &files, plan.save_state, writes);
+    };
+    files.write_maps(&outputs.render.film, &measurements, &mut writes);
+    let written = writes.written.clone();
+    let report = report_json(&ReportInput {
+        scene_path: job.scene.as_path(),
+        world: &world,
+        render: &outputs.render,
+        measurements: &measurements,
+        measure_seconds,
+        units: job.units,
+        outputs: written.clone(),
+        progressive: progressive_json(job, &prog, &done, spp),
+    });
+    files.write_report(&report, &mut writes);
+    if plan.save_state {
+        files.write_state(&outputs.render.film, &meter_sums, &mut writes);
+    }
+    writes.finish()?;
+    Ok(outputs.measured(&world, &measurements, written))
+}
+
+/// The scene's world and the hash its render states carry (of the scene file, the files it
+/// refers to and its settings).
+fn load_scene(job: &RenderJob) -> Result<(World, u64)> {
     let scene_path = job.scene.as_path();
     let world = scene::load_world_for(
         scene_path,
@@ -458,43 +328,94 @@ pub fn run(
         scene_bytes.extend(format!("\0--camera {c}").bytes());
     }
     let hash = crate::state::scene_hash(&scene_bytes, &world);
-    let name = scene_path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "render".into());
-    let mut stem = output_stem(job.out.as_deref(), &name, &["exr", "png", "hdr"]);
-    if let Some(s) = &job.shard {
-        stem = with_suffix(&stem, &s.suffix());
+    Ok((world, hash))
+}
+
+/// The files of a job, named after its output stem (a shard's carrying its suffix).
+struct JobPaths {
+    stem: PathBuf,
+    exr: PathBuf,
+    png: PathBuf,
+    hdr: PathBuf,
+    spectral: PathBuf,
+    state: PathBuf,
+    report: PathBuf,
+}
+
+impl JobPaths {
+    /// The job's file names; refuses an output directory that does not exist.
+    fn new(job: &RenderJob) -> Result<Self> {
+        let name = job
+            .scene
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "render".into());
+        let mut stem = output_stem(job.out.as_deref(), &name, &["exr", "png", "hdr"]);
+        if let Some(s) = &job.shard {
+            stem = with_suffix(&stem, &s.suffix());
+        }
+        check_output_dir(&stem)?;
+        Ok(JobPaths {
+            exr: with_suffix(&stem, ".exr"),
+            png: with_suffix(&stem, ".png"),
+            hdr: with_suffix(&stem, ".hdr"),
+            spectral: with_suffix(&stem, ".spectral.exr"),
+            state: with_suffix(&stem, ".state"),
+            report: with_suffix(&stem, ".report.json"),
+            stem,
+        })
     }
-    let (exr_path, png_path) = (with_suffix(&stem, ".exr"), with_suffix(&stem, ".png"));
-    let hdr_path = with_suffix(&stem, ".hdr");
-    check_output_dir(&stem)?;
-    let state_path = with_suffix(&stem, ".state");
-    let report_path = with_suffix(&stem, ".report.json");
-    let (w, h) = (world.camera.width, world.camera.height);
-    let state_existed = state_path.exists();
-    // A shard continues its own state: the same command, requeued, picks up where it stopped.
-    let resuming = job.resume || (job.shard.is_some() && state_existed && !job.overwrite);
-    let save_state = job.save_state || resuming || state_existed || job.shard.is_some();
-    let mut inputs = vec![(job.scene.clone(), "the scene file".to_string())];
-    inputs.extend(
-        world
-            .sources
-            .iter()
-            .map(|p| (p.clone(), "the file the scene refers to".to_string())),
-    );
-    let need_bytes = if save_state {
-        state_bytes_at_least(w, h, job.target.is_some())
-    } else {
-        0
-    };
-    check_outputs(&planned_outputs(job, &world, &stem), &inputs, need_bytes)?;
-    if state_existed && !resuming && !job.overwrite {
-        bail!(
-            "{} holds the samples of an earlier render: continue it with --resume, or start again and replace it with --overwrite (or choose another --out)",
-            crate::limits::printable(&state_path.display().to_string(), 300)
+}
+
+/// What the job does with NAME.state: continue it, and write it at the end.
+struct StatePlan {
+    resuming: bool,
+    save_state: bool,
+}
+
+impl StatePlan {
+    /// The plan, once the outputs are checked (see [`run`]) and an existing state that the
+    /// job would neither continue nor be allowed to replace is refused.
+    fn checked(job: &RenderJob, world: &World, paths: &JobPaths) -> Result<Self> {
+        let (w, h) = (world.camera.width, world.camera.height);
+        let state_existed = paths.state.exists();
+        // A shard continues its own state: the same command, requeued, picks up where it
+        // stopped.
+        let resuming = job.resume || (job.shard.is_some() && state_existed && !job.overwrite);
+        let save_state = job.save_state || resuming || state_existed || job.shard.is_some();
+        let mut inputs = vec![(job.scene.clone(), "the scene file".to_string())];
+        inputs.extend(
+            world
+                .sources
+                .iter()
+                .map(|p| (p.clone(), "the file the scene refers to".to_string())),
         );
+        let need_bytes = if save_state {
+            state_bytes_at_least(w, h, job.target.is_some())
+        } else {
+            0
+        };
+        check_outputs(
+            &planned_outputs(job, world, &paths.stem),
+            &inputs,
+            need_bytes,
+        )?;
+        if state_existed && !resuming && !job.overwrite {
+            bail!(
+                "{} holds the samples of an earlier render: continue it with --resume, or start again and replace it with --overwrite (or choose another --out)",
+                crate::limits::printable(&paths.state.display().to_string(), 300)
+            );
+        }
+        Ok(StatePlan {
+            resuming,
+            save_state,
+        })
     }
+}
+
+/// The progressive render's settings: the samples per pixel, the stopping rules, and a
+/// shard's first sample and light path.
+fn progressive(job: &RenderJob, world: &World) -> Progressive {
     let mut prog = Progressive {
         max_spp: job
             .max_spp
@@ -510,60 +431,100 @@ pub fn run(
         first_sample: 0,
         first_light_path: 0,
     };
-    let shard_info = job.shard.map(|s| s.info(prog.max_spp));
     if let Some(s) = &job.shard {
         prog.first_sample = s.index as u64 * prog.max_spp as u64;
         prog.first_light_path = s.index as u64 * shard::LIGHT_PATHS_PER_SHARD;
     }
-    let resume_job = RenderJob {
-        resume: resuming,
-        ..job.clone()
-    };
-    let mut film = initial_film(&resume_job, &world, hash, shard_info, &state_path)?;
-    let resumed_samples = film.total_samples();
-    let illuminance = world.settings.illuminance;
-    if job.health.any() && film.health.is_none() {
-        let h = crate::film::HealthFilm::new(job.health, illuminance, w * h)
-            .map_err(anyhow::Error::msg)?;
-        film.health = Some(h);
-    }
-    let spectral_path = with_suffix(&stem, ".spectral.exr");
-    // The images before the state: on a nearly full disk the small files still get written.
-    let write_images = |film: &Film, writes: &mut Writes| {
-        writes.attempt(&exr_path, || {
-            write_exr(scene_path, film, illuminance, &world.camera, &exr_path)
+    prog
+}
+
+/// What the job writes of a film (images, state) and of its measurements (grids, maps,
+/// report).
+struct JobFiles<'a> {
+    job: &'a RenderJob,
+    world: &'a World,
+    hash: u64,
+    shard_info: Option<crate::state::ShardInfo>,
+    paths: &'a JobPaths,
+}
+
+impl JobFiles<'_> {
+    /// The images of `film`. They come before the state: on a nearly full disk the small
+    /// files still get written.
+    fn write_images(&self, film: &Film, writes: &mut Writes) {
+        let (scene_path, world, p) = (self.job.scene.as_path(), self.world, self.paths);
+        let illuminance = world.settings.illuminance;
+        writes.attempt(&p.exr, || {
+            write_exr(scene_path, film, illuminance, &world.camera, &p.exr)
         });
-        writes.attempt(&hdr_path, || write_hdr(film, &world.camera, &hdr_path));
+        writes.attempt(&p.hdr, || write_hdr(film, &world.camera, &p.hdr));
         // The PNG too, so that the image pair on disk is always of the same estimate.
-        writes.attempt(&png_path, || write_png(film, &png_path, job.exposure_ev));
+        writes.attempt(&p.png, || write_png(film, &p.png, self.job.exposure_ev));
         if let Some(layers) = crate::film::spectral_layers(film, &scene_path.display().to_string())
         {
-            writes.attempt(&spectral_path, || {
-                Ok(crate::output::write_exr(&spectral_path, &layers)?)
+            writes.attempt(&p.spectral, || {
+                Ok(crate::output::write_exr(&p.spectral, &layers)?)
             });
         }
-    };
-    let write_state = |film: &Film, meters: &[crate::meter::MeterSums], writes: &mut Writes| {
-        writes.attempt(&state_path, || {
+    }
+
+    /// NAME.state: `film` and a shard's meter sums.
+    fn write_state(&self, film: &Film, meters: &[crate::meter::MeterSums], writes: &mut Writes) {
+        writes.attempt(&self.paths.state, || {
             RenderState::save_film(
-                scene_path,
-                hash,
-                &world,
+                &self.job.scene,
+                self.hash,
+                self.world,
                 film,
-                shard_info,
+                self.shard_info,
                 meters,
-                &state_path,
+                &self.paths.state,
             )
         });
-    };
-    progress.start(prog.max_spp as u64 * world.camera.inside_pixels() as u64)?;
+    }
+
+    /// Each grid's CSV and heat map, and the false-colour maps of `film` when asked for.
+    fn write_maps(
+        &self,
+        film: &Film,
+        measurements: &crate::meter::Measurements,
+        writes: &mut Writes,
+    ) {
+        let (job, stem) = (self.job, &self.paths.stem);
+        write_grids(self.world, measurements, stem, job.units, writes);
+        if job.falsecolour {
+            let scene = job.scene.display().to_string();
+            let layers = files::film_layers(&scene, film, self.world.settings.illuminance);
+            write_falsecolour(self.world, &layers, stem, job.units, writes);
+        }
+    }
+
+    /// NAME.report.json.
+    fn write_report(&self, report: &serde_json::Value, writes: &mut Writes) {
+        let path = &self.paths.report;
+        writes.attempt(path, || {
+            write_text(path, &serde_json::to_string_pretty(report)?)?;
+            Ok(())
+        });
+    }
+}
+
+/// The progressive render into `film`, its passes shown through `progress` and its
+/// checkpoints written (one that cannot be written is a warning: the render goes on).
+fn render(
+    files: &JobFiles,
+    film: &mut Film,
+    prog: &Progressive,
+    stop: &AtomicBool,
+    progress: &mut dyn Progress,
+) -> Result<(RenderResult, ImageDone)> {
     let progress = std::cell::RefCell::new(progress);
     let mut last = PassStatus::default();
     let (result, reason) = crate::render::render_progressive(
-        &world,
-        &mut film,
-        job.threads,
-        &prog,
+        files.world,
+        film,
+        files.job.threads,
+        prog,
         stop,
         &mut |s| {
             last = *s;
@@ -571,8 +532,8 @@ pub fn run(
         },
         &mut |f| {
             let mut writes = Writes::default();
-            write_images(f, &mut writes);
-            write_state(f, &[], &mut writes);
+            files.write_images(f, &mut writes);
+            files.write_state(f, &[], &mut writes);
             for e in &writes.failed {
                 progress
                     .borrow_mut()
@@ -581,227 +542,145 @@ pub fn run(
             Ok(())
         },
     )?;
-    let progress = progress.into_inner();
-    let spp = result.film.samples_per_pixel();
-    let mut outputs = RenderOutputs {
-        outcome: Outcome::Finished,
-        exr_path: exr_path.clone(),
-        png_path: png_path.clone(),
-        state_path: state_path.clone(),
-        report_path: report_path.clone(),
-        outputs: Vec::new(),
-        resumed_samples,
-        render: result,
-        meters: Vec::new(),
-        grids: Vec::new(),
-        truncation: None,
-    };
-    let result = &outputs.render;
-    let mut writes = Writes::default();
-    if reason == StopReason::Interrupted {
-        outputs.outcome = if result.film.total_samples() == resumed_samples {
-            // No pass finished: an image of nothing new would replace the files of an earlier
-            // render (or the same state again).
-            Outcome::InterruptedBeforeFirstPass
-        } else {
-            write_images(&result.film, &mut writes);
-            write_state(&result.film, &[], &mut writes);
-            Outcome::InterruptedRender
-        };
-        writes.finish()?;
-        return Ok(outputs);
-    }
-    progress.rendered(&ImageDone {
+    let done = ImageDone {
         reason,
         last,
-        target: job.target,
-    });
-    write_images(&result.film, &mut writes);
-    let t_measure = std::time::Instant::now();
-    // A shard measures its share of every meter's samples and keeps their sums for the merge.
-    let measurements = match job.shard {
-        Some(s) => crate::meter::measure_shard_until(&world, s.index, s.count, stop),
-        None => crate::meter::measure_all_until(&world, stop).map(|m| (m, Vec::new())),
+        target: files.job.target,
     };
-    let measure_seconds = t_measure.elapsed().as_secs_f64();
-    let Some((measurements, meter_sums)) = measurements else {
-        if save_state {
-            write_state(&result.film, &[], &mut writes);
-        }
-        outputs.outcome = Outcome::InterruptedMeasuring;
-        writes.finish()?;
-        return Ok(outputs);
+    Ok((result, done))
+}
+
+/// The render was stopped: a checkpoint of its image and state, unless no pass finished (an
+/// image of nothing new would replace the files of an earlier render, or the same state
+/// again).
+fn interrupted_render(mut outputs: RenderOutputs, files: &JobFiles) -> Result<RenderOutputs> {
+    let mut writes = Writes::default();
+    let film = &outputs.render.film;
+    outputs.outcome = if film.total_samples() == outputs.resumed_samples {
+        Outcome::InterruptedBeforeFirstPass
+    } else {
+        files.write_images(film, &mut writes);
+        files.write_state(film, &[], &mut writes);
+        Outcome::InterruptedRender
     };
-    write_grids(&world, &measurements, &stem, job.units, &mut writes);
-    if job.falsecolour {
-        let layers =
-            files::film_layers(&scene_path.display().to_string(), &result.film, illuminance);
-        write_falsecolour(&world, &layers, &stem, job.units, &mut writes);
-    }
-    let written = writes.written.clone();
-    let report = report_json(&ReportInput {
-        scene_path,
-        world: &world,
-        render: result,
-        measurements: &measurements,
-        measure_seconds,
-        units: job.units,
-        outputs: written.clone(),
-        progressive: serde_json::json!({
-            "stop_reason": format!("{reason:?}"),
-            "passes": last.passes,
-            "max_spp": prog.max_spp,
-            "image_samples_per_pixel": spp,
-            "target_relative_error_95": job.target.map(|t| t.relative),
-            "target_fraction": job.target.map(|t| t.fraction),
-            "target_floor_cd_m2": job.target.and_then(|t| t.floor_cd_m2),
-            "fraction_of_eligible_pixels_at_target": last.converged_fraction,
-            "max_time_s": job.max_time.map(|d| d.as_secs_f64()),
-            "shard": job.shard.map(|s| serde_json::json!({
-                "index": s.index,
-                "count": s.count,
-                "first_sample": prog.first_sample,
-            })),
-        }),
-    });
-    writes.attempt(&report_path, || {
-        write_text(&report_path, &serde_json::to_string_pretty(&report)?)?;
-        Ok(())
-    });
-    if save_state {
-        write_state(&result.film, &meter_sums, &mut writes);
-    }
     writes.finish()?;
-    outputs.outputs = written;
-    outputs.truncation = crate::report::json::truncation_warning(
-        &world,
-        outputs.render.stats.truncated_paths + measurements.stats.truncated_paths,
-    );
-    outputs.meters = world
-        .meters
-        .iter()
-        .zip(&measurements.meters)
-        .enumerate()
-        .map(|(k, (m, e))| MeterResult {
-            name: m.name.clone(),
-            kind: m.kind.clone(),
-            estimate: *e,
-            ugr: m.ugr(&world, e),
-            melanopic: measurements.melanopic.get(k).copied().flatten(),
-        })
-        .collect();
-    outputs.grids = world
-        .grids
-        .iter()
-        .zip(&measurements.grids)
-        .map(|(g, est)| GridResult {
-            name: g.name.clone(),
-            nx: g.nx,
-            ny: g.ny,
-            stats: crate::meter::grid_stats(est),
-            non_finite: crate::meter::grid_non_finite(est),
-        })
-        .collect();
     Ok(outputs)
 }
 
-/// The outputs of the end of a job, each attempted whether or not an earlier one failed
-/// (also used by `annual` and `merge`).
-#[derive(Default)]
-pub struct Writes {
-    /// Files written, in order.
-    pub written: Vec<String>,
-    /// One line per file that could not be written, naming it.
-    pub failed: Vec<String>,
+/// Every meter and grid point, and the seconds it took; None if `stop` was raised meanwhile.
+/// A shard measures its share of every meter's samples and keeps their sums for the merge.
+fn measure(
+    job: &RenderJob,
+    world: &World,
+    stop: &AtomicBool,
+) -> (Option<(Measurements, Vec<MeterSums>)>, f64) {
+    let t_measure = std::time::Instant::now();
+    let measurements = match job.shard {
+        Some(s) => crate::meter::measure_shard_until(world, s.index, s.count, stop),
+        None => crate::meter::measure_all_until(world, stop).map(|m| (m, Vec::new())),
+    };
+    (measurements, t_measure.elapsed().as_secs_f64())
 }
 
-impl Writes {
-    pub fn attempt(&mut self, path: &Path, write: impl FnOnce() -> Result<()>) {
-        let shown = path.display().to_string();
-        match write() {
-            Ok(()) => self.written.push(shown),
-            Err(e) => {
-                let e = error_text(&e);
-                self.failed.push(if e.contains(&shown) {
-                    e
-                } else {
-                    format!("{shown}: {e}")
-                });
-            }
+/// The meters were stopped: the images are written (in `writes`), and the state when the job
+/// keeps one; no report.
+fn interrupted_measuring(
+    mut outputs: RenderOutputs,
+    files: &JobFiles,
+    save_state: bool,
+    mut writes: Writes,
+) -> Result<RenderOutputs> {
+    if save_state {
+        files.write_state(&outputs.render.film, &[], &mut writes);
+    }
+    outputs.outcome = Outcome::InterruptedMeasuring;
+    writes.finish()?;
+    Ok(outputs)
+}
+
+/// The report's account of the progressive render: why it stopped, its passes and samples,
+/// the target and a shard's place.
+fn progressive_json(
+    job: &RenderJob,
+    prog: &Progressive,
+    done: &ImageDone,
+    spp: f64,
+) -> serde_json::Value {
+    serde_json::json!({
+        "stop_reason": format!("{:?}", done.reason),
+        "passes": done.last.passes,
+        "max_spp": prog.max_spp,
+        "image_samples_per_pixel": spp,
+        "target_relative_error_95": job.target.map(|t| t.relative),
+        "target_fraction": job.target.map(|t| t.fraction),
+        "target_floor_cd_m2": job.target.and_then(|t| t.floor_cd_m2),
+        "fraction_of_eligible_pixels_at_target": done.last.converged_fraction,
+        "max_time_s": job.max_time.map(|d| d.as_secs_f64()),
+        "shard": job.shard.map(|s| serde_json::json!({
+            "index": s.index,
+            "count": s.count,
+            "first_sample": prog.first_sample,
+        })),
+    })
+}
+
+impl RenderOutputs {
+    /// The outputs of a job whose render ended with `render` (finished until its meters say
+    /// otherwise), before anything is measured.
+    fn unmeasured(paths: &JobPaths, resumed_samples: u64, render: RenderResult) -> Self {
+        RenderOutputs {
+            outcome: Outcome::Finished,
+            exr_path: paths.exr.clone(),
+            png_path: paths.png.clone(),
+            state_path: paths.state.clone(),
+            report_path: paths.report.clone(),
+            outputs: Vec::new(),
+            resumed_samples,
+            render,
+            meters: Vec::new(),
+            grids: Vec::new(),
+            truncation: None,
         }
     }
 
-    /// One error listing every file that could not be written, if any.
-    pub fn finish(self) -> Result<()> {
-        match self.failed.len() {
-            0 => Ok(()),
-            1 => bail!("{}", self.failed[0]),
-            n => bail!(
-                "{n} files could not be written (the other outputs were):\n  {}",
-                self.failed.join("\n  ")
-            ),
-        }
-    }
-}
-
-/// Each grid's CSV and heat map, named after the grid.
-fn write_grids(
-    world: &World,
-    measurements: &crate::meter::Measurements,
-    stem: &Path,
-    units: UnitSystem,
-    writes: &mut Writes,
-) {
-    for (k, (g, est)) in world.grids.iter().zip(&measurements.grids).enumerate() {
-        let path = grid_csv_path(stem, &g.name);
-        writes.attempt(&path, || {
-            write_text(&path, &grid_csv(world, k, est, units))?;
-            Ok(())
-        });
-        let png = path.with_extension("png");
-        let values = crate::report::heatmap::GridValues {
-            name: g.name.clone(),
-            nx: g.nx as usize,
-            ny: g.ny as usize,
-            values: est.iter().map(|e| e.mean).collect(),
-            stderr: est.iter().map(|e| e.stderr).collect(),
-            size_m: (g.edge_u.length() as f64, g.edge_v.length() as f64),
-        };
-        let settings = crate::report::falsecolour::FalsecolourSettings {
-            quantity: Quantity::Illuminance,
-            units,
-            ..Default::default()
-        };
-        writes.attempt(&png, || {
-            crate::report::heatmap::write_grid_heatmap(&png, &values, &settings)?;
-            Ok(())
-        });
-    }
-}
-
-/// False-colour maps of the image (the EXR's channels): luminance, and illuminance when it was
-/// estimated.
-fn write_falsecolour(
-    world: &World,
-    layers: &crate::output::Layers,
-    stem: &Path,
-    units: UnitSystem,
-    writes: &mut Writes,
-) {
-    let mut quantities = vec![(Quantity::Luminance, ".luminance.png")];
-    if world.settings.illuminance {
-        quantities.push((Quantity::Illuminance, ".illuminance.png"));
-    }
-    for (q, suffix) in quantities {
-        let path = with_suffix(stem, suffix);
-        let settings = crate::report::falsecolour::FalsecolourSettings {
-            quantity: q,
-            units,
-            ..Default::default()
-        };
-        writes.attempt(&path, || {
-            crate::report::falsecolour::write_falsecolour(&path, layers, &settings)?;
-            Ok(())
-        });
+    /// The finished job's outputs: the files `written`, the truncation warning, and each
+    /// meter's and grid's result.
+    fn measured(
+        mut self,
+        world: &World,
+        measurements: &Measurements,
+        written: Vec<String>,
+    ) -> Self {
+        self.outputs = written;
+        self.truncation = crate::report::json::truncation_warning(
+            world,
+            self.render.stats.truncated_paths + measurements.stats.truncated_paths,
+        );
+        self.meters = world
+            .meters
+            .iter()
+            .zip(&measurements.meters)
+            .enumerate()
+            .map(|(k, (m, e))| MeterResult {
+                name: m.name.clone(),
+                kind: m.kind.clone(),
+                estimate: *e,
+                ugr: m.ugr(world, e),
+                melanopic: measurements.melanopic.get(k).copied().flatten(),
+            })
+            .collect();
+        self.grids = world
+            .grids
+            .iter()
+            .zip(&measurements.grids)
+            .map(|(g, est)| GridResult {
+                name: g.name.clone(),
+                nx: g.nx,
+                ny: g.ny,
+                stats: crate::meter::grid_stats(est),
+                non_finite: crate::meter::grid_non_finite(est),
+            })
+            .collect();
+        self
     }
 }
