@@ -211,13 +211,16 @@ impl MergePaths {
     }
 }
 
+/// Loaded states, each with the file it came from.
+type Loaded<'a> = Vec<(&'a PathBuf, RenderState)>;
+
 /// The states to merge, loaded, in the order of their shard index when they are the shards
 /// of one render (with which shards they are); refuses fewer than two states that are not
 /// shards.
 fn load_states(
     states: &[PathBuf],
     partial: bool,
-) -> Result<(Vec<(&PathBuf, RenderState)>, Option<ShardSummary>)> {
+) -> Result<(Loaded<'_>, Option<ShardSummary>)> {
     if states.is_empty() {
         bail!("nothing to merge: no state files given");
     }
