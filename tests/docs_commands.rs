@@ -167,6 +167,39 @@ fn shell_blocks(page: &str, text: &str) -> Vec<Vec<DocLine>> {
     blocks
 }
 
+/// Lines of `text`'s other fenced blocks (```text, untagged, …) that are candela commands: a
+/// command shown outside a ```sh block would go unrun.
+fn commands_outside_shell_blocks(page: &str, text: &str) -> Vec<String> {
+    let mut inside: Option<bool> = None; // Some(is a shell block) within a fence
+    let mut stray = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.trim_start();
+        if let Some(tag) = line.strip_prefix("```") {
+            inside = match inside {
+                Some(_) => None,
+                None => Some(["sh", "bash", "shell"].contains(&tag.trim())),
+            };
+        } else if inside == Some(false) && is_candela_command(line) {
+            stray.push(format!(
+                "{page}:{}: `{}` is in a fenced block other than ```sh, where it would go \
+                 unrun: show it in a ```sh block",
+                i + 1,
+                line.trim_end()
+            ));
+        }
+    }
+    stray
+}
+
+/// `candela SUBCOMMAND …`, a subcommand being a lowercase word.
+fn is_candela_command(line: &str) -> bool {
+    let mut words = line.split_whitespace();
+    words.next() == Some("candela")
+        && words
+            .next()
+            .is_some_and(|w| w.chars().all(|c| c.is_ascii_lowercase() || c == '-'))
+}
+
 /// A shell word or operator of a line, quotes removed.
 #[derive(Debug, PartialEq)]
 enum Token {
@@ -504,13 +537,24 @@ struct Tally {
     timings: Vec<(String, Duration, Duration)>,
     not_run: Vec<Vec<String>>,
     aliases_used: Vec<bool>,
-    text: String,
+    /// Which [`PREPARED`] files a command run names.
+    prepared_used: Vec<bool>,
+}
+
+fn note_prepared(code: &str, used: &mut [bool]) {
+    for cmd in commands(&tokenize(code).0) {
+        for (i, (name, _)) in PREPARED.iter().enumerate() {
+            used[i] |= cmd.iter().any(|w| w == name);
+        }
+    }
 }
 
 /// Runs the blocks of one page in a fresh scratch directory.
 fn run_page(repo: &Path, page: &str, bin: &Path, tally: &mut Tally) {
     let text = std::fs::read_to_string(repo.join(page)).unwrap();
-    tally.text += &text;
+    tally
+        .failures
+        .extend(commands_outside_shell_blocks(page, &text));
     let blocks = shell_blocks(page, &text);
     if blocks.is_empty() {
         return;
@@ -529,6 +573,7 @@ fn run_page(repo: &Path, page: &str, bin: &Path, tally: &mut Tally) {
                     code,
                     expect_failure,
                 } => {
+                    note_prepared(&code, &mut tally.prepared_used);
                     let o = run(&code, &cwd, bin, logs.path());
                     eprintln!(
                         "{:>6.1} s cpu {:>6.1} s wall  {}: {code}",
@@ -586,10 +631,10 @@ fn stale_entries(tally: &Tally) -> Vec<String> {
             ));
         }
     }
-    for (name, _) in PREPARED {
-        if !tally.text.contains(name) {
+    for (i, (name, _)) in PREPARED.iter().enumerate() {
+        if !tally.prepared_used[i] {
             stale.push(format!(
-                "PREPARED makes {name}, which no page names any more"
+                "PREPARED makes {name}, which no command names any more"
             ));
         }
     }
@@ -642,6 +687,7 @@ fn every_documented_command_runs() {
     let mut tally = Tally {
         not_run: vec![Vec::new(); NOT_RUN.len()],
         aliases_used: vec![false; ALIASES.len()],
+        prepared_used: vec![false; PREPARED.len()],
         ..Tally::default()
     };
     let start = Instant::now();
@@ -696,4 +742,6 @@ fn lines_are_read_as_the_shell_reads_them() {
     assert_eq!(blocks.len(), 1);
     assert_eq!(blocks[0][0].line, 2);
     assert_eq!(blocks[0][0].text, "candela render a    --spp 4");
+    let stray = "```text\ncandela annual s.ron  # x\ncandela: error\n```\n```sh\ncandela x\n```\n";
+    assert_eq!(commands_outside_shell_blocks("p", stray).len(), 1);
 }
