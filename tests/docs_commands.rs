@@ -191,10 +191,14 @@ fn commands_outside_shell_blocks(page: &str, text: &str) -> Vec<String> {
     stray
 }
 
-/// `candela SUBCOMMAND …`, a subcommand being a lowercase word.
+/// `candela SUBCOMMAND …`, a subcommand being a lowercase word; not a synopsis (`[OPTION]`,
+/// `a|b`, or a placeholder in capitals such as `VALUE`).
 fn is_candela_command(line: &str) -> bool {
+    let placeholder = |w: &str| w.len() > 1 && w.chars().all(|c| c.is_ascii_uppercase());
+    let synopsis = line.contains(['[', '|']) || line.split_whitespace().any(placeholder);
     let mut words = line.split_whitespace();
-    words.next() == Some("candela")
+    !synopsis
+        && words.next() == Some("candela")
         && words
             .next()
             .is_some_and(|w| w.chars().all(|c| c.is_ascii_lowercase() || c == '-'))
@@ -744,4 +748,9 @@ fn lines_are_read_as_the_shell_reads_them() {
     assert_eq!(blocks[0][0].text, "candela render a    --spp 4");
     let stray = "```text\ncandela annual s.ron  # x\ncandela: error\n```\n```sh\ncandela x\n```\n";
     assert_eq!(commands_outside_shell_blocks("p", stray).len(), 1);
+    assert!(!is_candela_command("candela convert VALUE FROM TO"));
+    assert!(!is_candela_command(
+        "candela probe NAME.exr X Y [--radius R]"
+    ));
+    assert!(is_candela_command("candela spectrum LED-B3"));
 }
