@@ -33,9 +33,6 @@
 //!
 //! A failure names the page and line, the command, its exit status and its stderr.
 
-#[path = "common/weather.rs"]
-mod weather;
-
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -50,36 +47,10 @@ const TOTAL_BUDGET: Duration = Duration::from_secs(480);
 const KILL_AFTER: Duration = Duration::from_secs(600);
 
 /// Commands the docs show that this test does not run: (the command's first words, why).
-const NOT_RUN: &[(&str, &str)] = &[
-    (
-        "bash scripts/test.sh",
-        "CI itself: the script runs this test",
-    ),
-    (
-        "scripts/setup_python.sh",
-        "installs the Python references into target/venv; scripts/test.sh runs it first",
-    ),
-    (
-        "cargo test",
-        "a test of this suite; scripts/test.sh runs them all",
-    ),
-    (
-        "pip install .",
-        "builds the Python module; scripts/test.sh builds it with maturin and runs tests/python",
-    ),
-    (
-        "bash examples/slurm/submit.sh",
-        "submits to a Slurm cluster; tests/slurm.rs runs it on a one-node cluster",
-    ),
-    (
-        "bash scripts/hostile.sh",
-        "writes ~250 MB and runs for minutes; tests/hostile_*.rs check its cases at test size",
-    ),
-    (
-        "bash bench/mitsuba.sh",
-        "a comparison with Mitsuba 3 (installed by bench/setup_mitsuba.sh), minutes per scene",
-    ),
-];
+const NOT_RUN: &[(&str, &str)] = &[(
+    "bash scripts/test.sh",
+    "CI itself: the script runs this test",
+)];
 
 /// Other spellings of the candela command: (the spelling, why it is the binary under test).
 const ALIASES: &[(&str, &str)] = &[(
@@ -92,28 +63,10 @@ const ALIASES: &[(&str, &str)] = &[(
 const COPIED: &[&str] = &["scenes", "data", "examples"];
 
 /// Files made in each scratch directory: (name, why).
-const PREPARED: &[(&str, &str)] = &[
-    (
-        "lyon.epw",
-        "the reader's weather file of the annual examples: a synthetic year \
-         (tests/common/weather.rs; scripts/synthetic_epw.py needs Python)",
-    ),
-    (
-        "office.ron",
-        "the reader's own scene of docs/cluster.md: scenes/office.ron, its luminaire paths \
-         made relative to the scratch directory",
-    ),
-];
+const PREPARED: &[(&str, &str)] = &[];
 
-fn prepare_file(name: &str, dir: &Path) {
-    match name {
-        "lyon.epw" => weather::synthetic_year(&dir.join(name)),
-        "office.ron" => {
-            let text = std::fs::read_to_string(dir.join("scenes/office.ron")).unwrap();
-            std::fs::write(dir.join(name), text.replace("\"../data/", "\"data/")).unwrap();
-        }
-        _ => unreachable!("PREPARED names {name} but prepare_file does not make it"),
-    }
+fn prepare_file(name: &str, _dir: &Path) {
+    panic!("PREPARED names {name} but prepare_file does not make it")
 }
 
 /// One logical line of a shell block: its text (continuations joined) and where it starts.

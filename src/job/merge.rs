@@ -217,10 +217,7 @@ type Loaded<'a> = Vec<(&'a PathBuf, RenderState)>;
 /// The states to merge, loaded, in the order of their shard index when they are the shards
 /// of one render (with which shards they are); refuses fewer than two states that are not
 /// shards.
-fn load_states(
-    states: &[PathBuf],
-    partial: bool,
-) -> Result<(Loaded<'_>, Option<ShardSummary>)> {
+fn load_states(states: &[PathBuf], partial: bool) -> Result<(Loaded<'_>, Option<ShardSummary>)> {
     if states.is_empty() {
         bail!("nothing to merge: no state files given");
     }

@@ -1,6 +1,8 @@
 //! Helpers shared by the render tests: build a world from RON text, render, summarise.
 #![allow(dead_code)]
 
+pub mod weather;
+
 use candela::film::Film;
 use candela::scene::{self, Overrides};
 use candela::world::World;
