@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Side-by-side benchmark of candela against Mitsuba 3 on scenes/bench-cornell.ron (issue 7).
+"""Side-by-side benchmark of candela against Mitsuba 3 on scenes/bench-cornell.ron.
 
 Run it through bench/mitsuba.sh (which installs Mitsuba into target/bench-venv and builds
 candela first); see bench/README.md for what is measured and how. Outline:

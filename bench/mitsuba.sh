@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The candela vs Mitsuba 3 benchmark in one command (issue 7; see bench/README.md):
+# The candela vs Mitsuba 3 benchmark in one command (see bench/README.md):
 #
 #   bash bench/mitsuba.sh                 # setup, build, references (cached), 3 alternated rounds
 #   bash bench/mitsuba.sh --reps 5 --check

@@ -5,7 +5,7 @@
 //! observers, narrow spectral lines across 360–830 nm, seeded random smooth spectra),
 //! computes every quantity with candela, asks `scripts/colour_reference.py` (run with the
 //! pinned colour-science in the project venv) for the same quantities, and fails on any
-//! deviation beyond the tolerances of issue 3.  It prints the number of cases and the
+//! deviation beyond the tolerance each check gives.  It prints the number of cases and the
 //! largest deviation per quantity.
 //!
 //! Python: `$CANDELA_PYTHON` if set, else `<repo>/target/venv/bin/python` (created by
