@@ -478,6 +478,49 @@ pub enum MaterialDesc {
         #[serde(default)]
         distribution: DistributionDesc,
     },
+    /// Lambertian plus a normalised Ward lobe (docs/ward.md): ρd + ρs ≤ 1; roughness α in
+    /// [0, 1] (0: a mirror), `roughness_v` makes it anisotropic with α along `orientation`.
+    Ward {
+        #[serde(default = "zero_spectrum")]
+        diffuse: SpectrumDesc,
+        specular: SpectrumDesc,
+        #[serde(default)]
+        roughness: f32,
+        #[serde(default)]
+        roughness_v: Option<f32>,
+        #[serde(default)]
+        orientation: Option<[f32; 3]>,
+        #[serde(default)]
+        fresnel: bool,
+    },
+    /// Radiance `plastic`: red green blue spec rough, mapped onto `Ward` (docs/ward.md).
+    RadiancePlastic {
+        colour: SpectrumDesc,
+        specular: f32,
+        roughness: f32,
+    },
+    /// Radiance `metal` (specular coloured), mapped onto `Ward`.
+    RadianceMetal {
+        colour: SpectrumDesc,
+        specular: f32,
+        roughness: f32,
+    },
+    /// Radiance `plastic2`: orientation ux uy uz, then red green blue spec urough vrough.
+    RadiancePlastic2 {
+        orientation: [f32; 3],
+        colour: SpectrumDesc,
+        specular: f32,
+        roughness_u: f32,
+        roughness_v: f32,
+    },
+    /// Radiance `metal2` (specular coloured).
+    RadianceMetal2 {
+        orientation: [f32; 3],
+        colour: SpectrumDesc,
+        specular: f32,
+        roughness_u: f32,
+        roughness_v: f32,
+    },
     /// Absorbs all light.
     Black,
     /// `material` under a tangent-space normal map (docs/scene-format.md → normal maps).

@@ -197,7 +197,7 @@ fn trace_impl<T: FnMut(Vec3, SampledSpectrum)>(
         if material.flags().contains(crate::bxdf::MaterialFlags::BLACK) {
             break;
         }
-        let frame = Frame::from_normal(hit.ns);
+        let frame = material.shading_frame(hit.ns);
         let wo = frame.to_local(-path.ray_d);
         if wo.z == 0.0 {
             break;
