@@ -175,7 +175,7 @@ pub fn trace_light_path(
         let black = material.flags().contains(crate::bxdf::MaterialFlags::BLACK);
         path.depth += 1;
         material.prepare(&mut wl);
-        let frame = Frame::from_normal(hit.ns);
+        let frame = material.shading_frame(hit.ns);
         let wo_world = -path.ray_d;
         let wo = frame.to_local(wo_world);
         if wo.z == 0.0 {
