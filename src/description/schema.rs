@@ -521,6 +521,37 @@ pub enum MaterialDesc {
         roughness_u: f32,
         roughness_v: f32,
     },
+    /// Translucent sheet, two-sided (docs/fenestration.md): diffuse reflectance and
+    /// transmittance, specular transmittance (spectra in [0, 1]), uncoloured specular
+    /// reflectance, roughness α (0: mirror and straight through) and Radiance's Fresnel
+    /// estimate on a pure surface; the four coefficients sum to at most 1 at every wavelength.
+    Translucent {
+        #[serde(default = "zero_spectrum")]
+        reflectance: SpectrumDesc,
+        #[serde(default = "zero_spectrum")]
+        transmittance: SpectrumDesc,
+        #[serde(default = "zero_spectrum")]
+        specular_transmittance: SpectrumDesc,
+        #[serde(default)]
+        specular: f32,
+        #[serde(default)]
+        roughness: f32,
+        #[serde(default)]
+        fresnel: bool,
+    },
+    /// Radiance's `trans` material: `colour` (red green blue), `specular` (spec), `roughness`
+    /// (rough), `transmissivity` (trans), `transmitted_specular` (tspec); converted to a
+    /// `Translucent` (docs/fenestration.md).
+    RadianceTrans {
+        colour: SpectrumDesc,
+        #[serde(default)]
+        specular: f32,
+        #[serde(default)]
+        roughness: f32,
+        transmissivity: f32,
+        #[serde(default)]
+        transmitted_specular: f32,
+    },
     /// Absorbs all light.
     Black,
     /// `material` under a tangent-space normal map (docs/scene-format.md → normal maps).

@@ -412,7 +412,17 @@ impl Path {
                 stats.bounce_rays += 1;
                 Pane::Through
             }
-            Some(PaneLobe::Scatter(bs)) => Pane::Scatter(Some(bs)),
+            Some(PaneLobe::Scatter(mut bs)) => {
+                // Light sampling at this vertex happens only when the pane scatters (probability
+                // 1 − q): it is weighed by 1/(1 − q), and the sampled lobe's weight keeps its
+                // value (and its pdf, which MIS shares with light sampling).
+                let q = material.straight_probability(wo);
+                if q > 0.0 && q < 1.0 {
+                    self.beta = self.beta / (1.0 - q);
+                    bs.f = bs.f * (1.0 - q);
+                }
+                Pane::Scatter(Some(bs))
+            }
         }
     }
 
