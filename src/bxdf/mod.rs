@@ -29,8 +29,8 @@ pub mod normal_map;
 pub mod oren_nayar;
 pub mod phong;
 pub mod thin_dielectric;
-pub mod ward;
 pub mod translucent;
+pub mod ward;
 
 use crate::description::context::{Context, SceneError};
 use crate::description::schema::MaterialDesc;
@@ -46,8 +46,8 @@ pub use microfacet::{Distribution, Masking, Microfacet};
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use thin_dielectric::ThinDielectric;
-pub use ward::{Ward, WardLobe};
 pub use translucent::Translucent;
+pub use ward::{Ward, WardLobe};
 
 /// Every material the renderer knows. The integrator only calls the methods below, so a new
 /// family is one new variant and one new file.

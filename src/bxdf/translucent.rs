@@ -297,7 +297,9 @@ impl Translucent {
         if !self.pure() {
             let a2 = self.roughness * self.roughness;
             if reflect {
-                f += SampledSpectrum::splat(self.specular * WardLobe::isotropic(self.roughness).eval(o, i));
+                f += SampledSpectrum::splat(
+                    self.specular * WardLobe::isotropic(self.roughness).eval(o, i),
+                );
             } else {
                 f += self.specular_transmittance.sample(wl) * gaussian_transmission(o, i, a2);
             }

@@ -5,4 +5,5 @@
 //! scene builder (`crate::scene`) only dispatches.
 
 pub mod context;
+pub mod material;
 pub mod schema;
