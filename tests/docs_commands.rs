@@ -678,7 +678,7 @@ fn lines_are_read_as_the_shell_reads_them() {
         plan("cd /shared/renders", &mut used),
         Plan::Cd("/shared/renders".into())
     );
-    let c = "CANDELA=/opt/candela bash examples/slurm/submit.sh office.ron office 8 64";
+    let c = "CANDELA_PYTHON=/usr/bin/python3 bash scripts/test.sh --test scenes";
     assert!(matches!(plan(c, &mut used), Plan::NotRun(_)));
     assert!(matches!(
         plan("ls -l && candela x", &mut used),
