@@ -226,113 +226,18 @@ impl Material {
                 *roughness,
                 *distribution,
             )?),
-            MaterialDesc::Ward {
-                diffuse,
-                specular,
-                roughness,
-                roughness_v,
-                orientation,
-                fresnel,
-            } => Material::Ward(Ward::build(
-                ctx,
-                field,
-                diffuse,
-                specular,
-                *roughness,
-                *roughness_v,
-                *orientation,
-                *fresnel,
-            )?),
-            MaterialDesc::RadiancePlastic {
-                colour,
-                specular,
-                roughness,
-            } => Material::Ward(Ward::from_radiance(
-                ctx,
-                field,
-                ward::RadianceKind::Plastic,
-                colour,
-                *specular,
-                (*roughness, *roughness),
-                None,
-            )?),
-            MaterialDesc::RadianceMetal {
-                colour,
-                specular,
-                roughness,
-            } => Material::Ward(Ward::from_radiance(
-                ctx,
-                field,
-                ward::RadianceKind::Metal,
-                colour,
-                *specular,
-                (*roughness, *roughness),
-                None,
-            )?),
-            MaterialDesc::RadiancePlastic2 {
-                orientation,
-                colour,
-                specular,
-                roughness_u,
-                roughness_v,
-            } => Material::Ward(Ward::from_radiance(
-                ctx,
-                field,
-                ward::RadianceKind::Plastic,
-                colour,
-                *specular,
-                (*roughness_u, *roughness_v),
-                Some(*orientation),
-            )?),
-            MaterialDesc::RadianceMetal2 {
-                orientation,
-                colour,
-                specular,
-                roughness_u,
-                roughness_v,
-            } => Material::Ward(Ward::from_radiance(
-                ctx,
-                field,
-                ward::RadianceKind::Metal,
-                colour,
-                *specular,
-                (*roughness_u, *roughness_v),
-                Some(*orientation),
-            )?),
-            MaterialDesc::Translucent {
-                reflectance,
-                transmittance,
-                specular_transmittance,
-                specular,
-                roughness,
-                fresnel,
-            } => Material::Translucent(std::sync::Arc::new(Translucent::build(
-                ctx,
-                field,
-                reflectance,
-                transmittance,
-                specular_transmittance,
-                *specular,
-                *roughness,
-                *fresnel,
-            )?)),
-            MaterialDesc::RadianceTrans {
-                colour,
-                specular,
-                roughness,
-                transmissivity,
-                transmitted_specular,
-            } => Material::Translucent(std::sync::Arc::new(Translucent::build_radiance(
-                ctx,
-                field,
-                colour,
-                [
-                    *specular,
-                    *roughness,
-                    *transmissivity,
-                    *transmitted_specular,
-                ],
-            )?)),
+            MaterialDesc::Ward { .. }
+            | MaterialDesc::RadiancePlastic { .. }
+            | MaterialDesc::RadianceMetal { .. }
+            | MaterialDesc::RadiancePlastic2 { .. }
+            | MaterialDesc::RadianceMetal2 { .. } => {
+                Material::Ward(Ward::from_desc(ctx, field, desc)?)
+            }
+            MaterialDesc::Translucent { .. } | MaterialDesc::RadianceTrans { .. } => {
+                Material::Translucent(std::sync::Arc::new(Translucent::from_desc(
+                    ctx, field, desc,
+                )?))
+            }
             MaterialDesc::Black => Material::Black,
             MaterialDesc::NormalMapped {
                 material,

@@ -24,7 +24,7 @@
 use super::ward::{radiance_fresnel, WardLobe};
 use super::{BsdfSample, MaterialFlags};
 use crate::description::context::{Context, Role, SceneError};
-use crate::description::schema::SpectrumDesc;
+use crate::description::schema::{MaterialDesc, SpectrumDesc};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
@@ -493,6 +493,52 @@ fn check_sum(
         });
     }
     Ok(())
+}
+
+impl Translucent {
+    /// The material of a `Translucent` or Radiance `trans` description at `field`; any other
+    /// description is a caller's error.
+    pub fn from_desc(ctx: &Context, field: &str, desc: &MaterialDesc) -> Result<Self, SceneError> {
+        Ok(match desc {
+            MaterialDesc::Translucent {
+                reflectance,
+                transmittance,
+                specular_transmittance,
+                specular,
+                roughness,
+                fresnel,
+            } => Translucent::build(
+                ctx,
+                field,
+                reflectance,
+                transmittance,
+                specular_transmittance,
+                *specular,
+                *roughness,
+                *fresnel,
+            )?,
+            MaterialDesc::RadianceTrans {
+                colour,
+                specular,
+                roughness,
+                transmissivity,
+                transmitted_specular,
+            } => Translucent::build_radiance(
+                ctx,
+                field,
+                colour,
+                [
+                    *specular,
+                    *roughness,
+                    *transmissivity,
+                    *transmitted_specular,
+                ],
+            )?,
+            _ => {
+                unreachable!("Translucent::from_desc is called with translucent descriptions only")
+            }
+        })
+    }
 }
 
 #[cfg(test)]

@@ -14,7 +14,7 @@
 
 use super::{same_hemisphere, BsdfSample, Frame, MaterialFlags};
 use crate::description::context::{Context, Role, SceneError};
-use crate::description::schema::SpectrumDesc;
+use crate::description::schema::{MaterialDesc, SpectrumDesc};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths, N_LAMBDA};
 use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
@@ -446,4 +446,87 @@ fn direction(ctx: &Context, field: &str, o: [f32; 3]) -> Result<Vec3, SceneError
         ));
     }
     Ok(v.normalize())
+}
+
+impl Ward {
+    /// The material of a `Ward` or Radiance `plastic`/`metal`/`plastic2`/`metal2` description
+    /// at `field`; any other description is a caller's error.
+    pub fn from_desc(ctx: &Context, field: &str, desc: &MaterialDesc) -> Result<Self, SceneError> {
+        Ok(match desc {
+            MaterialDesc::Ward {
+                diffuse,
+                specular,
+                roughness,
+                roughness_v,
+                orientation,
+                fresnel,
+            } => Ward::build(
+                ctx,
+                field,
+                diffuse,
+                specular,
+                *roughness,
+                *roughness_v,
+                *orientation,
+                *fresnel,
+            )?,
+            MaterialDesc::RadiancePlastic {
+                colour,
+                specular,
+                roughness,
+            } => Ward::from_radiance(
+                ctx,
+                field,
+                RadianceKind::Plastic,
+                colour,
+                *specular,
+                (*roughness, *roughness),
+                None,
+            )?,
+            MaterialDesc::RadianceMetal {
+                colour,
+                specular,
+                roughness,
+            } => Ward::from_radiance(
+                ctx,
+                field,
+                RadianceKind::Metal,
+                colour,
+                *specular,
+                (*roughness, *roughness),
+                None,
+            )?,
+            MaterialDesc::RadiancePlastic2 {
+                orientation,
+                colour,
+                specular,
+                roughness_u,
+                roughness_v,
+            } => Ward::from_radiance(
+                ctx,
+                field,
+                RadianceKind::Plastic,
+                colour,
+                *specular,
+                (*roughness_u, *roughness_v),
+                Some(*orientation),
+            )?,
+            MaterialDesc::RadianceMetal2 {
+                orientation,
+                colour,
+                specular,
+                roughness_u,
+                roughness_v,
+            } => Ward::from_radiance(
+                ctx,
+                field,
+                RadianceKind::Metal,
+                colour,
+                *specular,
+                (*roughness_u, *roughness_v),
+                Some(*orientation),
+            )?,
+            _ => unreachable!("Ward::from_desc is called with Ward descriptions only"),
+        })
+    }
 }
