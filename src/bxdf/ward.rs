@@ -452,7 +452,8 @@ impl Ward {
     /// The material of a `Ward` or Radiance `plastic`/`metal`/`plastic2`/`metal2` description
     /// at `field`; any other description is a caller's error.
     pub fn from_desc(ctx: &Context, field: &str, desc: &MaterialDesc) -> Result<Self, SceneError> {
-        Ok(match desc {
+        use RadianceKind::{Metal, Plastic};
+        let (kind, colour, specular, roughness, orientation) = match desc {
             MaterialDesc::Ward {
                 diffuse,
                 specular,
@@ -460,73 +461,56 @@ impl Ward {
                 roughness_v,
                 orientation,
                 fresnel,
-            } => Ward::build(
-                ctx,
-                field,
-                diffuse,
-                specular,
-                *roughness,
-                *roughness_v,
-                *orientation,
-                *fresnel,
-            )?,
+            } => {
+                return Ward::build(
+                    ctx,
+                    field,
+                    diffuse,
+                    specular,
+                    *roughness,
+                    *roughness_v,
+                    *orientation,
+                    *fresnel,
+                )
+            }
             MaterialDesc::RadiancePlastic {
                 colour,
                 specular,
                 roughness,
-            } => Ward::from_radiance(
-                ctx,
-                field,
-                RadianceKind::Plastic,
-                colour,
-                *specular,
-                (*roughness, *roughness),
-                None,
-            )?,
+            } => (Plastic, colour, *specular, (*roughness, *roughness), None),
             MaterialDesc::RadianceMetal {
                 colour,
                 specular,
                 roughness,
-            } => Ward::from_radiance(
-                ctx,
-                field,
-                RadianceKind::Metal,
-                colour,
-                *specular,
-                (*roughness, *roughness),
-                None,
-            )?,
+            } => (Metal, colour, *specular, (*roughness, *roughness), None),
             MaterialDesc::RadiancePlastic2 {
                 orientation,
                 colour,
                 specular,
                 roughness_u,
                 roughness_v,
-            } => Ward::from_radiance(
-                ctx,
-                field,
-                RadianceKind::Plastic,
+            } => (
+                Plastic,
                 colour,
                 *specular,
                 (*roughness_u, *roughness_v),
                 Some(*orientation),
-            )?,
+            ),
             MaterialDesc::RadianceMetal2 {
                 orientation,
                 colour,
                 specular,
                 roughness_u,
                 roughness_v,
-            } => Ward::from_radiance(
-                ctx,
-                field,
-                RadianceKind::Metal,
+            } => (
+                Metal,
                 colour,
                 *specular,
                 (*roughness_u, *roughness_v),
                 Some(*orientation),
-            )?,
+            ),
             _ => unreachable!("Ward::from_desc is called with Ward descriptions only"),
-        })
+        };
+        Ward::from_radiance(ctx, field, kind, colour, specular, roughness, orientation)
     }
 }
