@@ -204,15 +204,7 @@ fn annual_metrics_and_hours_match_radiance_matrix_method() {
         "candela annual",
     );
 
-    let pkg = String::from_utf8(run(
-        Command::new(&py).args([
-            "-c",
-            "import os, pyradiance; print(os.path.dirname(pyradiance.__file__))",
-        ]),
-        "import pyradiance",
-    ))
-    .unwrap();
-    let pkg = Path::new(pkg.trim());
+    let pkg = common::pyradiance_dir();
     let path = format!(
         "{}:{}",
         pkg.join("bin").display(),

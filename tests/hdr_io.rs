@@ -5,26 +5,9 @@
 mod common;
 
 use candela::output::{read_hdr, read_hdr_luminance, read_image, write_hdr};
-use common::python;
-use std::path::{Path, PathBuf};
+use common::pyradiance_dir;
+use std::path::Path;
 use std::process::Command;
-
-/// Directory of pyradiance's package (its `bin` holds Radiance's tools, `lib` its RAYPATH).
-fn pyradiance_dir() -> PathBuf {
-    let out = Command::new(python())
-        .args([
-            "-c",
-            "import os, pyradiance; print(os.path.dirname(pyradiance.__file__))",
-        ])
-        .output()
-        .expect("run python");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    PathBuf::from(String::from_utf8(out.stdout).unwrap().trim())
-}
 
 /// Runs a Radiance tool from pyradiance; returns its standard output.
 fn radiance(tool: &str, args: &[&str]) -> String {

@@ -160,47 +160,7 @@ fn sampling_matches_eval_and_pdf_chi_square() {
             cases.push((format!("{name} θo={t}"), m.clone(), dir_deg(t, p)));
         }
     }
-    let alpha = 0.01 / cases.len() as f64;
-    let results: Vec<(usize, Chi2Result)> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..2)
-            .map(|t| {
-                let cases = &cases;
-                s.spawn(move || {
-                    (0..cases.len())
-                        .filter(|k| k % 2 == t)
-                        .map(|k| {
-                            (
-                                k,
-                                chi2_test(&cases[k].1, cases[k].2, 100_000, 18, 500 + k as u64),
-                            )
-                        })
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        let mut all: Vec<_> = handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap())
-            .collect();
-        all.sort_by_key(|r| r.0);
-        all
-    });
-    let mut failures = Vec::new();
-    for (k, r) in results {
-        let name = &cases[k].0;
-        println!(
-            "{name:45} χ² = {:8.2}  dof = {:4}  p = {:.4}  ∫pdf = {:.5}",
-            r.stat, r.dof, r.p_value, r.pdf_integral
-        );
-        if let Some(msg) = r.message {
-            failures.push(format!("{name}: {msg}"));
-        } else if r.p_value < alpha {
-            failures.push(format!("{name}: p = {} < {alpha}", r.p_value));
-        }
-        if r.pdf_integral > 1.0 + 1e-3 {
-            failures.push(format!("{name}: pdf integrates to {}", r.pdf_integral));
-        }
-    }
+    let failures = chi2_cases(&cases, 500);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

@@ -12,7 +12,6 @@
 //! reference tests do.
 
 mod common;
-use common::python;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -154,16 +153,7 @@ fn run(cmd: &mut Command, what: &str) -> Vec<u8> {
 
 /// Radiance's illuminance (lx) at each point: mean and standard error of REPLICATES rays.
 fn radiance(dir: &Path, trans: &[f64; 7]) -> Vec<(f64, f64)> {
-    let py = python();
-    let pkg = String::from_utf8(run(
-        Command::new(&py).args([
-            "-c",
-            "import os, pyradiance; print(os.path.dirname(pyradiance.__file__))",
-        ]),
-        "import pyradiance",
-    ))
-    .unwrap();
-    let pkg = PathBuf::from(pkg.trim());
+    let pkg = common::pyradiance_dir();
     let path = format!(
         "{}:{}",
         pkg.join("bin").display(),

@@ -201,23 +201,7 @@ fn sampling_matches_pdf_chi_square() {
         ward(0.4, 0.4, 0.2, 0.2),
         -dir_deg(40.0, 10.0),
     ));
-    let alpha = 0.01 / cases.len() as f64;
-    let mut failures = Vec::new();
-    for (k, (name, m, wo)) in cases.iter().enumerate() {
-        let r = chi2_test(m, *wo, 100_000, 18, 5000 + k as u64);
-        println!(
-            "{name:40} χ² = {:8.2}  dof = {:4}  p = {:.4}  ∫pdf = {:.5}",
-            r.stat, r.dof, r.p_value, r.pdf_integral
-        );
-        if let Some(msg) = r.message {
-            failures.push(format!("{name}: {msg}"));
-        } else if r.p_value < alpha {
-            failures.push(format!("{name}: p = {} < {alpha}", r.p_value));
-        }
-        if r.pdf_integral > 1.0 + 1e-3 {
-            failures.push(format!("{name}: pdf integrates to {}", r.pdf_integral));
-        }
-    }
+    let failures = chi2_cases(&cases, 5000);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
@@ -397,15 +381,7 @@ fn radiance_ratios() -> Vec<Vec<f64>> {
     use std::process::Command;
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("ward_radiance");
     std::fs::create_dir_all(&dir).unwrap();
-    let out = Command::new(common::python())
-        .args([
-            "-c",
-            "import os, pyradiance; print(os.path.dirname(pyradiance.__file__))",
-        ])
-        .output()
-        .expect("python");
-    assert!(out.status.success(), "import pyradiance failed");
-    let pkg = std::path::PathBuf::from(String::from_utf8(out.stdout).unwrap().trim());
+    let pkg = common::pyradiance_dir();
     let (st, ct) = (
         SOURCE_THETA_DEG.to_radians().sin(),
         SOURCE_THETA_DEG.to_radians().cos(),

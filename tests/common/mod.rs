@@ -311,6 +311,24 @@ pub fn python() -> std::path::PathBuf {
     p
 }
 
+/// Directory of pyradiance's package in [`python`]'s environment: its `bin` holds Radiance's
+/// tools, its `lib` their RAYPATH.
+pub fn pyradiance_dir() -> std::path::PathBuf {
+    let out = std::process::Command::new(python())
+        .args([
+            "-c",
+            "import os, pyradiance; print(os.path.dirname(pyradiance.__file__))",
+        ])
+        .output()
+        .expect("run python");
+    assert!(
+        out.status.success(),
+        "import pyradiance: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::path::PathBuf::from(String::from_utf8(out.stdout).unwrap().trim())
+}
+
 /// Runs the reference script `tests/<script>` under [`python`] with `args`, writing `input`
 /// (JSON) to its standard input when given, and returns the JSON it prints.
 pub fn python_json(
