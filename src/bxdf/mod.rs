@@ -17,6 +17,7 @@
 //! everything, is it a delta, does it pass light straight through) is one [`MaterialFlags`]
 //! value, each family's `FLAGS` (or `flags()` where roughness decides).
 
+pub mod bsdf_file;
 pub mod coated;
 pub mod conductor;
 pub mod dielectric;
@@ -37,6 +38,7 @@ use crate::description::schema::MaterialDesc;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
+pub use bsdf_file::BsdfFile;
 pub use coated::Coated;
 pub use conductor::{Conductor, ConductorAt};
 pub use dielectric::Dielectric;
@@ -79,6 +81,8 @@ pub enum Material {
     /// Translucent sheet (Radiance's `trans`): diffuse and specular reflection and
     /// transmission, straight through when smooth.
     Translucent(std::sync::Arc<Translucent>),
+    /// Scattering read from a WINDOW / Radiance BSDF XML file (Klems matrices).
+    BsdfFile(std::sync::Arc<BsdfFile>),
     /// A coat with its base reflectance already sampled at the path's wavelengths (a
     /// [`Material::MetalRough`] at one hit).
     CoatedAt(std::sync::Arc<Coated>, SampledSpectrum),
@@ -238,6 +242,9 @@ impl Material {
                     ctx, field, desc,
                 )?))
             }
+            MaterialDesc::BsdfFile { .. } => Material::BsdfFile(std::sync::Arc::new(
+                BsdfFile::from_desc(ctx, field, desc)?,
+            )),
             MaterialDesc::Black => Material::Black,
             MaterialDesc::NormalMapped {
                 material,
@@ -417,6 +424,7 @@ impl Material {
             Material::ThinDielectric(_) => ThinDielectric::FLAGS,
             Material::Coated(m) => m.flags(),
             Material::Translucent(m) => m.flags(),
+            Material::BsdfFile(_) => BsdfFile::FLAGS,
             Material::CoatedAt(m, _) => m.flags(),
             Material::Ward(m) => m.flags(),
             Material::ConductorAt(m) => m.flags(),
@@ -500,6 +508,7 @@ impl Material {
             Material::ThinDielectric(_) => SampledSpectrum::ZERO,
             Material::Coated(m) => m.eval(wo, wi, wl),
             Material::Translucent(m) => m.eval(wo, wi, wl),
+            Material::BsdfFile(m) => m.eval(wo, wi),
             Material::CoatedAt(m, rho) => m.eval_base(wo, wi, *rho),
             Material::Ward(m) => m.eval(wo, wi, wl),
             Material::ConductorAt(m) => m.eval(wo, wi),
@@ -529,6 +538,7 @@ impl Material {
             Material::ThinDielectric(m) => m.sample(wo, uc, wl),
             Material::Coated(m) => m.sample(wo, uc, u, wl),
             Material::Translucent(m) => m.sample(wo, uc, u, wl),
+            Material::BsdfFile(m) => m.sample(wo, uc, u),
             Material::CoatedAt(m, rho) => m.sample_base(wo, uc, u, *rho),
             Material::Ward(m) => m.sample(wo, uc, u, wl),
             Material::ConductorAt(m) => m.sample(wo, u),
@@ -550,6 +560,7 @@ impl Material {
             Material::ThinDielectric(_) => 0.0,
             Material::Coated(m) => m.pdf(wo, wi),
             Material::Translucent(m) => m.pdf(wo, wi),
+            Material::BsdfFile(m) => m.pdf(wo, wi),
             Material::CoatedAt(m, _) => m.pdf(wo, wi),
             Material::Ward(m) => m.pdf(wo, wi),
             Material::ConductorAt(m) => m.pdf(wo, wi),
@@ -583,6 +594,7 @@ impl Material {
     pub fn shading_frame(&self, ns: Vec3) -> Frame {
         match self {
             Material::Ward(m) => m.frame(ns),
+            Material::BsdfFile(m) => m.frame(ns),
             _ => Frame::from_normal(ns),
         }
     }

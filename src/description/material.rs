@@ -134,6 +134,11 @@ pub enum MaterialDesc {
         #[serde(default)]
         fresnel: bool,
     },
+    /// Scattering read from an LBNL WINDOW / Radiance BSDF XML file of Klems matrices
+    /// (docs/fenestration.md): `file` relative to the scene; `up` (scene coordinates) orients
+    /// the file's azimuths as Radiance's `BSDF` primitive does (the file's X axis is
+    /// up × normal). The surface normal points into the room (WINDOW's back).
+    BsdfFile { file: String, up: [f32; 3] },
     /// Radiance's `trans` material: `colour` (red green blue), `specular` (spec), `roughness`
     /// (rough), `transmissivity` (trans), `transmitted_specular` (tspec); converted to a
     /// `Translucent` (docs/fenestration.md).
