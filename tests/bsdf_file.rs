@@ -78,7 +78,12 @@ fn sampling_matches_eval_and_pdf_chi_square() {
         "klems_full_lobe.xml",
     ] {
         let m = Material::BsdfFile(Arc::new(load(name)));
-        for (t, p) in [(3.0f32, 10.0f32), (40.0, 120.0), (80.0, 300.0), (130.0, 30.0)] {
+        for (t, p) in [
+            (3.0f32, 10.0f32),
+            (40.0, 120.0),
+            (80.0, 300.0),
+            (130.0, 30.0),
+        ] {
             cases.push((format!("{name} θo={t}"), m.clone(), dir_deg(t, p)));
         }
     }
@@ -107,7 +112,10 @@ fn sample_weights_are_the_row_sums_and_never_exceed_one() {
     for name in KLEMS {
         let m = load(name);
         for k in 0..400 {
-            let wi = dir(89.0 * (k % 20) as f64 / 19.0, 360.0 * (k / 20) as f64 / 20.0);
+            let wi = dir(
+                89.0 * (k % 20) as f64 / 19.0,
+                360.0 * (k / 20) as f64 / 20.0,
+            );
             for w in [wi, -wi] {
                 let (r, t) = m.reflected_transmitted(w);
                 assert!(r + t <= 1.01, "{name} from {w}: ρ {r} + τ {t}");
@@ -144,6 +152,29 @@ fn uniform_sky(l: f64) -> String {
     )
 }
 
+/// Σ_o Λ_o Σ_i f[o][i] Λ_i of the file's 'Transmission Front' block: the illuminance under an
+/// infinite pane of it in a uniform sky of unit luminance.
+fn double_sum(name: &str) -> f64 {
+    use candela::bxdf::bsdf_file::{klems::KlemsMatrix, xml};
+    let parsed = xml::read(&data(name)).unwrap();
+    let b = parsed
+        .blocks
+        .into_iter()
+        .find(|b| b.block == xml::Block::TransToPos)
+        .unwrap();
+    let (inc, out) = b.bases.unwrap();
+    let m = KlemsMatrix::new(inc, out, b.values);
+    let (ni, no) = (m.inc.len(), m.out.len());
+    (0..no)
+        .map(|o| {
+            m.out.proj_sr(o) as f64
+                * (0..ni)
+                    .map(|i| m.f[o * ni + i] as f64 * m.inc.proj_sr(i) as f64)
+                    .sum::<f64>()
+        })
+        .sum()
+}
+
 /// The share of a horizontal meter's cosine-weighted hemisphere that a 2a × 2a square centred
 /// 1 m above it fills.
 fn square_view_factor(a: f64) -> f64 {
@@ -161,16 +192,19 @@ fn a_meter_under_a_pane_in_a_uniform_sky_gets_the_files_transmission() {
     let f = square_view_factor(1000.0);
     for (name, flip, tau) in [
         ("klems_quarter_diffuse.xml", false, 0.1592 * PI),
+        (
+            "klems_half_lobe.xml",
+            false,
+            double_sum("klems_half_lobe.xml") / PI,
+        ),
         ("klems_full_clear.xml", false, 1.0),
         // Sky on the file's exterior (−Z) side: Transmission Front, 0.4; turned over (sky on
         // +Z): Transmission Back, 0.2.
         ("klems_quarter_sides.xml", false, 0.4),
         ("klems_quarter_sides.xml", true, 0.2),
     ] {
-        let material = format!(
-            "BsdfFile(file: \"tests/data/bsdf/{name}\", up: (0, 0, 1))"
-        );
-        let e = meter_under(&material, flip, &uniform_sky(l), 1 << 15);
+        let material = format!("BsdfFile(file: \"tests/data/bsdf/{name}\", up: (0, 0, 1))");
+        let e = meter_under(&material, flip, &uniform_sky(l), 1 << 18);
         let expected = PI * l * (f * tau + 1.0 - f);
         println!(
             "{name} (flipped: {flip}): E = {:.3} ± {:.3} lx, expected {expected:.3} lx",
@@ -313,7 +347,111 @@ fn scene_errors_name_the_material_field() {
             .to_string()
     };
     let e = build("BsdfFile(file: \"tests/data/bsdf/nope.xml\", up: (0, 0, 1))");
-    assert!(e.contains("materials[\"blind\"].file") && e.contains("nope.xml"), "{e}");
+    assert!(
+        e.contains("materials[\"blind\"].file") && e.contains("nope.xml"),
+        "{e}"
+    );
     let e = build("BsdfFile(file: \"tests/data/bsdf/klems_quarter_diffuse.xml\", up: (0, 0, 0))");
     assert!(e.contains("materials[\"blind\"].up"), "{e}");
+}
+
+#[test]
+fn the_sun_through_a_window_lights_the_work_plane_as_the_file_tabulates() {
+    // A 2 m × 1.2 m window of the lobe file in the plane y = 0 (normal +y into the room, up
+    // +z), the sun outside, nothing else: each point of the window sends the sun's light
+    // toward a meter as L = f(wo, sun) E⊥ |cos θi|, so E = E⊥ |cos θi| ∫ f cos θw cos θm / r² dA
+    // over the window, here by the midpoint rule on 1200 × 720 cells (the file is constant
+    // within each pair of patches; the cells that straddle a patch border err by < 0.1 %).
+    let m = load("klems_half_lobe.xml");
+    let n = Vec3::Y;
+    let frame = BsdfFile::load(&data("klems_half_lobe.xml"), Vec3::Z)
+        .unwrap()
+        .frame(n);
+    let sun = Vec3::new(0.3, -0.8, 0.5).normalize();
+    let e_n = 80_000.0;
+    let wi = frame.to_local(sun);
+    let points = [Vec3::new(2.0, 1.0, 0.8), Vec3::new(2.0, 2.0, 0.8)];
+    let (nx, nz) = (1200, 720);
+    let da = (2.0 / nx as f64) * (1.2 / nz as f64);
+    let by_quadrature = |p: &Vec3, jitter: f32| {
+        let mut sum = 0.0f64;
+        for ix in 0..nx {
+            for iz in 0..nz {
+                let x = Vec3::new(
+                    1.0 + 2.0 * (ix as f32 + 0.5) / nx as f32,
+                    0.0,
+                    0.9 + 1.2 * (iz as f32 + 0.5) / nz as f32,
+                );
+                let d = *p - x;
+                let r2 = d.length_squared() as f64;
+                let wo_world = d.normalize();
+                let cos_m = (-wo_world.z) as f64;
+                if cos_m <= 0.0 {
+                    continue;
+                }
+                let wo = frame.to_local(wo_world);
+                let f = if jitter > 0.0 {
+                    // Radiance's direct calculation averages f over view directions
+                    // moved by up to ±jitter/2 in x and y (m_bsdf.c bsdf_jitter).
+                    let mut acc = 0.0f64;
+                    for k in 0..16 {
+                        let (a, b) = ((k % 4) as f32 + 0.5, (k / 4) as f32 + 0.5);
+                        let v = Vec3::new(
+                            wo.x + jitter * (a / 4.0 - 0.5),
+                            wo.y + jitter * (b / 4.0 - 0.5),
+                            wo.z,
+                        )
+                        .normalize();
+                        acc += m.value(v, wi) as f64 / 16.0;
+                    }
+                    acc
+                } else {
+                    m.value(wo, wi) as f64
+                };
+                sum += f * wo_world.y as f64 * cos_m / r2 * da;
+            }
+        }
+        e_n * wi.z.abs() as f64 * sum
+    };
+    let expected: Vec<f64> = points.iter().map(|p| by_quadrature(p, 0.0)).collect();
+    // √ of the half basis' smallest projected solid angle, 0.0343 sr.
+    let blurred: Vec<f64> = points.iter().map(|p| by_quadrature(p, 0.185)).collect();
+    let meters: Vec<String> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            format!(
+                "Illuminance(name: \"p{i}\", position: ({}, {}, {}), normal: (0, 0, 1))",
+                p.x, p.y, p.z
+            )
+        })
+        .collect();
+    let w = world(&format!(
+        r#"(
+        camera: (position: (2, 3.5, 1.5), look_at: (2, 0, 1.5), up: (0, 0, 1), vfov_deg: 60, resolution: (1, 1)),
+        render: (spp: 1),
+        materials: {{ "win": BsdfFile(file: "tests/data/bsdf/klems_half_lobe.xml", up: (0, 0, 1)) }},
+        objects: [(shape: Quad(origin: (1, 0, 0.9), edge_u: (0, 0, 1.2), edge_v: (2, 0, 0)), material: "win")],
+        lights: [Distant(direction: ({}, {}, {}), spectrum: Named("E"), amount: Illuminance({e_n}))],
+        meters: [{}],
+        measure: (samples: {}),
+    )"#,
+        -sun.x,
+        -sun.y,
+        -sun.z,
+        meters.join(", "),
+        1 << 20
+    ));
+    let ours = measure_all(&w).meters;
+    for (i, (e, want)) in ours.iter().zip(&expected).enumerate() {
+        println!(
+            "p{i}: E = {:.2} ± {:.2} lx, the file by quadrature {want:.2} lx (with Radiance's \
+             jitter of the view direction {:.2} lx, {:+.2} %)",
+            e.mean,
+            e.stderr,
+            blurred[i],
+            100.0 * (blurred[i] / want - 1.0)
+        );
+        assert_estimate_near(e.mean, e.stderr, *want, 0.01, "sun through a window");
+    }
 }

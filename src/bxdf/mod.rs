@@ -242,9 +242,9 @@ impl Material {
                     ctx, field, desc,
                 )?))
             }
-            MaterialDesc::BsdfFile { .. } => Material::BsdfFile(std::sync::Arc::new(
-                BsdfFile::from_desc(ctx, field, desc)?,
-            )),
+            MaterialDesc::BsdfFile { .. } => {
+                Material::BsdfFile(std::sync::Arc::new(BsdfFile::from_desc(ctx, field, desc)?))
+            }
             MaterialDesc::Black => Material::Black,
             MaterialDesc::NormalMapped {
                 material,

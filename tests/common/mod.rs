@@ -1,6 +1,7 @@
 //! Helpers shared by the render tests: build a world from RON text, render, summarise.
 #![allow(dead_code)]
 
+pub mod radiance_room;
 pub mod weather;
 
 use candela::film::Film;

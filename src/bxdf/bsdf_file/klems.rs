@@ -323,7 +323,10 @@ impl KlemsMatrix {
     pub fn incident_angles_deg(&self, i: usize) -> (f64, f64) {
         let v = self.inc.centre(i);
         let theta = (v.z as f64).acos().to_degrees();
-        let phi = (v.y as f64).atan2(v.x as f64).to_degrees().rem_euclid(360.0);
+        let phi = (v.y as f64)
+            .atan2(v.x as f64)
+            .to_degrees()
+            .rem_euclid(360.0);
         (theta, phi)
     }
 }
@@ -342,7 +345,10 @@ mod tests {
             let b = KlemsBasis::standard(name).unwrap();
             assert_eq!(b.len(), n, "{name}");
             let total: f64 = (0..n).map(|i| b.proj_sr(i) as f64).sum();
-            assert!((total - std::f64::consts::PI).abs() < 1e-5, "{name}: {total}");
+            assert!(
+                (total - std::f64::consts::PI).abs() < 1e-5,
+                "{name}: {total}"
+            );
         }
         assert!(KlemsBasis::standard("LBNL/Klems Eighth").is_none());
     }
@@ -351,7 +357,11 @@ mod tests {
     fn sampled_points_fall_in_their_own_patch() {
         let b = KlemsBasis::standard("LBNL/Klems Full").unwrap();
         for i in 0..b.len() {
-            for u in [Vec2::new(0.01, 0.02), Vec2::new(0.5, 0.5), Vec2::new(0.98, 0.97)] {
+            for u in [
+                Vec2::new(0.01, 0.02),
+                Vec2::new(0.5, 0.5),
+                Vec2::new(0.98, 0.97),
+            ] {
                 assert_eq!(b.index(b.sample(i, u)), i, "patch {i} at {u}");
             }
         }

@@ -91,7 +91,8 @@ fn at(path: &Path, doc: &roxmltree::Document, node: roxmltree::Node, msg: &str) 
 }
 
 fn child<'a, 'i>(n: roxmltree::Node<'a, 'i>, name: &str) -> Option<roxmltree::Node<'a, 'i>> {
-    n.children().find(|c| c.is_element() && c.tag_name().name() == name)
+    n.children()
+        .find(|c| c.is_element() && c.tag_name().name() == name)
 }
 
 fn children<'a, 'i: 'a>(
@@ -165,8 +166,7 @@ pub fn parse(path: &Path, source: &str) -> Result<ParsedFile, String> {
         skipped: Vec::new(),
     };
     for wd in children(layer, "WavelengthData") {
-        let wl = child(wd, "Wavelength")
-            .ok_or_else(|| at(path, &doc, wd, "no <Wavelength>"))?;
+        let wl = child(wd, "Wavelength").ok_or_else(|| at(path, &doc, wd, "no <Wavelength>"))?;
         let name = text(wl);
         if !name.eq_ignore_ascii_case("Visible") {
             let shown = crate::limits::printable(name, 40);
@@ -229,7 +229,10 @@ fn custom_basis(
                     path,
                     doc,
                     n,
-                    &format!("{:?} is not a number", crate::limits::printable(text(n), 40)),
+                    &format!(
+                        "{:?} is not a number",
+                        crate::limits::printable(text(n), 40)
+                    ),
                 )
             })
         };
@@ -294,8 +297,8 @@ fn data_block(
             ))
         }
     };
-    let data = child(db, "ScatteringData")
-        .ok_or_else(|| at(path, doc, db, "no <ScatteringData>"))?;
+    let data =
+        child(db, "ScatteringData").ok_or_else(|| at(path, doc, db, "no <ScatteringData>"))?;
     let data_line = doc.text_pos_at(data.range().start).row;
     let line = doc.text_pos_at(db.range().start).row;
     if let Layout::Tree(_) = layout {
