@@ -474,6 +474,36 @@ pub enum ShapeDesc {
         #[serde(default)]
         lights: bool,
     },
+    /// Venetian blinds, expanded to triangles (`geometry::blinds`): Radiance's `genblinds`
+    /// with its axes X, Y, Z along `out`, `width_dir`, `up` and its origin at `origin`.
+    /// Lengths in metres; give `spacing` or `count`.
+    Blinds {
+        origin: V3,
+        /// Along the slats (genblinds' +Y).
+        width_dir: V3,
+        /// Up the stack of slats (genblinds' +Z), perpendicular to `width_dir`.
+        up: V3,
+        /// Normal of the blinds' plane toward which the slats reach from `origin` (genblinds' +X).
+        out: V3,
+        width: f64,
+        height: f64,
+        /// Slat depth (chord of a curved slat), m.
+        depth: f64,
+        /// Distance between slats, m (the count is height / spacing, rounded).
+        #[serde(default)]
+        spacing: Option<f64>,
+        #[serde(default)]
+        count: Option<u32>,
+        /// Slat tilt, degrees in [-90, 90]: a positive angle lifts the slats' `out` edge.
+        angle_deg: f64,
+        /// Radius of curvature of the slats' cross-section, m (genblinds' `-r`: positive puts
+        /// the centre of curvature on the `up` side); `None` for flat slats.
+        #[serde(default)]
+        curvature_radius: Option<f64>,
+        /// Slat thickness, m: only 0 (slats are two-sided surfaces, as genblinds makes them).
+        #[serde(default)]
+        thickness: f64,
+    },
     /// One mesh (`Obj`, `Ply`, `Triangles` or `Model`) stored once and placed at each of
     /// `transforms` (each applied before the object's own `transform`).
     Instances {

@@ -123,6 +123,9 @@ impl Shape {
                 }
                 Shape::Mesh(mesh)
             }
+            ShapeDesc::Blinds { .. } => {
+                Shape::Mesh(super::Blinds::from_desc(ctx, field, desc)?.mesh())
+            }
             ShapeDesc::Obj(rel) => {
                 let (mesh, libraries) = super::io::load_obj_and_libraries(&ctx.resolve(rel))
                     .map_err(|e| mesh_err(ctx, field, rel, e))?;

@@ -33,6 +33,7 @@
 //! let pdf_light = geo.pdf_prim_solid_angle(lp, hit.p, &lh); // same `reference` as when sampling
 //! ```
 
+pub mod blinds;
 mod bvh;
 mod desc;
 pub mod gltf;
@@ -50,6 +51,7 @@ mod tangent;
 mod traverse;
 mod wide;
 
+pub use blinds::Blinds;
 pub use bvh::BUILD_PEAK_BYTES_PER_PRIM;
 pub(crate) use desc::mesh_err;
 pub use instance::{InstanceGroup, NO_INSTANCE};
