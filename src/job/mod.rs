@@ -262,6 +262,9 @@ pub fn run(
 ) -> Result<RenderOutputs> {
     check_job(job)?;
     let (world, hash) = load_scene(job)?;
+    for note in world.load_notes() {
+        progress.warning(&note);
+    }
     let paths = JobPaths::new(job)?;
     let plan = StatePlan::checked(job, &world, &paths)?;
     let prog = progressive(job, &world);

@@ -101,6 +101,23 @@ pub struct World {
 }
 
 impl World {
+    /// What reading the scene's data files noted for the user (data a file holds that is not
+    /// used, a direction made by reciprocity), each naming its file.
+    pub fn load_notes(&self) -> Vec<String> {
+        self.materials
+            .iter()
+            .filter_map(|m| match m {
+                crate::bxdf::Material::BsdfFile(f) => Some(f),
+                _ => None,
+            })
+            .flat_map(|f| {
+                f.notes
+                    .iter()
+                    .map(|n| format!("BSDF file '{}': {n}", f.path.display()))
+            })
+            .collect()
+    }
+
     /// The same world lit by `lights` instead (lights at infinity: skies, suns, environments;
     /// objects emit nothing afterwards). Daylight coefficients use it to light one geometry by
     /// a unit sky, then by each hour's sun, without building it again. Light-traced caustics
