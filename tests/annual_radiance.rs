@@ -46,7 +46,7 @@
 //! test fails, as the other reference tests do.
 
 mod common;
-use common::python;
+use common::{python, run};
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -81,18 +81,6 @@ const RADIANCE_REL_SE: [f64; 2] = [0.0071, 0.038];
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn run(cmd: &mut Command, what: &str) -> Vec<u8> {
-    let t0 = std::time::Instant::now();
-    let out = cmd.output().unwrap_or_else(|e| panic!("{what}: {e}"));
-    assert!(
-        out.status.success(),
-        "{what} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    eprintln!("{what}: {:.1} s", t0.elapsed().as_secs_f64());
-    out.stdout
 }
 
 /// (direct-normal, diffuse-horizontal) irradiance of each of the 8760 records.

@@ -566,3 +566,16 @@ pub fn gauss(seed: u64, i: u64) -> f64 {
     let u2 = (b >> 11) as f64 / (1u64 << 53) as f64;
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
+
+/// Run `cmd`, panicking with `what` and its error output if it fails; its standard output.
+pub fn run(cmd: &mut std::process::Command, what: &str) -> Vec<u8> {
+    let t0 = std::time::Instant::now();
+    let out = cmd.output().unwrap_or_else(|e| panic!("{what}: {e}"));
+    assert!(
+        out.status.success(),
+        "{what} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    eprintln!("{what}: {:.1} s", t0.elapsed().as_secs_f64());
+    out.stdout
+}

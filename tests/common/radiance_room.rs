@@ -7,6 +7,7 @@
 //! Radiance's standard error at each point comes from the spread of independent rtrace rays
 //! (-u+) at the point, candela's from its meter.
 
+use super::run;
 use std::path::Path;
 use std::process::Command;
 
@@ -180,19 +181,6 @@ pub fn candela_scene(w: &Window, sky: f64, sun: Option<Sun>, samples: u64) -> St
         lights.join(", "),
         meters.join(", ")
     )
-}
-
-/// Run `cmd`, panicking with `what` and its error output if it fails; its standard output.
-pub fn run(cmd: &mut Command, what: &str) -> Vec<u8> {
-    let t0 = std::time::Instant::now();
-    let out = cmd.output().unwrap_or_else(|e| panic!("{what}: {e}"));
-    assert!(
-        out.status.success(),
-        "{what} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    eprintln!("{what}: {:.1} s", t0.elapsed().as_secs_f64());
-    out.stdout
 }
 
 /// Radiance's illuminance (lx) at each point: mean and standard error of `replicates` rays,

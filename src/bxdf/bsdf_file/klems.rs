@@ -306,17 +306,23 @@ impl KlemsMatrix {
     /// Largest hemispherical sum Σ_o f[o][i] Λ_o over the incident patches i (what a ray
     /// arriving through patch i scatters in all), with that patch.
     pub fn max_hemispherical(&self) -> (f64, usize) {
-        let (ni, no) = (self.inc.len(), self.out.len());
         let mut best = (0.0f64, 0usize);
-        for i in 0..ni {
-            let s: f64 = (0..no)
-                .map(|o| self.f[o * ni + i] as f64 * self.out.proj_sr(o) as f64)
-                .sum();
+        for i in 0..self.inc.len() {
+            let s = self.hemispherical(i);
             if s > best.0 {
                 best = (s, i);
             }
         }
         best
+    }
+
+    /// Σ_o f[o][i] Λ_o: the fraction of light arriving through incident patch `i` that the
+    /// matrix scatters.
+    pub fn hemispherical(&self, i: usize) -> f64 {
+        let ni = self.inc.len();
+        (0..self.out.len())
+            .map(|o| self.f[o * ni + i] as f64 * self.out.proj_sr(o) as f64)
+            .sum()
     }
 
     /// The polar and azimuth angles (degrees) of the centre of incident patch `i`.

@@ -119,7 +119,7 @@ impl BsdfFile {
             if let (Some(r), Some(t)) = (&blocks[refl.slot()], &blocks[trans.slot()]) {
                 if r.inc.name == t.inc.name {
                     let worst = (0..r.inc.len())
-                        .map(|i| hemispherical(r, i) + hemispherical(t, i))
+                        .map(|i| r.hemispherical(i) + t.hemispherical(i))
                         .fold(0.0f64, f64::max);
                     if worst > MAX_HEMISPHERICAL {
                         return Err(format!(
@@ -222,7 +222,7 @@ impl BsdfFile {
         };
         let sum = |b: Block| {
             self.block(b)
-                .map_or(0.0, |m| hemispherical(m, m.inc.index(a)))
+                .map_or(0.0, |m| m.hemispherical(m.inc.index(a)))
         };
         (sum(refl), sum(trans))
     }
@@ -248,7 +248,10 @@ impl BsdfFile {
             return None;
         }
         let (r, t, b) = self.rows(wo);
-        let (sr, st) = self.row_sums(wo);
+        let (sr, st) = (
+            r.map_or(0.0, |m| m.row_sum(b)),
+            t.map_or(0.0, |m| m.row_sum(b)),
+        );
         let total = sr + st;
         if total <= 0.0 {
             return None;
@@ -273,12 +276,4 @@ impl BsdfFile {
             specular: false,
         })
     }
-}
-
-/// Σ_o f[o][i] Λ_o for incident patch `i`.
-fn hemispherical(m: &KlemsMatrix, i: usize) -> f64 {
-    let ni = m.inc.len();
-    (0..m.out.len())
-        .map(|o| m.f[o * ni + i] as f64 * m.out.proj_sr(o) as f64)
-        .sum()
 }
